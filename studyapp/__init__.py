@@ -1,0 +1,7 @@
+"""studyapp: velocity estimation studies for audio-haptic stick-slip simulation.
+
+After Sinclair, Wanderley and Hayward, "Velocity Estimation Algorithms for
+Audio-Haptic Simulations Involving Stick-Slip", IEEE Trans. Haptics 7(4), 2014.
+"""
+
+__version__ = "0.1.0"

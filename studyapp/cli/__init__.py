@@ -1,0 +1,70 @@
+"""The ``studyapp`` command line.
+
+Each sub-command lives in its own module of this package with two functions:
+``register(subparsers)`` adds its parser (argparse only, so start-up stays fast)
+and sets ``func``; the function imports what it needs and returns an exit code.
+A ``UserError`` becomes one line on stderr and exit code 2.
+"""
+
+import argparse
+import importlib
+import sys
+
+from studyapp import __version__
+from studyapp.errors import UserError
+
+# Module names under studyapp.cli, in the order shown by --help. A module that
+# does not exist yet is skipped, so layers can land one at a time.
+COMMANDS = [
+    "gui",
+    "demo",
+    "estimators",
+    "estimate",
+    "simulate",
+    "simulate_set",
+    "optimise",
+    "evaluate",
+    "tradeoff",
+    "live",
+    "run",
+    "export",
+    "analyse",
+    "bench",
+]
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(
+        prog="studyapp",
+        description="Velocity estimation studies for audio-haptic stick-slip simulation.",
+    )
+    parser.add_argument("--version", action="version", version=f"studyapp {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        try:
+            module = importlib.import_module(f"studyapp.cli.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"studyapp.cli.{name}":
+                continue
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv=None):
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        if "gui" in parser._subparsers._group_actions[0].choices:
+            args = parser.parse_args(["gui"])
+        else:
+            parser.print_help()
+            return 0
+    try:
+        return args.func(args) or 0
+    except UserError as exc:
+        print(f"studyapp: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("studyapp: interrupted", file=sys.stderr)
+        return 130

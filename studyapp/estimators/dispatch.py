@@ -1,0 +1,106 @@
+"""Compiled dispatch: one sample, one block, or a bank of estimators.
+
+Every kernel has the signature ``step(s, p, x, a, v) -> v_hat``: ``s`` is its
+state (float64, starts as zeros, changed in place), ``p`` its parameters
+(float64, read only), and ``x``, ``a``, ``v`` the position, acceleration and
+tachometer velocity samples (0.0 when not measured).
+
+Bad input policy (one policy for every estimator). A non-finite sample (NaN or
+inf) in any input is replaced by the last finite sample of that input (0.0
+before the first one) and counted; the kernel never sees it, so a bad sample
+can never poison later output. The first ``GUARD`` slots of every state vector
+hold ``[last_x, last_a, last_v, bad_count]``; the kernel's own state follows.
+
+The block form ``run_block`` is the streaming form ``step_guarded`` in a
+compiled loop, so its output equals per-sample stepping exactly for any split
+of the input into blocks.
+"""
+
+import numpy as np
+from numba import njit
+
+from studyapp.estimators import (
+    bdiff, complementary, foaw, hybrids, kalman, kinds, leastsq, levant, lowpass, lvt,
+)
+
+GUARD = 4
+
+
+@njit(cache=True)
+def step_any(kind, s, p, x, a, v):
+    """One step of the kernel ``kind`` (no input guard)."""
+    if kind == kinds.BDIFF:
+        return bdiff.step(s, p, x, a, v)
+    elif kind == kinds.LOWPASS:
+        return lowpass.step(s, p, x, a, v)
+    elif kind == kinds.LEASTSQ:
+        return leastsq.step(s, p, x, a, v)
+    elif kind == kinds.FOAW:
+        return foaw.step(s, p, x, a, v)
+    elif kind == kinds.LEVANT:
+        return levant.step_levant(s, p, x, a, v)
+    elif kind == kinds.LEVANTLP:
+        return levant.step_levantlp(s, p, x, a, v)
+    elif kind == kinds.KALPOS:
+        return kalman.step_kalpos(s, p, x, a, v)
+    elif kind == kinds.KALMAN:
+        return kalman.step_kalman(s, p, x, a, v)
+    elif kind == kinds.KALLEV:
+        return hybrids.step_kallev(s, p, x, a, v)
+    elif kind == kinds.KALLEVACC:
+        return hybrids.step_kallevacc(s, p, x, a, v)
+    elif kind == kinds.KALFOAW:
+        return hybrids.step_kalfoaw(s, p, x, a, v)
+    elif kind == kinds.KALFOAWACC:
+        return hybrids.step_kalfoawacc(s, p, x, a, v)
+    elif kind == kinds.COMP1 or kind == kinds.COMP2:
+        return complementary.step(s, p, x, a, v)
+    elif kind == kinds.LVT:
+        return lvt.step(s, p, x, a, v)
+    return 0.0
+
+
+@njit(cache=True)
+def step_guarded(kind, s, p, x, a, v):
+    """One step with the bad-input policy applied (the streaming form)."""
+    bad = False
+    if np.isfinite(x):
+        s[0] = x
+    else:
+        x = s[0]
+        bad = True
+    if np.isfinite(a):
+        s[1] = a
+    else:
+        a = s[1]
+        bad = True
+    if np.isfinite(v):
+        s[2] = v
+    else:
+        v = s[2]
+        bad = True
+    if bad:
+        s[3] += 1.0
+    return step_any(kind, s[GUARD:], p, x, a, v)
+
+
+@njit(cache=True)
+def run_block(kind, s, p, xs, acc, vel, out):
+    """The block form: ``out[i] = step_guarded(...)`` for every sample."""
+    for i in range(xs.shape[0]):
+        out[i] = step_guarded(kind, s, p, xs[i], acc[i], vel[i])
+
+
+@njit(cache=True)
+def run_bank(kind_ids, states, params, xs, acc, vel, out):
+    """Advance every estimator of a bank over one block; row e of ``out`` is estimator e.
+
+    Estimators that are not in the loop only observe the stream, so each can
+    run its whole block in turn: the output equals per-sample interleaving.
+    """
+    for e in range(kind_ids.shape[0]):
+        kind = kind_ids[e]
+        s = states[e]
+        p = params[e]
+        for i in range(xs.shape[0]):
+            out[e, i] = step_guarded(kind, s, p, xs[i], acc[i], vel[i])

@@ -1,0 +1,32 @@
+"""LVT: the tachometer's measured velocity, passed through unchanged.
+
+The paper's linear velocity transducer (Trans-Tek Series 100, flat to 500 Hz,
+0.115 mm/s RMS noise at rest; Sec. 4.2) needs no estimation: it is the
+reference condition of the study (Sec. 8.4).
+"""
+
+from numba import njit
+
+from studyapp.estimators import kinds
+from studyapp.estimators.spec import EstimatorSpec
+
+
+def build(rate, params):
+    import numpy as np
+
+    return np.zeros(1), 1
+
+
+@njit(cache=True)
+def step(s, p, x, a, v):
+    return v
+
+
+SPEC = EstimatorSpec(
+    name="LVT",
+    kind=kinds.LVT,
+    description="The measured tachometer velocity, passed through.",
+    inputs=("velocity",),
+    build=build,
+    reference="paper Sec. 4.2 and 8.4",
+)
