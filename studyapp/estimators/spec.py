@@ -18,7 +18,7 @@ from studyapp.errors import ParameterError
 
 RATE_MIN = 1_000.0
 RATE_MAX = 96_000.0
-NYQUIST_FRACTION = 0.45  # cut-offs must stay below this fraction of the rate
+NYQUIST_FRACTION = 0.49  # cut-offs must stay below this fraction of the rate (Table 1 has 2,254 Hz at 5 kHz)
 
 INPUTS = ("position", "acceleration", "velocity")
 

@@ -1,0 +1,30 @@
+"""``studyapp bench estimators|loop|live``: speed, measured (medians), never asserted in tests."""
+
+
+def register(sub):
+    parser = sub.add_parser("bench", help="measure speed: estimators, closed loop, live engine")
+    kinds = parser.add_subparsers(dest="bench", metavar="WHAT", required=True)
+
+    p = kinds.add_parser("estimators", help="ns per sample of every estimator and of the bank")
+    p.add_argument("--rate", type=float, default=48_000.0, help="sample rate in Hz (default 48000)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.estimators.benchmark"))
+
+    p = kinds.add_parser("loop", help="closed-loop throughput with all fourteen estimators")
+    p.add_argument("--rate", type=float, default=48_000.0, help="sample rate in Hz (default 48000)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.model.benchmark"))
+
+    p = kinds.add_parser("live", help="highest rate the live engine holds in real time")
+    p.add_argument("--seconds", type=float, default=30.0, help="confirmation run length (default 30)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.engine.benchmark"))
+
+
+def _run(module):
+    def run(args):
+        import importlib
+
+        return importlib.import_module(module).run_cli(args)
+
+    return run

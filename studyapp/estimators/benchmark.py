@@ -1,0 +1,102 @@
+"""What each estimator costs: nanoseconds per sample, medians of repeated runs.
+
+Two forms are timed on a synthetic stick-slip signal (``studyapp.synthetic``):
+
+- block: ``Estimator.process`` called from Python on consecutive blocks of
+  ``block`` samples (the haptic loop's block size), so the per-call overhead of
+  a real block-wise caller is included;
+- stream: the compiled streaming step (``dispatch.step_guarded``) called once
+  per sample inside a compiled loop, as the closed loop calls it.
+
+The bank figure is ``Bank.process`` with every position/acceleration estimator
+(all but LVT) on the same blocks. Timings are wall-clock medians: run on an
+otherwise idle machine, and don't compare figures across machines.
+"""
+
+import json
+import statistics
+import sys
+import time
+
+import numpy as np
+from numba import njit
+
+from studyapp import estimators
+from studyapp.estimators.dispatch import step_guarded
+from studyapp.estimators.spec import validate_rate
+from studyapp.synthetic import stick_slip
+
+BLOCK = 256
+
+
+@njit(cache=True)
+def _stream(kind, s, p, xs, acc, vel, out):
+    for i in range(xs.shape[0]):
+        out[i] = step_guarded(kind, s, p, xs[i], acc[i], vel[i])
+
+
+def _signal(rate, n):
+    sig = stick_slip(rate, n / rate)
+    return sig["position"], sig["acceleration"], sig["velocity_lvt"]
+
+
+def _median_ns(fn, n, repeats):
+    fn()  # compile and warm caches
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter_ns()
+        fn()
+        times.append(time.perf_counter_ns() - start)
+    return statistics.median(times) / n
+
+
+def _blockwise(process, x, a, v, block):
+    def run():
+        for i in range(0, x.shape[0], block):
+            process(x[i:i + block], a[i:i + block], v[i:i + block])
+    return run
+
+
+def cost(name, rate, params=None, n=100_000, repeats=5, block=BLOCK):
+    """Median ns/sample of estimator ``name`` in its block and streaming forms."""
+    x, a, v = _signal(rate, n)
+    est = estimators.create(name, rate, **(params or {}))
+    block_ns = _median_ns(_blockwise(est.process, x, a, v, block), n, repeats)
+    out = np.empty(n)
+    stream_ns = _median_ns(lambda: _stream(est.kind, est.state, est.p, x, a, v, out), n, repeats)
+    return {"block_ns_per_sample": block_ns, "stream_ns_per_sample": stream_ns}
+
+
+def bank_cost(rate, names=None, n=100_000, repeats=5, block=BLOCK):
+    """Median ns/sample of a Bank of ``names`` (default: all but LVT) on blocks."""
+    names = names or [e for e in estimators.names() if e != "LVT"]
+    x, a, v = _signal(rate, n)
+    bank = estimators.Bank(rate, names)
+    return _median_ns(_blockwise(bank.process, x, a, v, block), n, repeats)
+
+
+def run(rate, progress=True):
+    result = {"rate": rate, "estimators": {}}
+    for name in estimators.names():
+        if progress:
+            print(f"bench estimators: {name} ...", file=sys.stderr, flush=True)
+        result["estimators"][name] = cost(name, rate)
+    if progress:
+        print("bench estimators: bank of all fourteen ...", file=sys.stderr, flush=True)
+    result["bank_ns_per_sample"] = bank_cost(rate)
+    return result
+
+
+def run_cli(args):
+    rate = validate_rate(args.rate)
+    result = run(rate)
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    print(f"estimator cost at {rate:g} Hz (median ns per sample)")
+    print(f"{'name':<12}{'block':>10}{'stream':>10}")
+    for name, r in result["estimators"].items():
+        print(f"{name:<12}{r['block_ns_per_sample']:>10.1f}{r['stream_ns_per_sample']:>10.1f}")
+    bank = result["bank_ns_per_sample"]
+    print(f"bank of all fourteen: {bank:.1f} ns/sample = {1e9 / bank / rate:.1f}x real time at {rate:g} Hz")
+    return 0
