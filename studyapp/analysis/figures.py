@@ -1,0 +1,141 @@
+"""The paper's figures from a ``StudyAnalysis``: Fig. 7 and 8 box plots, Fig. 9 scatter.
+
+Figures are ``matplotlib.figure.Figure`` objects built without pyplot, so the
+same drawing code renders to files (Agg, PNG and SVG) and into the GUI's Qt
+canvas. Boxes follow matplotlib's defaults (median line, quartile box,
+whiskers to the furthest sample within 1.5 IQR of the box); every sample is
+drawn over its box, outliers included, so no separate outlier marks. Conditions run best first, left to right, as in
+the paper. The letters above the boxes are the compact letter display of the
+pairwise rank-sum tests (compact_letters.py): two conditions sharing a letter
+are not significantly different.
+"""
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.transforms import blended_transform_factory
+
+from studyapp.atomic import atomic_path
+
+FORMATS = ("png", "svg")
+_SIZE = (7.5, 4.8)
+
+
+def draw_adjustment(figure, study):
+    """Fig. 7: maximum friction force F_max per condition (adjustment task)."""
+    _draw_box_plot(
+        figure,
+        study.adjustment,
+        study,
+        ylabel="max $F_{max}$ (N)",
+        title="Fig. 7: maximum friction force $F_{max}$ (adjustment task)",
+    )
+
+
+def draw_rating(figure, study):
+    """Fig. 8: normalised noisiness rating per condition (rating task)."""
+    _draw_box_plot(
+        figure,
+        study.rating,
+        study,
+        ylabel="noisiness (0 = least, 1 = most noisy)",
+        title="Fig. 8: subjective noisiness (rating task)",
+    )
+    if study.rating.groups:
+        figure.axes[0].set_ylim(-0.05, 1.05)
+
+
+def draw_scatter(figure, study):
+    """Fig. 9: median noisiness against median max F_max per condition; top left is better."""
+    ax = figure.add_subplot(1, 1, 1)
+    rating = study.rating.summary.set_index("condition")
+    adjustment = study.adjustment.summary.set_index("condition")
+    common = [c for c in adjustment.index if c in rating.index]
+    ax.set_title("Fig. 9: median noisiness against median max $F_{max}$")
+    ax.set_xlabel("median noisiness (normalised)")
+    ax.set_ylabel("median max $F_{max}$ (N)")
+    if not common:
+        _say(ax, "no condition appears in both tasks")
+        return
+    x = rating.loc[common, "median"].to_numpy()
+    y = adjustment.loc[common, "median"].to_numpy()
+    xerr = np.vstack([x - rating.loc[common, "q1"].to_numpy(), rating.loc[common, "q3"].to_numpy() - x])
+    yerr = np.vstack([y - adjustment.loc[common, "q1"].to_numpy(), adjustment.loc[common, "q3"].to_numpy() - y])
+    ax.errorbar(x, y, xerr=xerr, yerr=yerr, fmt="none", ecolor="0.75", elinewidth=1, zorder=1)
+    ax.scatter(x, y, s=36, color="C0", zorder=2)
+    for name, xi, yi, dy in zip(common, x, y, _label_offsets(x, y)):
+        ax.annotate(name, (xi, yi), xytext=(5, dy), textcoords="offset points", fontsize=9,
+                    va="bottom" if dy > 0 else "top")
+    ax.grid(True, alpha=0.3)
+    figure.text(0.01, 0.01, "points: medians; bars: quartiles; top left is better", fontsize=8, color="0.35")
+
+
+FIGURES = {
+    "fig7_adjustment": draw_adjustment,
+    "fig8_rating": draw_rating,
+    "fig9_scatter": draw_scatter,
+}
+
+
+def render(name, study):
+    """A new ``Figure`` holding figure ``name`` (a key of ``FIGURES``) of ``study``."""
+    figure = Figure(figsize=_SIZE, layout="constrained")
+    FIGURES[name](figure, study)
+    return figure
+
+
+def save_figure(figure, directory, stem):
+    """Write ``figure`` as ``directory/stem.png`` and ``.svg`` (atomically); the paths written."""
+    paths = []
+    for fmt in FORMATS:
+        target = directory / f"{stem}.{fmt}"
+        with atomic_path(target) as tmp:
+            figure.savefig(tmp, format=fmt, dpi=120)
+        paths.append(target)
+    return paths
+
+
+def _draw_box_plot(figure, task, study, ylabel, title):
+    ax = figure.add_subplot(1, 1, 1)
+    # Room between the axes and the title for the letters.
+    ax.set_title(title, pad=16)
+    ax.set_ylabel(ylabel)
+    if not task.groups:
+        _say(ax, f"no {task.task} responses")
+        return
+    names = task.conditions
+    data = [task.groups[c] for c in names]
+    positions = np.arange(1, len(names) + 1)
+    ax.boxplot(data, positions=positions, widths=0.55, tick_labels=names, showfliers=False,
+               medianprops={"color": "C3", "linewidth": 1.8})
+    jitter = np.random.default_rng(0)
+    for x, values in zip(positions, data):
+        ax.scatter(x + jitter.uniform(-0.18, 0.18, values.size), values, s=9, color="C0", alpha=0.45,
+                   linewidths=0, zorder=3)
+    above = blended_transform_factory(ax.transData, ax.transAxes)
+    for x, name in zip(positions, names):
+        ax.text(x, 1.01, task.letters[name], transform=above, ha="center", va="bottom", fontsize=9)
+    ax.tick_params(axis="x", labelrotation=30)
+    ax.grid(True, axis="y", alpha=0.3)
+    correction = ", Holm-corrected" if study.holm else ""
+    figure.text(
+        0.01, 0.01,
+        f"letters: conditions sharing a letter do not differ (Wilcoxon rank-sum, p < {study.alpha:g}{correction})",
+        fontsize=8, color="0.35",
+    )
+
+
+def _label_offsets(x, y):
+    """Vertical label offsets (points): below the point when an earlier label sits close by."""
+    span_x = max(np.ptp(x), 1e-12)
+    span_y = max(np.ptp(y), 1e-12)
+    offsets = []
+    for k in range(len(x)):
+        near = [j for j in range(k) if abs(x[j] - x[k]) < 0.12 * span_x and abs(y[j] - y[k]) < 0.06 * span_y]
+        offsets.append(-4 if any(offsets[j] > 0 for j in near) else 4)
+    return offsets
+
+
+def _say(ax, message):
+    ax.text(0.5, 0.5, message, transform=ax.transAxes, ha="center", va="center", color="0.4")
+    ax.set_xticks([])
+    ax.set_yticks([])

@@ -1,0 +1,139 @@
+"""Load and check the study's responses: an exported responses.csv or a results folder.
+
+The export contract (``studyapp export``) gives one row per response with at
+least ``participant, session, task, condition, trial, fmax, rating, time,
+protocol_hash``. ``task`` is ``rating`` (``rating`` is the participant's
+noisiness in [0, 1], higher = noisier; ``fmax`` the task's constant F_max) or
+``adjustment`` (``fmax`` the confirmed breakdown F_max in newtons, ``trial``
+1..6). The analysis needs ``participant, task, condition, trial, fmax,
+rating``.
+
+A response whose value is empty (a trial begun but never confirmed) is kept
+out of the statistics but not forgotten: the missing-trials check counts it as
+missing. A value that is present but not a number, out of range, or a task that
+is neither ``rating`` nor ``adjustment`` is bad input: one line naming the file,
+the column and the row.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from studyapp.errors import InputDataError, UserError
+
+REQUIRED_COLUMNS = ["participant", "task", "condition", "trial", "fmax", "rating"]
+TASKS = ("rating", "adjustment")
+_TEXT_COLUMNS = ["participant", "session", "task", "condition", "protocol_hash"]
+
+
+def load_responses(source):
+    """Checked responses from ``source``: a ``.csv`` export or a results folder.
+
+    Returns ``(responses, label)``; ``label`` names the source in messages. A
+    results folder is exported with ``studyapp.experiment.export.export_responses``.
+    """
+    path = Path(source)
+    if path.suffix.lower() == ".csv":
+        if not path.is_file():
+            raise InputDataError(f"{path}: no such responses file")
+        try:
+            frame = pd.read_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+            raise InputDataError(f"{path}: not a readable CSV file ({_first_line(exc)})") from None
+        return check_responses(frame, str(path), csv_rows=True), str(path)
+    if path.is_dir():
+        try:
+            from studyapp.experiment.export import export_responses
+        except ImportError:
+            raise UserError(
+                f"{path}: reading a results folder needs studyapp.experiment.export, which is not "
+                "installed; pass an exported responses.csv instead"
+            ) from None
+        return check_responses(export_responses(path), str(path)), str(path)
+    raise UserError(f"{path}: expected a results folder or an exported responses .csv file")
+
+
+def check_responses(frame, label, csv_rows=False):
+    """A cleaned copy of ``frame``: text columns as str, numbers as float, tasks checked.
+
+    ``csv_rows`` numbers rows as lines of the CSV file (header = line 1) in messages.
+    """
+    missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
+    if missing:
+        raise InputDataError(
+            f"{label}: missing column '{missing[0]}' (the analysis needs {', '.join(REQUIRED_COLUMNS)})"
+        )
+    if len(frame) == 0:
+        raise InputDataError(f"{label}: no responses (the file has a header but no rows)")
+    frame = frame.reset_index(drop=True).copy()
+
+    def where(index):
+        return f"line {index + 2}" if csv_rows else f"row {index + 1}"
+
+    for column in ["participant", "task", "condition"]:
+        text = frame[column].astype(object).where(frame[column].notna(), None)
+        text = text.map(lambda v: None if v is None else str(v).strip())
+        empty = text.isna() | (text == "")
+        if empty.any():
+            raise InputDataError(f"{label}: column '{column}' is empty at {where(int(np.flatnonzero(empty)[0]))}")
+        frame[column] = text.astype(object)
+    frame["task"] = frame["task"].str.lower()
+    bad_task = ~frame["task"].isin(TASKS)
+    if bad_task.any():
+        i = int(np.flatnonzero(bad_task)[0])
+        raise InputDataError(
+            f"{label}: column 'task' at {where(i)} is '{frame['task'][i]}'; allowed: {', '.join(TASKS)}"
+        )
+    frame["condition"] = frame["condition"].str.upper()
+    if "session" in frame.columns:
+        frame["session"] = frame["session"].astype(object).where(frame["session"].notna(), "").map(str)
+    else:
+        frame["session"] = ""
+
+    for column in ["trial", "fmax", "rating"]:
+        frame[column] = _numbers(frame[column], column, label, where)
+    trials = frame["trial"].dropna()
+    bad_trial = (trials < 1) | (trials != np.round(trials))
+    if bad_trial.any():
+        i = int(bad_trial.index[np.flatnonzero(bad_trial)[0]])
+        raise InputDataError(f"{label}: column 'trial' at {where(i)} is {frame['trial'][i]:g}; allowed: 1, 2, 3, ...")
+    adjustment = frame["task"] == "adjustment"
+    fmax = frame["fmax"].where(adjustment)
+    bad_fmax = fmax.notna() & ~(np.isfinite(fmax) & (fmax >= 0))
+    if bad_fmax.any():
+        i = int(np.flatnonzero(bad_fmax)[0])
+        raise InputDataError(f"{label}: column 'fmax' at {where(i)} is {fmax[i]:g}; allowed: a finite F_max >= 0 N")
+    rating = frame["rating"].where(~adjustment)
+    bad_rating = rating.notna() & ~((rating >= 0) & (rating <= 1))
+    if bad_rating.any():
+        i = int(np.flatnonzero(bad_rating)[0])
+        raise InputDataError(
+            f"{label}: column 'rating' at {where(i)} is {rating[i]:g}; allowed: a normalised rating in [0, 1]"
+        )
+    return frame
+
+
+def response_values(responses, task):
+    """The rows of ``task`` that hold a value, with that value in a column ``value``."""
+    column = "fmax" if task == "adjustment" else "rating"
+    rows = responses[(responses["task"] == task) & responses[column].notna()]
+    return rows.assign(value=rows[column].astype(float))
+
+
+def _numbers(series, column, label, where):
+    """``series`` as float; an empty cell is NaN, anything else that is not a number is an error."""
+    if pd.api.types.is_numeric_dtype(series) and not pd.api.types.is_bool_dtype(series):
+        return series.astype(float)
+    text = series.astype(object).map(lambda v: "" if v is None or (isinstance(v, float) and np.isnan(v)) else str(v).strip())
+    numbers = pd.to_numeric(text.replace("", np.nan), errors="coerce")
+    bad = numbers.isna() & (text != "")
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InputDataError(f"{label}: column '{column}' at {where(i)} is '{text[i]}', not a number")
+    return numbers.astype(float)
+
+
+def _first_line(exc):
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__

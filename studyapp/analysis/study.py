@@ -1,0 +1,113 @@
+"""The whole analysis of a study's responses (paper Sec. 9-10), as one result object.
+
+Adjustment task (Fig. 7): every confirmed breakdown F_max is one sample of its
+condition; conditions are ordered best first (highest median). Rating task
+(Fig. 8): every participant's normalised noisiness is one sample; ordered best
+first (lowest median). For each task: median and quartiles, pairwise Wilcoxon
+rank-sum tests of every pair (optionally Holm-corrected), and the compact
+letters marking which conditions differ. Fig. 9 pairs the two medians per
+condition. Consistency and, given an evaluation, the numerical comparison
+follow (see consistency.py and numerical.py).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from studyapp.analysis.compact_letters import compact_letters
+from studyapp.analysis.consistency import participant_spearman, variance_decomposition
+from studyapp.analysis.missing_trials import find_missing_trials
+from studyapp.analysis.numerical import compare_with_numerical
+from studyapp.analysis.rank_sum import pairwise_rank_sum
+from studyapp.analysis.responses import response_values
+from studyapp.analysis.summary import summarise
+
+ALPHA = 0.05
+
+
+@dataclass
+class TaskAnalysis:
+    """One task's samples and statistics, conditions ordered best first."""
+
+    task: str
+    groups: dict  # condition -> float array of samples, best first
+    summary: pd.DataFrame  # condition, n, median, q1, q3
+    wilcoxon: pd.DataFrame  # condition_a, condition_b, statistic, p_value, significant, p_raw
+    letters: dict  # condition -> compact letters
+
+    @property
+    def conditions(self):
+        return list(self.groups)
+
+    def medians(self):
+        return self.summary.set_index("condition")["median"]
+
+
+@dataclass
+class StudyAnalysis:
+    """Everything the report shows; built by ``analyse``."""
+
+    source: str
+    responses: pd.DataFrame
+    adjustment: TaskAnalysis
+    rating: TaskAnalysis
+    missing: pd.DataFrame
+    participant_spearman: pd.DataFrame  # participant, rho, p_value, conditions
+    spearman_task: str  # the task the per-participant rho is computed on
+    variance: pd.DataFrame
+    numerical: pd.DataFrame | None = None
+    holm: bool = False
+    alpha: float = ALPHA
+
+    @property
+    def participants(self):
+        return sorted(self.responses["participant"].unique())
+
+    def intra_lower_pct(self):
+        """Mean over conditions of how much lower intra- than total variance is, in percent."""
+        values = self.variance["intra_lower_pct"].to_numpy(dtype=float)
+        values = values[np.isfinite(values)]
+        return float(values.mean()) if values.size else float("nan")
+
+
+def analyse(responses, source="responses", evaluation=None, holm=False, alpha=ALPHA, expected=None):
+    """``StudyAnalysis`` of checked ``responses`` (see responses.py).
+
+    ``evaluation`` is a parsed evaluation.json or None; ``expected`` maps a task
+    to its responses per condition and participant (see missing_trials.py).
+    """
+    adjustment_values = response_values(responses, "adjustment")
+    rating_values = response_values(responses, "rating")
+    adjustment = _task(adjustment_values, "adjustment", higher_is_better=True, holm=holm, alpha=alpha)
+    rating = _task(rating_values, "rating", higher_is_better=False, holm=holm, alpha=alpha)
+    spearman_task, spearman_values = ("adjustment", adjustment_values)
+    if adjustment_values.empty:
+        spearman_task, spearman_values = ("rating", rating_values)
+    numerical = None
+    if evaluation is not None:
+        numerical = compare_with_numerical(evaluation, rating.medians(), adjustment.medians())
+    return StudyAnalysis(
+        source=source,
+        responses=responses,
+        adjustment=adjustment,
+        rating=rating,
+        missing=find_missing_trials(responses, expected),
+        participant_spearman=participant_spearman(spearman_values),
+        spearman_task=spearman_task,
+        variance=variance_decomposition(adjustment_values, adjustment.conditions),
+        numerical=numerical,
+        holm=holm,
+        alpha=alpha,
+    )
+
+
+def _task(values, task, higher_is_better, holm, alpha):
+    medians = values.groupby("condition")["value"].median()
+    # Best first; ties broken by name so the order is reproducible.
+    order = sorted(medians.index, key=lambda c: (-medians[c] if higher_is_better else medians[c], c))
+    groups = {c: values.loc[values["condition"] == c, "value"].to_numpy(dtype=float) for c in order}
+    wilcoxon = pairwise_rank_sum(groups, alpha=alpha, holm=holm)
+    different = wilcoxon.loc[wilcoxon["significant"], ["condition_a", "condition_b"]].itertuples(index=False)
+    letters = compact_letters(order, [tuple(pair) for pair in different])
+    return TaskAnalysis(task, groups, summarise(groups), wilcoxon, letters)

@@ -1,0 +1,56 @@
+"""``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] -o REPORT_DIR``: the paper's Sec. 9-10.
+
+RESULTS_DIR is a results folder or an exported responses .csv. Writes the
+Wilcoxon, summary and Spearman tables, Figs. 7-9 (PNG and SVG) and
+report.html into REPORT_DIR (see studyapp/analysis/report_folder.py).
+Participants short of responses are listed on stderr and in the report.
+"""
+
+import sys
+
+
+def register(subparsers):
+    parser = subparsers.add_parser(
+        "analyse",
+        help="Wilcoxon and Spearman analyses, Figs. 7-9 and report.html from study responses",
+        description="Analyse study responses as the paper's Sec. 9-10: pairwise Wilcoxon rank-sum tests, "
+        "medians and quartiles, per-participant Spearman rho, Figs. 7-9 and one self-contained report.html.",
+    )
+    parser.add_argument("results", metavar="RESULTS_DIR", help="a results folder, or a responses .csv from 'studyapp export'")
+    parser.add_argument("-o", "--output", metavar="REPORT_DIR", required=True, help="folder for the tables, figures and report.html")
+    parser.add_argument("--evaluation", metavar="DIR", help="an 'studyapp evaluate -o DIR' folder (or its evaluation.json): compare with the numerical rankings")
+    parser.add_argument("--holm", action="store_true", help="Holm-correct the p-values of each task's pairwise tests")
+    parser.add_argument("--alpha", type=float, default=0.05, help="significance threshold (default 0.05, the paper's)")
+    parser.add_argument("--trials", type=int, metavar="N", help="adjustment trials each participant owes per condition (default: the most any participant has)")
+    parser.set_defaults(func=run)
+
+
+def run(args):
+    from studyapp.analysis.missing_trials import describe_missing
+    from studyapp.analysis.numerical import load_evaluation
+    from studyapp.analysis.report_folder import write_report_folder
+    from studyapp.analysis.responses import load_responses
+    from studyapp.analysis.study import analyse
+    from studyapp.errors import ParameterError
+
+    if not 0.0 < args.alpha < 1.0:
+        raise ParameterError(f"--alpha {args.alpha:g}: allowed 0 < alpha < 1")
+    if args.trials is not None and args.trials < 1:
+        raise ParameterError(f"--trials {args.trials}: allowed an integer >= 1")
+
+    def say(message):
+        print(f"studyapp analyse: {message}", file=sys.stderr, flush=True)
+
+    say(f"reading {args.results}")
+    responses, label = load_responses(args.results)
+    evaluation = load_evaluation(args.evaluation) if args.evaluation else None
+    expected = {"adjustment": args.trials} if args.trials else None
+    study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected)
+    say(f"{len(study.participants)} participants, {len(responses)} responses")
+    for row in study.missing.itertuples():
+        say(f"warning: {describe_missing(row)}")
+    if not study.missing.empty:
+        say(f"{len(study.missing)} short participant/condition combinations listed in missing_trials.csv")
+    write_report_folder(study, args.output, progress=say)
+    say(f"report: {args.output}/report.html")
+    return 0
