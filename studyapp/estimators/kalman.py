@@ -1,10 +1,86 @@
-"""KALPOS and KALMAN. PLACEHOLDER KERNELS: to be written (helper)."""
+"""KALPOS and KALMAN: Kalman filters on a driven-mass model (paper Sec. 5.6, eqs. 16-19).
+
+Model (Bar-Shalom's discrete white-noise acceleration models, paper eq. 18),
+sample period T, no input (B = 0):
+
+    KALMAN  state [x, v, a]   F = [[1, T, T^2/2], [0, 1, T], [0, 0, 1]]   Gamma = [T^2/2, T, 1]^T
+            measures z = [x, a]:  H = [[1, 0, 0], [0, 0, 1]],  R = diag(r_pos, r_acc)
+    KALPOS  state [x, v]      F = [[1, T], [0, 1]]                         Gamma = [T^2/2, T]^T
+            measures z = x:       H = [1, 0],                   R = r_pos
+
+    predict  x- = F x,  P- = F P F^T + Q                                 (eqs. 16-17)
+    update   K = P- H^T (H P- H^T + R)^-1,  x = x- + K (z - H x-),  P = (I - K H) P-
+
+The output at step k is the velocity of the posterior (after the update).
+
+The process noise Q: an ambiguity in the paper. Eq. 19 writes
+Q = Gamma sigma^2 Gamma^T and calls sigma "the power spectral density"; a
+spectral density would need a factor T to become a per-step variance, and the
+authors' public code used Q = q T Gamma Gamma^T. Table 1's Q values were tuned
+with one of the two, and the paper does not say which. Both are offered by the
+parameter ``q_convention``:
+
+    "eq19"    Q = q Gamma Gamma^T      (the paper's eq. 19 as printed; equals filterpy's
+                                        Q_discrete_white_noise(dim, dt=T, var=q)); default
+    "scaled"  Q = q T Gamma Gamma^T    (the authors' code)
+
+Numerics. In metres and seconds, at 40-96 kHz the covariance spans some 15
+orders of magnitude (Var x ~ 1e-10 m^2, Var a ~ 1e4 m^2/s^4, off-diagonals
+with powers of T in between), and the textbook update loses its precision.
+The filter therefore runs on the scaled state y = S [x, v, a] with
+S = diag(1, T, T^2), i.e. y = [x, T v, T^2 a], all in metres. Then
+
+    F_s = S F S^-1 = [[1, 1, 1/2], [0, 1, 1], [0, 0, 1]]      (constant: binomial-like)
+    Q_s = S Q S^T  = q_T g g^T,  g = [1/2, 1, 1]^T  ([1/2, 1]^T for KALPOS)
+          with q_T = q T^4 ("eq19") or q T^5 ("scaled")
+    H_s = e_x for position (R_p unchanged) and e_a for acceleration, the measured
+          acceleration entering as T^2 a with R_s = T^4 r_acc,
+
+and the posterior, mapped back by S^-1, is the unscaled textbook filter's up
+to rounding.
+
+Scaling alone is not enough at the ends of the parameter ranges: when one
+measurement is far more precise than the process noise (e.g. r_acc / q ~
+1e-24), the conditional variances are differences of numbers 1e16 times
+larger, and a covariance-form update -- Joseph form included, which we tried
+first -- turns P indefinite within 10^6 samples at 96 kHz. The filter
+therefore keeps P in factored form, P = U D U^T (U unit upper triangular, D
+diagonal): Thornton's weighted Gram-Schmidt time update (P- = W diag(D, q_T)
+W^T with W = [F_s U | g]) and Bierman's scalar measurement update. Every
+new D is a weighted sum of squares or a D times a ratio of positive numbers,
+so P stays symmetric (by construction) and positive definite; D's entries are
+the conditional variances, which is exactly what the subtraction above loses.
+Because R is diagonal the two measurements of KALMAN are applied one after
+the other (position, then acceleration), which gives the joint update's
+posterior. The arithmetic is unrolled (no np.linalg, no allocation).
+
+Start. At the first sample the filter is set to x = x_0, v = a = 0 and
+P_0 = diag(r_pos, (1 m/s)^2, (100 m/s^2)^2) (unscaled; [r_pos, (1 m/s)^2]
+for KALPOS), and outputs 0; from the second sample on it predicts and
+updates. Ignoring the first acceleration sample keeps the start identical for
+KALPOS, KALMAN and the hybrids.
+
+State (KALMAN, ``KALMAN_STATE`` = 10):
+``[started, y0, y1, y2, u01, u02, u12, d0, d1, d2]`` (scaled units).
+State (KALPOS, ``KALPOS_STATE`` = 6): ``[started, y0, y1, u01, d0, d1]``.
+Parameters (KALMAN, ``KALMAN_PARAMS`` = 8):
+``[rate, T^2, q_T, r_pos, T^4 r_acc, P0_x, T^2 P0_v, T^4 P0_a]``.
+Parameters (KALPOS, ``KALPOS_PARAMS`` = 5): ``[rate, q_T, r_pos, P0_x, T^2 P0_v]``.
+"""
 
 import numpy as np
 from numba import njit
 
 from studyapp.estimators import kinds
 from studyapp.estimators.spec import EstimatorSpec, Param, q_convention
+
+P0_VELOCITY = 1.0  # m/s: standard deviation of the initial velocity
+P0_ACCELERATION = 100.0  # m/s^2: standard deviation of the initial acceleration
+
+KALMAN_STATE = 10
+KALPOS_STATE = 6
+KALMAN_PARAMS = 8
+KALPOS_PARAMS = 5
 
 
 def q_param(default):
@@ -19,22 +95,196 @@ def r_acc_param(default):
     return Param("r_acc", default, "(m/s^2)^2", 1e-9, 1e12, doc="acceleration measurement covariance R_a")
 
 
+def scaled_q(rate, params):
+    """q_T, the factor of g g^T in the scaled process noise Q_s."""
+    t = 1.0 / rate
+    q = params["q"] * t**4
+    return q * t if params["q_convention"] == "scaled" else q
+
+
+def kalman_params(rate, params):
+    """The KALMAN block of a parameter vector (also the head of the hybrids')."""
+    t = 1.0 / rate
+    r_pos = params["r_pos"]
+    return np.array([
+        rate, t * t, scaled_q(rate, params), r_pos, t**4 * params["r_acc"],
+        r_pos, t * t * P0_VELOCITY**2, t**4 * P0_ACCELERATION**2,
+    ])
+
+
 def build_kalpos(rate, params):
-    return np.zeros(1), 1
+    t = 1.0 / rate
+    r_pos = params["r_pos"]
+    return np.array([rate, scaled_q(rate, params), r_pos, r_pos, t * t * P0_VELOCITY**2]), KALPOS_STATE
 
 
 def build_kalman(rate, params):
-    return np.zeros(1), 1
+    return kalman_params(rate, params), KALMAN_STATE
 
 
-@njit(cache=True)
-def step_kalpos(s, p, x, a, v):
-    return 0.0
+def unscaled_posterior(state, rate):
+    """(mean, covariance) of the posterior in SI units from a KALPOS or KALMAN state slice.
+
+    For inspection and tests; ``state`` is the kernel's own state (after the
+    input guard); ``len(state)`` tells the order. P = S^-1 U D U^T S^-1.
+    """
+    t = 1.0 / rate
+    if len(state) == KALPOS_STATE:
+        y = np.array(state[1:3])
+        u = np.array([[1.0, state[3]], [0.0, 1.0]])
+        d = np.array(state[4:6])
+    else:
+        y = np.array(state[1:4])
+        u = np.array([[1.0, state[4], state[5]], [0.0, 1.0, state[6]], [0.0, 0.0, 1.0]])
+        d = np.array(state[7:10])
+    s_inv = np.array([1.0, 1.0 / t, 1.0 / (t * t)])[: len(y)]
+    us = u * s_inv[:, None]
+    return y * s_inv, (us * d) @ us.T
+
+
+@njit(cache=True, inline="always")
+def kalman_step(s, p, x, a):
+    """One KALMAN step on state ``s[0:10]``, parameters ``p[0:8]``; returns the posterior velocity.
+
+    ``a`` is the acceleration measurement (m/s^2): the accelerometer for
+    KALMAN, the differentiators' estimate for the hybrids.
+    """
+    if s[0] == 0.0:
+        s[0] = 1.0
+        s[1] = x
+        s[2] = 0.0
+        s[3] = 0.0
+        s[4] = 0.0
+        s[5] = 0.0
+        s[6] = 0.0
+        s[7] = p[5]
+        s[8] = p[6]
+        s[9] = p[7]
+        return 0.0
+    q = p[2]
+    u01 = s[4]
+    u02 = s[5]
+    u12 = s[6]
+    d0 = s[7]
+    d1 = s[8]
+    d2 = s[9]
+    # predict: y = F_s y with F_s = [[1, 1, 1/2], [0, 1, 1], [0, 0, 1]]
+    y0 = s[1] + s[2] + 0.5 * s[3]
+    y1 = s[2] + s[3]
+    y2 = s[3]
+    # P- = W diag(d0, d1, d2, q_T) W^T with W = [F_s U | g], g = [1/2, 1, 1]^T;
+    # Thornton's weighted Gram-Schmidt, last row first, gives P- = U D U^T
+    w01 = u01 + 1.0
+    w02 = u02 + u12 + 0.5
+    w12 = u12 + 1.0
+    d2n = d2 + q
+    u02n = (w02 * d2 + 0.5 * q) / d2n
+    u12n = (w12 * d2 + q) / d2n
+    w02 -= u02n
+    w03 = 0.5 - u02n
+    w12 -= u12n
+    w13 = 1.0 - u12n
+    d1n = d1 + d2 * w12 * w12 + q * w13 * w13
+    u01n = (w01 * d1 + w02 * w12 * d2 + w03 * w13 * q) / d1n
+    w01 -= u01n
+    w02 -= u01n * w12
+    w03 -= u01n * w13
+    d0n = d0 + d1 * w01 * w01 + d2 * w02 * w02 + q * w03 * w03
+    # Bierman's update with the position, H = e_0: f = U^T e_0 = [1, u01, u02]
+    r = p[3]
+    alpha = r + d0n
+    b0 = d0n
+    d0n *= r / alpha
+    v1 = d1n * u01n
+    beta = alpha
+    alpha += v1 * u01n
+    d1n *= beta / alpha
+    b1 = v1
+    u01_old = u01n
+    u01n -= u01n / beta * b0
+    b0 += u01_old * v1
+    v2 = d2n * u02n
+    beta = alpha
+    alpha += v2 * u02n
+    d2n *= beta / alpha
+    lam = u02n / beta
+    u02_old = u02n
+    u12_old = u12n
+    u02n -= lam * b0
+    u12n -= lam * b1
+    b0 += u02_old * v2
+    b1 += u12_old * v2
+    e = (x - y0) / alpha
+    y0 += b0 * e
+    y1 += b1 * e
+    y2 += v2 * e
+    # Bierman's update with the scaled acceleration T^2 a, H = e_2: f = [0, 0, 1]; U is unchanged
+    r = p[4]
+    alpha = r + d2n
+    e = (a * p[1] - y2) / alpha
+    y0 += u02n * d2n * e
+    y1 += u12n * d2n * e
+    y2 += d2n * e
+    d2n *= r / alpha
+    s[1] = y0
+    s[2] = y1
+    s[3] = y2
+    s[4] = u01n
+    s[5] = u02n
+    s[6] = u12n
+    s[7] = d0n
+    s[8] = d1n
+    s[9] = d2n
+    return y1 * p[0]
 
 
 @njit(cache=True)
 def step_kalman(s, p, x, a, v):
-    return 0.0
+    return kalman_step(s, p, x, a)
+
+
+@njit(cache=True)
+def step_kalpos(s, p, x, a, v):
+    if s[0] == 0.0:
+        s[0] = 1.0
+        s[1] = x
+        s[2] = 0.0
+        s[3] = 0.0
+        s[4] = p[3]
+        s[5] = p[4]
+        return 0.0
+    q = p[1]
+    u01 = s[3]
+    d0 = s[4]
+    d1 = s[5]
+    # predict: y = F_s y with F_s = [[1, 1], [0, 1]]; W = [F_s U | g], g = [1/2, 1]^T
+    y0 = s[1] + s[2]
+    y1 = s[2]
+    w01 = u01 + 1.0
+    d1n = d1 + q
+    u01n = (w01 * d1 + 0.5 * q) / d1n
+    w01 -= u01n
+    w02 = 0.5 - u01n
+    d0n = d0 + d1 * w01 * w01 + q * w02 * w02
+    # Bierman's update with the position: f = [1, u01]
+    r = p[2]
+    alpha = r + d0n
+    b0 = d0n
+    d0n *= r / alpha
+    v1 = d1n * u01n
+    beta = alpha
+    alpha += v1 * u01n
+    d1n *= beta / alpha
+    u01_old = u01n
+    u01n -= u01n / beta * b0
+    b0 += u01_old * v1
+    e = (x - y0) / alpha
+    s[1] = y0 + b0 * e
+    s[2] = y1 + v1 * e
+    s[3] = u01n
+    s[4] = d0n
+    s[5] = d1n
+    return s[2] * p[0]
 
 
 SPEC_KALPOS = EstimatorSpec(
