@@ -1,0 +1,212 @@
+"""The recordings an estimator is measured on, and its raw objectives over them.
+
+A ``Take`` is one recording made ready for evaluation: the measured position,
+acceleration and tachometer velocity the estimators read, and the reference
+velocity they are judged against, the LVT (``reference="lvt"``, the paper's
+choice, eq. 25) or the simulated true velocity (``"true"``). A ``Dataset`` is
+a list of takes and the delay bound; ``raw_objectives(name, params)`` runs the
+estimator on every take, from rest, and returns eq. 28's vector
+``[E_0, D_0, ..., E_{n-1}, D_{n-1}]`` (E in m/s, D in samples).
+
+``RecordingFiles`` is a small picklable pointer to recording files: a worker
+process (or a dask worker on a shared file system) loads the files once,
+warms up the compiled estimators once, and keeps both for every later task.
+"""
+
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from studyapp.errors import InputDataError, UserError
+from studyapp.evaluation.metric import Reference
+
+REFERENCE_COLUMNS = {"lvt": "velocity_lvt", "true": "velocity_true"}
+DEFAULT_MAX_LAG_S = 0.02  # 100 samples at 5 kHz: far beyond any useful estimator's delay
+
+
+@dataclass
+class Take:
+    """One recording ready for evaluation (arrays in SI units)."""
+
+    name: str
+    rate: float
+    position: np.ndarray
+    acceleration: np.ndarray
+    velocity: np.ndarray
+    reference: np.ndarray
+    fmax: float | None = None
+    sha256: str | None = None
+
+
+def reference_column(reference):
+    try:
+        return REFERENCE_COLUMNS[reference]
+    except KeyError:
+        raise UserError(f"reference = {reference!r}: allowed is 'lvt' or 'true'") from None
+
+
+def take_from_recording(recording, name, reference="lvt", sha256=None):
+    """A ``Take`` from a ``studyapp.recording.Recording`` (columns by the CSV names)."""
+    columns = recording.columns
+    wanted = ["position", "acceleration", "velocity_lvt", reference_column(reference)]
+    for column in wanted:
+        if column not in columns:
+            raise InputDataError(f"{name}: no {column!r} column (it has {', '.join(columns)})")
+    arrays = {c: np.ascontiguousarray(columns[c], dtype=np.float64) for c in wanted}
+    fmax = recording.meta.get("fmax") if recording.meta else None
+    return Take(
+        name=name, rate=float(recording.rate), position=arrays["position"],
+        acceleration=arrays["acceleration"], velocity=arrays["velocity_lvt"],
+        reference=arrays[reference_column(reference)],
+        fmax=None if fmax is None else float(fmax), sha256=sha256,
+    )
+
+
+def file_sha256(path):
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def load_takes(paths, reference="lvt"):
+    """Load recording files (``.h5``, ``.npz`` or ``.csv``) as takes; one-line errors name the file."""
+    from studyapp.recording import load
+
+    takes = []
+    for path in paths:
+        path = Path(path)
+        if not path.is_file():
+            raise InputDataError(f"{path}: no such recording file")
+        takes.append(take_from_recording(load(path), str(path), reference, file_sha256(path)))
+    if not takes:
+        raise UserError("no recordings given")
+    return takes
+
+
+class Dataset:
+    """Takes plus the delay bound; measures raw objectives (eq. 28) of a parameter set."""
+
+    def __init__(self, takes, max_lag_s=DEFAULT_MAX_LAG_S):
+        if not takes:
+            raise UserError("no recordings given")
+        self.takes = list(takes)
+        self.max_lag_s = float(max_lag_s)
+        self.references = []
+        for take in self.takes:
+            max_lag = max(1, int(round(self.max_lag_s * take.rate)))
+            if max_lag >= take.reference.shape[0]:
+                raise InputDataError(
+                    f"{take.name}: {take.reference.shape[0]} samples is too short for a delay bound of "
+                    f"{self.max_lag_s:g} s ({max_lag} samples)")
+            self.references.append(Reference(take.reference, max_lag))
+
+    def load(self):
+        return self
+
+    @property
+    def names(self):
+        return [t.name for t in self.takes]
+
+    def estimate(self, take, name, params):
+        """The velocity estimate of ``name`` with ``params`` on one take, started from rest."""
+        from studyapp.estimators import create
+
+        estimator = create(name, take.rate, **params)
+        return estimator.process(take.position, take.acceleration, take.velocity)
+
+    def delays_and_errors(self, name, params):
+        """(E, D) arrays over the takes."""
+        errors = np.empty(len(self.takes))
+        delays = np.empty(len(self.takes))
+        for r, (take, ref) in enumerate(zip(self.takes, self.references)):
+            delays[r], errors[r] = ref.measure(self.estimate(take, name, params))
+        return errors, delays
+
+    def raw_objectives(self, name, params):
+        """Eq. 28: [E_0, D_0, E_1, D_1, ...]."""
+        errors, delays = self.delays_and_errors(name, params)
+        raw = np.empty(2 * len(self.takes))
+        raw[0::2] = errors
+        raw[1::2] = delays
+        return raw
+
+
+def warm_up(names, rate=5000.0):
+    """Run each estimator once on a few samples, so numba's compiled code is loaded in this process."""
+    from studyapp.estimators import create
+
+    x = np.zeros(16)
+    for name in names:
+        create(name, rate).process(x, x, x)
+
+
+_LOADED = {}
+
+
+@dataclass(frozen=True)
+class RecordingFiles:
+    """A picklable pointer to recording files; ``load()`` reads them once per process."""
+
+    paths: tuple
+    reference: str = "lvt"
+    max_lag_s: float = DEFAULT_MAX_LAG_S
+    warm: tuple = ()
+
+    def load(self):
+        dataset = _LOADED.get(self)
+        if dataset is None:
+            warm_up(self.warm)
+            dataset = Dataset(load_takes(self.paths, self.reference), self.max_lag_s)
+            _LOADED.clear()
+            _LOADED[self] = dataset
+        return dataset
+
+
+def raw_objectives_task(source, name, params):
+    """The executor's unit of work: raw objectives of one parameter set (``source.load()`` gives the data)."""
+    return source.load().raw_objectives(name, params)
+
+
+RECORDING_SUFFIXES = (".npz", ".h5", ".csv")
+
+
+def _order(path):
+    """Sort key: the F_max in a ``fmax_<value>`` file name first (numerically), then the name."""
+    stem = path.stem
+    if stem.startswith("fmax_"):
+        try:
+            return (0, float(stem[5:]), path.name)
+        except ValueError:
+            pass
+    return (1, 0.0, path.name)
+
+
+def expand_paths(items):
+    """Recording files from command-line items: files as given, directories by their recordings (by F_max)."""
+    paths = []
+    for item in items:
+        path = Path(item)
+        if path.is_dir():
+            found = sorted((p for p in path.iterdir() if p.suffix.lower() in RECORDING_SUFFIXES), key=_order)
+            if not found:
+                raise InputDataError(f"{path}: directory holds no recordings ({', '.join(RECORDING_SUFFIXES)})")
+            paths += found
+        elif not path.exists():
+            raise InputDataError(f"{path}: no such recording file")
+        else:
+            paths.append(path)
+    return [str(p) for p in paths]
+
+
+def estimator_names(text, default):
+    """Names from ``--estimators A,B C`` (comma or space separated), checked; ``default`` when empty."""
+    from studyapp.estimators.registry import spec
+
+    if not text:
+        return list(default)
+    names = [n for item in text for n in item.replace(",", " ").split()]
+    return list(dict.fromkeys(spec(n).name for n in names))

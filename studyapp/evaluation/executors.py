@@ -1,0 +1,60 @@
+"""Where the parameter sets are evaluated: a ``concurrent.futures.Executor``.
+
+- ``InlineExecutor``: in this process, one task at a time (``--workers 1``,
+  tests, debugging).
+- a ``ProcessPoolExecutor`` over all cores by default; each worker process
+  loads the recordings and warms up the compiled estimators once.
+- a dask.distributed ``Client``'s executor (``--scheduler ADDRESS``), to carry
+  a large study past one machine; the workers must see the recording files at
+  the same paths (a shared file system) and have studyapp installed.
+
+Any other ``Executor`` works too: the optimiser only calls ``submit``.
+"""
+
+import os
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
+
+from studyapp.errors import UserError
+
+
+class InlineExecutor(Executor):
+    """Runs each task at once, in the calling thread."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except BaseException as exc:
+            future.set_exception(exc)
+        return future
+
+
+def cpu_count():
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+def make_executor(workers=None, scheduler=None, initializer=None, initargs=()):
+    """The executor for ``--workers`` / ``--scheduler`` (``initializer`` runs once per local worker)."""
+    if scheduler:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise UserError(
+                f"--scheduler {scheduler}: needs dask.distributed, which is not installed "
+                "(pip install 'dask[distributed]')") from None
+        try:
+            client = Client(scheduler)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise UserError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+        return client.get_executor()
+    workers = cpu_count() if workers is None else int(workers)
+    if workers < 1:
+        raise UserError(f"--workers {workers}: allowed is an integer of at least 1")
+    if workers == 1:
+        if initializer is not None:
+            initializer(*initargs)
+        return InlineExecutor()
+    return ProcessPoolExecutor(max_workers=workers, initializer=initializer, initargs=initargs)

@@ -1,0 +1,210 @@
+"""The objective-sum optimiser (paper Sec. 6.3, steps 1-8, Fig. 3).
+
+Every estimator is tuned by its own ``AdaptiveSearch``; all are tied together
+by one ``ObjectiveSum``, whose scale comes from the best and worst estimator.
+One iteration:
+
+1. every estimator still searching proposes a new parameter set (step 6);
+2. the sets are evaluated on all recordings, in parallel, by an executor
+   (step 7): eq. 28's raw objectives [E_0, D_0, ...] of each set;
+3. the objective sum accepts or rejects each candidate under the memorised
+   scale and memorises a new scale if any estimator improved (step 8);
+4. an estimator stops searching once ``patience`` new sets in a row brought no
+   improvement; the run ends when none is left (the paper's rule, 1000).
+
+Iterations are synchronous and each estimator draws from its own generator
+(seeded from the run's seed and its name), so a run is reproducible whatever
+the number of workers and whether it was resumed from a checkpoint. An
+estimator's objectives depend only on its parameters, so a repeated set (an
+integer-only space revisits points) is taken from a cache instead of being run
+again; it still counts as a new set for the stopping rule.
+"""
+
+import time
+import zlib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from studyapp.errors import UserError
+from studyapp.evaluation import checkpoint as checkpoints
+from studyapp.evaluation.normalisation import ObjectiveSum
+from studyapp.evaluation.search import AdaptiveSearch
+
+
+def estimator_seed(seed, name):
+    """Independent generator seed per estimator (stable across runs and Python versions)."""
+    return [int(seed), zlib.crc32(name.encode("utf-8"))]
+
+
+def _key(params):
+    return tuple(sorted((k, repr(v)) for k, v in params.items()))
+
+
+@dataclass
+class Result:
+    """The tuned parameters and how they were found."""
+
+    params: dict  # name -> parameters of the retained set
+    objectives: dict  # name -> F_g under the final memorised scale
+    raw: dict  # name -> raw objectives [E_0, D_0, ...] of the retained set
+    iterations: int
+    evaluated: int  # parameter sets run (cache hits not counted)
+    sets: dict  # name -> parameter sets proposed (with repeats)
+    seconds: float
+    resumed: bool = False
+    scale: dict = field(default_factory=dict)  # memorised offsets and scales
+
+
+class Optimiser:
+    """Tune several estimators together.
+
+    ``spaces``: name -> ``Space``; ``objective(name, params) -> raw vector`` is a
+    picklable callable run by ``executor`` (an object with ``submit``).
+    ``tolerance`` is the least fall of F_g that counts as an improvement (the
+    default is 1e-6 per objective, far below any difference that matters).
+    ``fingerprint`` (a JSON-able dict) identifies the run for checkpoints.
+    """
+
+    def __init__(self, spaces, objective, executor, patience=1000, seed=0, tolerance=None,
+                 max_sets=None, checkpoint=None, checkpoint_interval=30.0, progress=None, fingerprint=None):
+        if not spaces:
+            raise UserError("no estimators to optimise")
+        self.spaces = dict(spaces)
+        self.objective = objective
+        self.executor = executor
+        self.patience = int(patience)
+        if self.patience < 1:
+            raise UserError(f"--patience {patience}: allowed is an integer of at least 1")
+        self.seed = int(seed)
+        self.tolerance = tolerance
+        self.max_sets = None if max_sets is None else int(max_sets)
+        self.checkpoint = checkpoint
+        self.checkpoint_interval = float(checkpoint_interval)
+        self.progress = progress
+        self.fingerprint = {
+            "seed": self.seed, "patience": self.patience, "max_sets": self.max_sets,
+            "spaces": {name: space.describe() for name, space in self.spaces.items()},
+            **(fingerprint or {}),
+        }
+        self.searches = {
+            name: AdaptiveSearch(space, estimator_seed(self.seed, name), self.patience)
+            for name, space in self.spaces.items()
+        }
+        self.sum = None
+        self.cache = {name: {} for name in self.spaces}
+        self.evaluated = 0
+        self.seconds = 0.0
+        self.resumed = False
+
+    # -- evaluation ----------------------------------------------------------------
+    def _evaluate(self, proposals):
+        """Raw objectives of name -> params, from the cache or the executor."""
+        futures = {}
+        raws = {}
+        for name, params in proposals.items():
+            hit = self.cache[name].get(_key(params))
+            if hit is not None:
+                raws[name] = hit
+            else:
+                futures[name] = self.executor.submit(self.objective, name, params)
+        for name, future in futures.items():
+            raw = np.asarray(future.result(), dtype=np.float64)
+            self.cache[name][_key(proposals[name])] = raw
+            raws[name] = raw
+            self.evaluated += 1
+        return {name: raws[name] for name in proposals}
+
+    def _active(self):
+        return [name for name, s in self.searches.items()
+                if not s.done and (self.max_sets is None or s.sets < self.max_sets)]
+
+    # -- checkpoints ------------------------------------------------------------------
+    def state(self):
+        return {
+            "fingerprint": self.fingerprint,
+            "sum": self.sum.state(),
+            "searches": {name: s.state() for name, s in self.searches.items()},
+            "evaluated": self.evaluated,
+            "seconds": self.seconds,
+        }
+
+    def _save(self):
+        if self.checkpoint is not None:
+            checkpoints.write(self.checkpoint, self.state())
+
+    def resume(self, path):
+        """Continue from the checkpoint at ``path`` (made by a run with the same fingerprint)."""
+        state = checkpoints.read(path)
+        saved = state.get("fingerprint")
+        if saved != _jsonable(self.fingerprint):
+            differ = sorted(k for k in set(saved or {}) | set(self.fingerprint)
+                            if (saved or {}).get(k) != _jsonable(self.fingerprint).get(k))
+            raise UserError(f"{path}: checkpoint of a different run (differs in: {', '.join(differ)})")
+        self.sum = ObjectiveSum.from_state(state["sum"])
+        for name, s in self.searches.items():
+            s.restore(state["searches"][name])
+        self.evaluated = int(state["evaluated"])
+        self.seconds = float(state["seconds"])
+        self.resumed = True
+
+    # -- the procedure ------------------------------------------------------------------
+    def run(self):
+        started = time.monotonic() - self.seconds
+        last_save = time.monotonic()
+        names = list(self.spaces)
+        if self.sum is None:
+            # Steps 1-4: a first set per estimator (the spec's defaults, Table 1), b_0 = 0.
+            first = {name: self.searches[name].best for name in names}
+            raws = self._evaluate(first)
+            j = len(next(iter(raws.values())))
+            tolerance = 1e-6 * j if self.tolerance is None else float(self.tolerance)
+            self.sum = ObjectiveSum(tolerance)
+            self.sum.start(raws)
+        try:
+            while True:
+                active = self._active()
+                if not active:
+                    break
+                # Steps 5-8.
+                proposals = {name: self.searches[name].propose() for name in active}
+                raws = self._evaluate(proposals)
+                decisions = self.sum.step(raws)
+                for name in active:
+                    self.searches[name].report(proposals[name], decisions[name].accepted)
+                self.seconds = time.monotonic() - started
+                self._report(final=False)
+                if self.checkpoint is not None and time.monotonic() - last_save >= self.checkpoint_interval:
+                    self._save()
+                    last_save = time.monotonic()
+        except KeyboardInterrupt:
+            self.seconds = time.monotonic() - started
+            self._save()
+            raise
+        self.seconds = time.monotonic() - started
+        self._save()
+        self._report(final=True)
+        return Result(
+            params={name: dict(self.searches[name].best) for name in names},
+            objectives=self.sum.objectives(),
+            raw={name: self.sum.best[name].tolist() for name in names},
+            iterations=self.sum.iteration,
+            evaluated=self.evaluated,
+            sets={name: self.searches[name].sets for name in names},
+            seconds=self.seconds,
+            resumed=self.resumed,
+            scale={"offsets": self.sum.offsets.tolist(), "scales": self.sum.scales.tolist()},
+        )
+
+    def _report(self, final):
+        if self.progress is None:
+            return
+        done = {name for name in self.spaces if name not in self._active()}
+        self.progress(self.sum.iteration, self.evaluated, self.sum.objectives(), done, final=final)
+
+
+def _jsonable(value):
+    """``value`` as it reads back from JSON (tuples become lists, keys strings)."""
+    import json
+
+    return json.loads(json.dumps(value))

@@ -1,0 +1,34 @@
+"""Progress of a long optimisation on stderr: the best objective per estimator.
+
+One line at most every ``interval`` seconds (and a last one at the end):
+iteration, parameter sets evaluated, elapsed time, then for each estimator its
+best F_g under the scale in force, with ``*`` once it has stopped searching.
+On a terminal the line is redrawn in place; in a log each update is a line.
+"""
+
+import sys
+import time
+
+
+class Progress:
+    def __init__(self, stream=None, interval=2.0):
+        self.stream = sys.stderr if stream is None else stream
+        self.interval = float(interval)
+        self.started = time.monotonic()
+        self.last = -float("inf")
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.drawn = False
+
+    def __call__(self, iteration, evaluated, objectives, done, final=False):
+        now = time.monotonic()
+        if not final and now - self.last < self.interval:
+            return
+        self.last = now
+        parts = [f"{name} {value:.4g}{'*' if name in done else ''}" for name, value in objectives.items()]
+        line = f"iter {iteration} sets {evaluated} {now - self.started:.0f}s | " + "  ".join(parts)
+        if self.tty:
+            self.stream.write("\r\033[K" + line + ("\n" if final else ""))
+            self.drawn = not final
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
