@@ -1,0 +1,84 @@
+"""``studyapp run --protocol FILE --participant ID [--simulated-participant] [--headless]
+[--resume] [--results DIR] [--seed N]``: run one participant's session.
+
+With ``--simulated-participant --headless`` the session runs in this process
+without a display: the closed loop is stepped directly and the simulated
+participant plays every trial (the demo, the end-to-end check, an in-silico
+pilot). Progress goes to stderr; the session folder is printed on stdout.
+Without ``--headless`` the session runs in the experimenter console
+(``studyapp.gui.run_session(args)``).
+"""
+
+
+def register(sub):
+    parser = sub.add_parser("run", help="run a participant's session of a study protocol")
+    parser.add_argument("--protocol", required=True, metavar="FILE", help="study protocol (TOML), e.g. protocols/demo.toml")
+    parser.add_argument("--participant", required=True, metavar="ID",
+                        help="participant pseudonym: 1 to 32 letters, digits, '_' or '-'")
+    parser.add_argument("--simulated-participant", action="store_true",
+                        help="a simulated participant plays the session")
+    parser.add_argument("--headless", action="store_true",
+                        help="no display: run in this process (needs --simulated-participant)")
+    parser.add_argument("--resume", action="store_true", help="continue the participant's unfinished session")
+    parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
+    parser.add_argument("--seed", type=int, default=None, metavar="N",
+                        help="session seed (default: from the study seed and the participant's enrolment)")
+    parser.set_defaults(func=run)
+
+
+def run(args):
+    import sys
+
+    from studyapp.errors import UserError
+    from studyapp.experiment.protocol import load_protocol
+    from studyapp.experiment.session import check_participant
+
+    check_participant(args.participant)
+    if args.seed is not None and not 0 <= args.seed < 2**63:
+        raise UserError(f"--seed {args.seed}: allowed is an integer from 0 to 2**63 - 1")
+    if args.headless and not args.simulated_participant:
+        raise UserError("--headless: allowed only with --simulated-participant (a person takes part through the GUI)")
+    protocol = load_protocol(args.protocol)
+    if not args.headless:
+        return _run_in_gui(args)
+
+    from studyapp.experiment.session import Session
+    from studyapp.experiment.session_runner import SessionRunner
+    from studyapp.experiment.simulated_participant import SimulatedParticipant
+
+    def progress(message):
+        print(f"studyapp run: {message}", file=sys.stderr, flush=True)
+
+    if args.resume:
+        session = Session.resume(protocol, args.participant, args.results, seed=args.seed)
+    else:
+        session = Session.create(protocol, args.participant, args.results, seed=args.seed,
+                                 apparatus={"device": "simulated", "participant": "simulated", "audio": False})
+    progress(f"session {session.folder} ({len(session.finished_steps())} of {len(session.schedule)} trials done)")
+    runner = SessionRunner(session, progress=progress)
+    runner.begin()
+    try:
+        SimulatedParticipant(session.seed).play(runner)
+    except BaseException:
+        runner.finish("interrupted")
+        session.close()
+        raise
+    complete = runner.finish()
+    session.close()
+    progress(f"session {'complete' if complete else 'stopped'}: {session.folder}")
+    print(session.folder)
+    return 0
+
+
+def _run_in_gui(args):
+    import importlib
+
+    from studyapp.errors import UserError
+
+    try:
+        gui = importlib.import_module("studyapp.gui")
+    except ImportError as exc:
+        raise UserError(f"the GUI cannot start ({exc}): allowed is --simulated-participant --headless") from None
+    if not hasattr(gui, "run_session"):
+        raise UserError("the GUI (studyapp.gui) is not available yet: run with --simulated-participant --headless")
+    return gui.run_session(args)

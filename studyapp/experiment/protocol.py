@@ -1,0 +1,273 @@
+"""A study protocol: a TOML file, validated on load.
+
+A protocol says everything a session needs (paper Sec. 8): the haptic rate,
+the conditions of the rating task (its constant F_max, 1 N in the paper) and of
+the adjustment task (trials per condition, the knob's F_max ceiling and how
+many decades its logarithmic map spans), the estimator parameters (Table 1
+unless overridden), the study-wide seed of the Latin squares, and the
+instructions shown to the participant. ``docs/experiment.md`` lists every field.
+
+Nothing starts on an invalid protocol: ``load_protocol`` raises one
+``UserError`` whose single line names the file, the field and what is allowed.
+The protocol's hash is the SHA-256 of the file's bytes, so two sessions ran the
+same study exactly when their hashes agree.
+"""
+
+import hashlib
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from studyapp.errors import UserError
+
+TASKS = ("rating", "adjustment")
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
+NAME_ALLOWED = "1 to 32 letters, digits, '_' or '-'"
+KNOB_MAX = 127  # 7-bit MIDI controller (the paper's Akai LPD-8)
+
+
+@dataclass(frozen=True)
+class RatingSpec:
+    """The rating task: each condition on its own knob, rated at a constant F_max."""
+
+    conditions: tuple
+    fmax: float
+    confirm_pad: int
+    instructions: str
+
+
+@dataclass(frozen=True)
+class AdjustmentSpec:
+    """The adjustment task: one knob sets F_max from 0 up to ``ceiling`` over ``decades``."""
+
+    conditions: tuple
+    trials: int
+    ceiling: float
+    decades: float
+    knob: int
+    confirm_pad: int
+    instructions: str
+
+
+@dataclass(frozen=True)
+class Protocol:
+    path: str
+    text: str
+    sha256: str
+    study: str
+    title: str
+    tasks: tuple
+    seed: int
+    rate: float
+    knobs: int
+    pads: int
+    gesture: str
+    estimators: dict = field(default_factory=dict)
+    rating: RatingSpec | None = None
+    adjustment: AdjustmentSpec | None = None
+
+    def task(self, name):
+        return getattr(self, name)
+
+    def estimator_params(self, name):
+        """The parameter overrides for estimator ``name`` ({} = Table 1 defaults)."""
+        return dict(self.estimators.get(name, {}))
+
+    def settings(self):
+        """A JSON-ready summary of the validated protocol (stored in session.json)."""
+        out = {
+            "study": self.study,
+            "title": self.title,
+            "tasks": list(self.tasks),
+            "seed": self.seed,
+            "rate": self.rate,
+            "knobs": self.knobs,
+            "pads": self.pads,
+            "gesture": self.gesture,
+            "estimators": {k: dict(v) for k, v in self.estimators.items()},
+        }
+        for name in self.tasks:
+            spec = self.task(name)
+            out[name] = {k: (list(v) if isinstance(v, tuple) else v) for k, v in spec.__dict__.items()}
+        return out
+
+
+class _Fields:
+    """Reads one TOML table, turning each problem into one line naming file and field."""
+
+    def __init__(self, source, table, values):
+        self.source = source
+        self.table = table
+        self.values = values
+        self.used = set()
+
+    def fail(self, key, problem, allowed):
+        where = f"[{self.table}] {key}" if key else f"[{self.table}]"
+        raise UserError(f"{self.source}: {where} {problem}: allowed is {allowed}")
+
+    def get(self, key, allowed, default=...):
+        self.used.add(key)
+        if key not in self.values:
+            if default is ...:
+                self.fail(key, "is missing", allowed)
+            return default
+        return self.values[key]
+
+    def string(self, key, allowed="a non-empty string", default=..., pattern=None):
+        value = self.get(key, allowed, default)
+        if not isinstance(value, str) or not value.strip() or (pattern and not pattern.fullmatch(value)):
+            self.fail(key, f"= {value!r}", allowed)
+        return value
+
+    def integer(self, key, low, high, default=...):
+        allowed = f"an integer from {low} to {high}"
+        value = self.get(key, allowed, default)
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            self.fail(key, f"= {value!r}", allowed)
+        return value
+
+    def number(self, key, low, high, unit="", default=..., low_open=False):
+        allowed = f"a number {'above' if low_open else 'from'} {low:g}{' to ' + format(high, 'g') if high is not None else ''} {unit}".strip()
+        value = self.get(key, allowed, default)
+        bad = isinstance(value, bool) or not isinstance(value, (int, float))
+        if not bad:
+            value = float(value)
+            bad = not (value > low if low_open else value >= low) or (high is not None and value > high)
+        if bad:
+            self.fail(key, f"= {value!r}", allowed)
+        return value
+
+    def conditions(self, key, known, at_least, at_most):
+        allowed = (f"a list of {at_least} to {at_most} different estimator names from: {', '.join(known)}")
+        value = self.get(key, allowed)
+        if not isinstance(value, list) or not at_least <= len(value) <= at_most:
+            self.fail(key, f"= {value!r}", allowed)
+        for name in value:
+            if name not in known:
+                self.fail(key, f"has unknown condition {name!r}", allowed)
+        if len(set(value)) != len(value):
+            self.fail(key, "names a condition twice", allowed)
+        return tuple(value)
+
+    def finish(self):
+        unknown = sorted(set(self.values) - self.used)
+        if unknown:
+            self.fail(unknown[0], "is not a known field", "one of " + ", ".join(sorted(self.used)))
+
+
+def _table(source, document, name, required=True):
+    if name not in document:
+        if required:
+            raise UserError(f"{source}: table [{name}] is missing: allowed is a [{name}] table (see docs/experiment.md)")
+        return None
+    value = document[name]
+    if not isinstance(value, dict):
+        raise UserError(f"{source}: [{name}] = {value!r}: allowed is a table")
+    return _Fields(source, name, value)
+
+
+def parse_protocol(text, source="<protocol>"):
+    """Validate protocol ``text`` (TOML); ``source`` names the file in error messages."""
+    from studyapp import estimators
+    from studyapp.estimators.registry import spec as estimator_spec
+    from studyapp.estimators.spec import RATE_MAX, RATE_MIN
+
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise UserError(f"{source}: not valid TOML ({exc})") from None
+    known_tables = ("study", "apparatus", "estimators", *TASKS)
+    for name in document:
+        if name not in known_tables:
+            raise UserError(f"{source}: [{name}] is not a known table: allowed are {', '.join(known_tables)}")
+
+    study = _table(source, document, "study")
+    name = study.string("name", NAME_ALLOWED, pattern=NAME_PATTERN)
+    title = study.string("title", default=name)
+    tasks_allowed = "a list of the tasks to run, in order: 'rating', 'adjustment' or both"
+    tasks = study.get("tasks", tasks_allowed)
+    if (not isinstance(tasks, list) or not tasks or len(set(tasks)) != len(tasks)
+            or any(t not in TASKS for t in tasks)):
+        study.fail("tasks", f"= {tasks!r}", tasks_allowed)
+    seed = study.integer("seed", 0, 2**32 - 1)
+    study.finish()
+
+    apparatus = _table(source, document, "apparatus")
+    rate = apparatus.number("rate", RATE_MIN, RATE_MAX, "Hz")
+    knobs = apparatus.integer("knobs", 1, 64, default=8)
+    pads = apparatus.integer("pads", 1, 64, default=8)
+    gesture = apparatus.string("gesture", default="strokes")
+    apparatus.finish()
+
+    known = estimators.names()
+    overrides = {}
+    table = _table(source, document, "estimators", required=False)
+    for est, params in (table.values.items() if table else ()):
+        if est not in known:
+            table.fail(est, "is not an estimator", "one of " + ", ".join(known))
+        if not isinstance(params, dict):
+            table.fail(est, f"= {params!r}", "a table of parameters, e.g. LOWPASS = { cutoff_hz = 256.0 }")
+        try:
+            estimator_spec(est).validate(rate, params)
+        except UserError as exc:
+            raise UserError(f"{source}: [estimators] {est}: {exc}") from None
+        overrides[est] = dict(params)
+
+    specs = {}
+    for task in tasks:
+        t = _table(source, document, task)
+        pad = t.integer("confirm_pad", 0, pads - 1, default=0)
+        instructions = t.string("instructions")
+        if task == "rating":
+            specs[task] = RatingSpec(
+                conditions=t.conditions("conditions", known, 2, knobs),
+                fmax=t.number("fmax", 0.0, None, "N", low_open=True),
+                confirm_pad=pad,
+                instructions=instructions,
+            )
+        else:
+            specs[task] = AdjustmentSpec(
+                conditions=t.conditions("conditions", known, 1, len(known)),
+                trials=t.integer("trials", 1, 100),
+                ceiling=t.number("ceiling", 0.0, None, "N", low_open=True),
+                decades=t.number("decades", 0.1, 12.0, "decades", default=3.0),
+                knob=t.integer("knob", 0, knobs - 1, default=0),
+                confirm_pad=pad,
+                instructions=instructions,
+            )
+        t.finish()
+    for task in TASKS:
+        if task in document and task not in tasks:
+            raise UserError(f"{source}: [{task}] is given but [study] tasks does not list it: "
+                            f"allowed is to list it in tasks or remove the table")
+
+    return Protocol(
+        path=source,
+        text=text,
+        sha256=hashlib.sha256(text.encode("utf-8")).hexdigest(),
+        study=name,
+        title=title,
+        tasks=tuple(tasks),
+        seed=seed,
+        rate=rate,
+        knobs=knobs,
+        pads=pads,
+        gesture=gesture,
+        estimators=overrides,
+        **specs,
+    )
+
+
+def load_protocol(path):
+    """Read and validate the protocol file at ``path``; its hash is the SHA-256 of its bytes."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise UserError(f"{path}: cannot read the protocol ({exc.strerror or exc})") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise UserError(f"{path}: not UTF-8 text: allowed is a UTF-8 TOML file") from None
+    return parse_protocol(text, str(path))

@@ -1,0 +1,174 @@
+"""Runs a session's trials: routes knob, pad and time events to the current task,
+logs them, and keeps the closed loop on the task's condition and F_max.
+
+Whoever plays the session (the simulated participant, or the GUI for a person
+with MIDI knobs) calls the same methods: ``start_trial``, ``knob``, ``pad``,
+``set_bowing``, ``advance`` (run the loop for a while, which also ticks the
+task) and ``finish``. Every record a task returns is appended to the session
+log with the trial's ``step`` and ``task``. The loop's faults and the stability
+monitor's changes of verdict are logged too.
+
+The loop is made per trial by ``make_loop(estimators, source, seed)`` (the
+rating trial gets all its conditions, an adjustment trial only its own), so
+every adjustment trial starts from a string at rest with F_max = 0. Headless,
+the default builds ``studyapp.model.ClosedLoop`` in-process; the GUI passes a
+factory for the real-time engine.
+
+On resume, the rating trial gets back the knob positions logged before the
+interruption. An interrupted adjustment trial starts again from F_max = 0 (a
+sudden return to a high F_max could be unsafe on a real device).
+"""
+
+import numpy as np
+
+from studyapp import __version__
+from studyapp.experiment.adjustment_task import AdjustmentTask
+from studyapp.experiment.rating_task import RatingTask
+
+
+def closed_loop_factory(protocol, audio=False):
+    """``make_loop`` building the model's ClosedLoop in-process for ``protocol``."""
+
+    def make_loop(estimators, source, seed):
+        from studyapp.model import ClosedLoop, LoopConfig
+
+        config = LoopConfig(rate=protocol.rate, estimators=estimators, source=source, fmax=0.0,
+                            gesture=protocol.gesture, seed=seed, audio=audio)
+        return ClosedLoop(config)
+
+    return make_loop
+
+
+class SessionRunner:
+    def __init__(self, session, make_loop=None, progress=None):
+        self.session = session
+        self.protocol = session.protocol
+        self.make_loop = make_loop or closed_loop_factory(self.protocol)
+        self.progress = progress or (lambda message: None)
+        self.trial = None
+        self.task = None
+        self.loop = None
+        self.bowing = False
+        self._loop_source = None
+        self._loop_fmax = None
+        self._broken = False
+        self._fault = None
+
+    def log(self, event):
+        if self.trial is not None:
+            event = {"step": self.trial.step, "task": self.trial.task, **event}
+        return self.session.log.append(event)
+
+    def begin(self):
+        """Log the start of this run of the program (the first, or a resume)."""
+        resumed = any(e.get("type") == "run_start" for e in self.session.events())
+        done = len(self.session.finished_steps())
+        self.session.log.append({"type": "run_start", "resume": resumed, "app_version": __version__,
+                                 "finished_trials": done, "trials": len(self.session.schedule)})
+
+    def start_trial(self):
+        """Make the next unfinished trial current and return it (None when the session is done)."""
+        trial = self.session.next_trial()
+        self.trial, self.task, self.loop = trial, None, None
+        if trial is None:
+            return None
+        p = self.protocol
+        if trial.task == "rating":
+            spec = p.rating
+            self.task = RatingTask(trial.conditions, spec.fmax, spec.confirm_pad, trial.trial)
+            conditions = trial.conditions
+        else:
+            spec = p.adjustment
+            self.task = AdjustmentTask(trial.condition, trial.trial, spec.ceiling, spec.decades,
+                                       spec.knob, spec.confirm_pad)
+            conditions = (trial.condition,)
+        earlier = [e for e in self.session.events() if e.get("step") == trial.step]
+        restored = 0
+        if trial.task == "rating":
+            for e in earlier:
+                if e.get("type") == "knob":
+                    self.task.knob(e["index"], e["value"])
+                    restored += 1
+        seed = int(np.random.SeedSequence([self.session.seed, trial.step]).generate_state(1)[0])
+        estimators = {c: p.estimator_params(c) for c in conditions}
+        self.loop = self.make_loop(estimators, self.task.source or conditions[0], seed)
+        self._loop_source = self.task.source or conditions[0]
+        self._loop_fmax = None
+        self._broken = False
+        self._fault = None
+        self.bowing = False
+        self.log({"type": "trial_start", "trial": trial.trial, "condition": trial.condition,
+                  "conditions": list(trial.conditions), "restart": bool(earlier),
+                  "restored_knobs": restored, "loop_seed": seed})
+        self._apply()
+        self.progress(f"[{trial.step + 1}/{len(self.session.schedule)}] {trial.describe()}")
+        return trial
+
+    def _apply(self):
+        """Bring the loop to the task's condition and F_max (effective at the next block)."""
+        source = self.task.source
+        if source is not None and source != self._loop_source:
+            self.loop.set_source(source)
+            self._loop_source = source
+        fmax = self.task.fmax
+        if fmax != self._loop_fmax:
+            self.loop.set_fmax(fmax)
+            self._loop_fmax = fmax
+
+    def _handle(self, records):
+        response = None
+        for record in records:
+            stamped = self.log(record)
+            if record.get("type") == "response":
+                response = stamped
+        self._apply()
+        if response is not None:
+            self.set_bowing(False)
+            self.progress(f"    response: {self._summary(response)}")
+        return records
+
+    @staticmethod
+    def _summary(response):
+        if response["task"] == "rating":
+            return ", ".join(f"{r['condition']} {r['rating']:.2f}" for r in response["responses"])
+        return f"F_max = {response['fmax']:.3g} N"
+
+    def knob(self, index, value):
+        return self._handle(self.task.knob(index, value))
+
+    def pad(self, index):
+        return self._handle(self.task.pad(index))
+
+    def tick(self, dt):
+        return self._handle(self.task.tick(dt))
+
+    def set_bowing(self, on):
+        on = bool(on)
+        if self.loop is not None and on != self.bowing:
+            self.loop.set_bowing(on)
+            self.bowing = on
+            self.log({"type": "bowing", "on": on})
+
+    def advance(self, seconds):
+        """Run the loop for ``seconds`` (whole samples), tick the task, and return the loop's block."""
+        n = max(1, int(round(seconds * self.loop.rate)))
+        block = self.loop.run(n)
+        broken = bool(self.loop.monitor.broken)
+        if broken != self._broken:
+            self._broken = broken
+            self.log({"type": "stability", "broken": broken, "score": float(self.loop.monitor.score),
+                      "fmax": self.task.fmax})
+        if self.loop.fault is not None and self.loop.fault != self._fault:
+            self._fault = self.loop.fault
+            self.log({"type": "fault", "message": str(self.loop.fault), "fmax": self.task.fmax})
+        self.tick(n / self.loop.rate)
+        return block
+
+    def finish(self, reason="done"):
+        """Log the end of this run; and of the session, when every trial has a response."""
+        self.trial, self.task = None, None
+        complete = self.session.complete
+        if complete:
+            self.session.log.append({"type": "session_end"})
+        self.session.log.append({"type": "run_stop", "reason": reason})
+        return complete
