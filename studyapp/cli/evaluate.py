@@ -1,0 +1,113 @@
+"""``studyapp evaluate RECORDINGS... [--params PARAMS.toml] [--json] [-o DIR]`` (paper Sec. 7, Fig. 5).
+
+Per estimator and recording: error E and delay D, both also as percent of
+LOWPASS; the global objective and ranking; pairwise Wilcoxon rank-sum tests;
+Fig. 5-style box plots (a: F_max 0-7.7 N, b: 2.2-12.1 N); and with
+``--validation DIR`` the Sec. 7.3 comparison on an independent set.
+"""
+
+
+def register(sub):
+    p = sub.add_parser("evaluate", help="error, delay, objective and ranking of estimators on recordings (Fig. 5)")
+    p.add_argument("recordings", nargs="+", metavar="RECORDING",
+                   help="recording files (.npz/.h5/.csv) or directories of them")
+    p.add_argument("--params", metavar="PARAMS.toml", help="tuned parameters (from studyapp optimise)")
+    p.add_argument("--estimators", nargs="+", metavar="NAMES",
+                   help="estimators to evaluate (default: those in --params, else the paper's thirteen)")
+    p.add_argument("--reference", choices=("lvt", "true"), default="lvt",
+                   help="reference velocity: the LVT tachometer (paper) or the true velocity (default lvt)")
+    p.add_argument("--max-lag", type=float, default=0.02, metavar="SECONDS",
+                   help="longest delay searched by the cross-correlation (default 0.02 s)")
+    p.add_argument("--json", action="store_true", help="print the results as one JSON object")
+    p.add_argument("-o", "--output", metavar="DIR",
+                   help="write evaluation.json, evaluation.csv, wilcoxon.csv and the Fig. 5 plots here")
+    p.add_argument("--validation", metavar="DIR",
+                   help="also evaluate this independent set and compare at matching F_max (Sec. 7.3)")
+    p.set_defaults(func=run)
+
+
+def run(args):
+    import json
+    import sys
+    from pathlib import Path
+
+    from studyapp.errors import UserError
+    from studyapp.evaluation.dataset import Dataset, expand_paths, load_takes
+    from studyapp.evaluation.parameter_sets import parameter_sets
+    from studyapp.evaluation.report import evaluate
+
+    if args.max_lag <= 0:
+        raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
+    output = Path(args.output) if args.output else None
+    if output is not None and output.exists() and not output.is_dir():
+        raise UserError(f"-o {output}: exists and is not a directory")
+    takes = load_takes(expand_paths(args.recordings), args.reference)
+    params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes))
+    result = evaluate(Dataset(takes, args.max_lag), params)
+    document = result.to_json()
+    validation = None
+    if args.validation:
+        from studyapp.evaluation.validation import compare
+
+        other = load_takes(expand_paths([args.validation]), args.reference)
+        summary, rows = compare(result, evaluate(Dataset(other, args.max_lag), params))
+        validation = (summary, rows)
+        document["validation"] = summary
+    if output is not None:
+        _write_outputs(output, result, document, validation)
+    if args.json:
+        json.dump(document, sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _print_table(result, validation)
+    return 0
+
+
+def _write_outputs(output, result, document, validation):
+    import json
+    import sys
+
+    from studyapp.atomic import atomic_open
+    from studyapp.evaluation import figures
+    from studyapp.evaluation.report import GROUP_TITLES, GROUPS
+    from studyapp.evaluation.significance import pairwise
+    from studyapp.evaluation.tables import write_csv
+
+    output.mkdir(parents=True, exist_ok=True)
+    with atomic_open(output / "evaluation.json", "w", encoding="utf-8") as f:
+        json.dump(document, f, indent=1, allow_nan=False)
+    write_csv(output / "evaluation.csv", result.rows())
+    tests = []
+    for group in GROUPS:
+        if not result.group_mask(group).any():
+            print(f"studyapp evaluate: no recording in group {group} ({GROUP_TITLES[group]}): "
+                  f"no fig5{group}", file=sys.stderr)
+            continue
+        measures = result.measures(group)
+        for measure, samples in measures.items():
+            tests += [{"group": group, "measure": measure, **row} for row in pairwise(samples)]
+        figures.boxplots(measures, f"Fig. 5{group}: {GROUP_TITLES[group]}", output / f"fig5{group}")
+    write_csv(output / "wilcoxon.csv", tests, ["group", "measure", "a", "b", "n_a", "n_b", "median_a",
+                                               "median_b", "statistic", "p", "significant"])
+    if validation is not None:
+        summary, rows = validation
+        with atomic_open(output / "validation.json", "w", encoding="utf-8") as f:
+            json.dump(summary, f, indent=1, allow_nan=False)
+        write_csv(output / "validation.csv", rows)
+
+
+def _print_table(result, validation):
+    import numpy as np
+
+    print(f"{'rank':>4}  {'estimator':<11} {'objective':>10} {'E median':>11} {'E %LP':>7} "
+          f"{'D median':>8} {'D %LP':>7}")
+    for rank, name in enumerate(result.ranking, 1):
+        e, d = result.errors[name], result.delays[name]
+        print(f"{rank:>4}  {name:<11} {result.objective[name]:>10.4g} {np.median(e):>11.4g} "
+              f"{np.nanmedian(result.error_pct(name)):>7.1f} {np.median(d):>8.1f} "
+              f"{np.nanmedian(result.delay_pct(name)):>7.1f}")
+    if validation is not None:
+        s = validation[0]
+        print(f"validation ({s['matched_recordings']} matched recordings): error difference "
+              f"{s['error_difference_pct_mean']:.3g} +- {s['error_difference_pct_std'] or 0:.3g} %, "
+              f"delay difference {s['delay_difference_mean']:.3g} +- {s['delay_difference_std'] or 0:.3g} samples")

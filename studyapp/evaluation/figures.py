@@ -1,0 +1,125 @@
+"""Figures of the evaluation: Fig. 5-style box plots and the speed/accuracy trade.
+
+Fig. 5 (paper): for one group of recordings, three panels of box plots across
+recordings, the per-recording objective, the error and the delay as percent
+of LOWPASS, each with its estimators ordered best (lowest median) to worst.
+Boxes of the best estimator and of those not significantly different from it
+(Wilcoxon rank-sum, p >= 0.05) are filled; the others are hollow.
+
+Every figure is written as PNG and SVG (matplotlib, Agg backend).
+"""
+
+import numpy as np
+
+from studyapp.evaluation.significance import not_different_from_best
+
+PANELS = (
+    ("objective", "objective per recording"),
+    ("error_pct_lowpass", "error E (% of LOWPASS)"),
+    ("delay_pct_lowpass", "delay D (% of LOWPASS)"),
+)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, stem):
+    """Write ``stem``.png and ``stem``.svg atomically; return both paths."""
+    from studyapp.atomic import atomic_path
+
+    paths = []
+    for suffix in (".png", ".svg"):
+        target = stem.with_suffix(suffix)
+        with atomic_path(target) as tmp:
+            fig.savefig(tmp, format=suffix[1:], dpi=120, bbox_inches="tight")
+        paths.append(target)
+    return paths
+
+
+def boxplots(measures, title, stem):
+    """One Fig. 5-style figure: ``measures`` is measure -> name -> values."""
+    plt = _pyplot()
+    names = list(next(iter(measures.values())))
+    fig, axes = plt.subplots(1, 3, figsize=(max(9.0, 1.25 * len(names)), 4.6))
+    for ax, (key, label) in zip(axes, PANELS):
+        samples = {n: np.asarray(measures[key][n], dtype=np.float64) for n in names}
+        order = sorted(names, key=lambda n: np.nanmedian(samples[n]) if np.isfinite(samples[n]).any() else np.inf)
+        data = [samples[n][np.isfinite(samples[n])] for n in order]
+        best = not_different_from_best(samples)
+        parts = ax.boxplot(data, patch_artist=True, widths=0.6, showfliers=True)
+        for name, box in zip(order, parts["boxes"]):
+            box.set_facecolor("#8fb8de" if name in best else "white")
+            box.set_edgecolor("#1f3b57")
+        for median in parts["medians"]:
+            median.set_color("#b22222")
+        ax.set_xticks(range(1, len(order) + 1), order, rotation=60, ha="right", fontsize=8)
+        ax.set_title(label, fontsize=10)
+        if key != "objective":
+            ax.axhline(100.0, color="0.6", lw=0.8, ls="--")
+        ax.grid(axis="y", alpha=0.3)
+    fig.suptitle(f"{title}  (filled: best and not significantly different, Wilcoxon rank-sum p >= 0.05)",
+                 fontsize=10)
+    fig.tight_layout()
+    paths = save(fig, stem)
+    plt.close(fig)
+    return paths
+
+
+def tradeoff_plot(table, stem):
+    """Cost (ns/sample, streaming) against the global objective, one panel per rate, Pareto front drawn."""
+    plt = _pyplot()
+    rates = sorted({row["rate"] for row in table})
+    fig, axes = plt.subplots(1, len(rates), figsize=(4.2 * len(rates), 4.2), squeeze=False)
+    for ax, rate in zip(axes[0], rates):
+        rows = [r for r in table if r["rate"] == rate and np.isfinite(r["objective"])]
+        for r in rows:
+            ax.scatter(r["cost_ns_per_sample"], r["objective"], color="#1f77b4" if r["pareto"] else "0.6", s=22)
+            ax.annotate(r["estimator"], (r["cost_ns_per_sample"], r["objective"]), fontsize=7,
+                        xytext=(3, 3), textcoords="offset points")
+        front = sorted((r for r in rows if r["pareto"]), key=lambda r: r["cost_ns_per_sample"])
+        if front:
+            ax.step([r["cost_ns_per_sample"] for r in front], [r["objective"] for r in front], where="post",
+                    color="#1f77b4", lw=1.2, label="Pareto front")
+            ax.legend(fontsize=8)
+        ax.set_xscale("log")
+        ax.set_xlabel("cost (ns/sample, streaming form)")
+        ax.set_ylabel("global objective F_g (lower is better)")
+        ax.set_title(f"{rate / 1000:g} kHz", fontsize=10)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    paths = save(fig, stem)
+    plt.close(fig)
+    return paths
+
+
+def rate_plot(table, stem):
+    """What a higher rate buys: median error (m/s) and median delay (ms) of each estimator against rate."""
+    plt = _pyplot()
+    names = list(dict.fromkeys(row["estimator"] for row in table))
+    fig, axes = plt.subplots(1, 3, figsize=(13.0, 4.2))
+    for name in names:
+        rows = sorted((r for r in table if r["estimator"] == name), key=lambda r: r["rate"])
+        rates = [r["rate"] / 1000 for r in rows]
+        axes[0].plot(rates, [r["error_median"] for r in rows], marker="o", label=name)
+        axes[1].plot(rates, [r["delay_median_ms"] for r in rows], marker="o", label=name)
+        axes[2].plot(rates, [r["cost_ns_per_sample"] * r["rate"] * 1e-9 * 100 for r in rows], marker="o", label=name)
+    axes[0].set_ylabel("median error E (m/s)")
+    axes[1].set_ylabel("median delay D (ms)")
+    axes[2].set_ylabel("CPU load of one core (%)")
+    for ax in axes:
+        ax.set_xlabel("rate (kHz)")
+        ax.set_xscale("log")
+        ax.grid(alpha=0.3)
+    axes[0].set_yscale("log")
+    axes[2].set_yscale("log")
+    axes[2].legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    paths = save(fig, stem)
+    plt.close(fig)
+    return paths

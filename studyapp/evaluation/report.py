@@ -1,0 +1,156 @@
+"""The numerical comparison of tuned estimators (paper Sec. 7.2, Fig. 5).
+
+For every estimator and recording r: the delay-corrected error E_r (m/s) and
+the delay D_r (samples) of eqs. 22-24; both as a percentage of LOWPASS's on
+the same recording (Fig. 5's normalisation, since results vary between
+recordings but are consistent across estimators within one); and the
+normalised objectives of eqs. 29-32 with the bounds taken over the evaluated
+estimators themselves. A recording's objective is F_2r + F_2r+1; the global
+objective F_g is their sum over all recordings (eq. 27), and the ranking is by
+F_g, best (lowest) first.
+
+Fig. 5's two groups: (a) the recordings of F_max = 0 to 7.7 N, (b) the
+high-gain half, 2.2 to 12.1 N. A recording without a known F_max belongs to
+group a only.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from studyapp.evaluation.normalisation import bounds, per_objective
+
+BASELINE = "LOWPASS"
+GROUPS = {"a": (0.0, 7.7), "b": (2.2, 12.1)}
+GROUP_TITLES = {"a": "F_max 0 to 7.7 N", "b": "F_max 2.2 to 12.1 N (high gain)"}
+
+
+def in_group(fmax, group):
+    low, high = GROUPS[group]
+    if fmax is None:
+        return group == "a"
+    return low - 1e-9 <= fmax <= high + 1e-9
+
+
+def _percent(values, baseline):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pct = 100.0 * np.asarray(values, dtype=np.float64) / np.asarray(baseline, dtype=np.float64)
+    return np.where(np.isfinite(pct), pct, np.nan)
+
+
+@dataclass
+class Evaluation:
+    """E and D of each estimator on each recording, and what follows from them."""
+
+    names: list  # estimators evaluated, in the order given
+    recordings: list  # recording names (files)
+    fmax: list  # F_max of each recording (None when unknown)
+    rates: list
+    params: dict  # name -> parameters used
+    errors: dict  # name -> array (m/s)
+    delays: dict  # name -> array (samples)
+    baseline_errors: np.ndarray
+    baseline_delays: np.ndarray
+
+    def __post_init__(self):
+        raw = np.array([self._raw(name) for name in self.names])
+        self.offsets, self.scales = bounds(raw)
+        self.recording_objective = {}
+        self.objective = {}
+        for name, row in zip(self.names, raw):
+            f = per_objective(row, self.offsets, self.scales)
+            per_recording = f[0::2] + f[1::2]
+            self.recording_objective[name] = per_recording
+            self.objective[name] = float(np.sum(per_recording)) if np.all(np.isfinite(f)) else float("inf")
+
+    def _raw(self, name):
+        raw = np.empty(2 * len(self.recordings))
+        raw[0::2] = self.errors[name]
+        raw[1::2] = self.delays[name]
+        return raw
+
+    @property
+    def ranking(self):
+        return sorted(self.names, key=lambda n: (self.objective[n], self.names.index(n)))
+
+    def error_pct(self, name):
+        return _percent(self.errors[name], self.baseline_errors)
+
+    def delay_pct(self, name):
+        return _percent(self.delays[name], self.baseline_delays)
+
+    def group_mask(self, group):
+        return np.array([in_group(f, group) for f in self.fmax], dtype=bool)
+
+    def measures(self, group):
+        """measure -> name -> values over the group's recordings (for plots and tests)."""
+        mask = self.group_mask(group)
+        return {
+            "objective": {n: self.recording_objective[n][mask] for n in self.names},
+            "error_pct_lowpass": {n: self.error_pct(n)[mask] for n in self.names},
+            "delay_pct_lowpass": {n: self.delay_pct(n)[mask] for n in self.names},
+        }
+
+    def to_json(self):
+        """The ``studyapp evaluate --json`` structure (NaN becomes null)."""
+        return {
+            "estimators": {
+                name: {
+                    "error": _list(self.errors[name]),
+                    "delay": [int(d) for d in self.delays[name]],
+                    "error_pct_lowpass": _list(self.error_pct(name)),
+                    "delay_pct_lowpass": _list(self.delay_pct(name)),
+                    "objective": _number(self.objective[name]),
+                }
+                for name in self.names
+            },
+            "ranking": self.ranking,
+            "recordings": [
+                {"file": r, "fmax": f, "rate": rate}
+                for r, f, rate in zip(self.recordings, self.fmax, self.rates)
+            ],
+        }
+
+    def rows(self):
+        """Long-format rows, one per estimator and recording (evaluation.csv)."""
+        for name in self.names:
+            e_pct, d_pct = self.error_pct(name), self.delay_pct(name)
+            for r, recording in enumerate(self.recordings):
+                yield {
+                    "estimator": name, "recording": recording, "fmax": self.fmax[r],
+                    "error": self.errors[name][r], "delay": int(self.delays[name][r]),
+                    "delay_s": self.delays[name][r] / self.rates[r],
+                    "error_pct_lowpass": e_pct[r], "delay_pct_lowpass": d_pct[r],
+                    "recording_objective": self.recording_objective[name][r],
+                    "objective": self.objective[name], "rank": self.ranking.index(name) + 1,
+                }
+
+
+def _number(x):
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
+def _list(values):
+    return [_number(v) for v in values]
+
+
+def evaluate(dataset, params):
+    """An ``Evaluation`` of each ``name -> parameters`` in ``params`` on ``dataset``.
+
+    LOWPASS is the percentage baseline; when it is not among the names it is
+    run with its own entry of ``params`` if any, else Table 1's default.
+    """
+    names = list(params)
+    errors, delays = {}, {}
+    for name in names:
+        errors[name], delays[name] = dataset.delays_and_errors(name, params[name])
+    if BASELINE in errors:
+        base_e, base_d = errors[BASELINE], delays[BASELINE]
+    else:
+        base_e, base_d = dataset.delays_and_errors(BASELINE, {})
+    return Evaluation(
+        names=names, recordings=dataset.names, fmax=[t.fmax for t in dataset.takes],
+        rates=[t.rate for t in dataset.takes], params=params, errors=errors, delays=delays,
+        baseline_errors=base_e, baseline_delays=base_d,
+    )

@@ -1,0 +1,27 @@
+"""CSV tables of evaluation results, written atomically (NaN and None as empty cells)."""
+
+import csv
+import math
+
+from studyapp.atomic import atomic_open
+
+
+def _cell(v):
+    if v is None:
+        return ""
+    if isinstance(v, float):
+        return "" if math.isnan(v) else repr(v)
+    if hasattr(v, "item"):
+        return _cell(v.item())
+    return v
+
+
+def write_csv(path, rows, columns=None):
+    rows = list(rows)
+    if columns is None:
+        columns = list(rows[0]) if rows else []
+    with atomic_open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: _cell(row.get(k)) for k in columns})
