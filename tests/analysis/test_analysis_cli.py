@@ -1,0 +1,159 @@
+"""``studyapp analyse`` on a synthetic export: every output, missing trials reported, bad input refused."""
+
+import contextlib
+import io
+
+import pandas as pd
+import pytest
+
+from studyapp.cli import main
+from tests.analysis.conftest import SYNTHETIC_FMAX, SYNTHETIC_NOISINESS, synthetic_responses
+
+TABLES = {
+    "wilcoxon_adjustment.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
+    "wilcoxon_rating.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
+    "summary_adjustment.csv": ["condition", "n", "median", "q1", "q3"],
+    "summary_rating.csv": ["condition", "n", "median", "q1", "q3"],
+    "spearman_participants.csv": ["participant", "rho", "p_value"],
+}
+FIGURES = ["fig7_adjustment", "fig8_rating", "fig9_scatter"]
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    """One analysis of the synthetic study (P03 lacks FOAW trials 5 and 6), with its stderr."""
+    folder = tmp_path_factory.mktemp("analyse")
+    source = folder / "responses.csv"
+    synthetic_responses(drop={("P03", "FOAW", 5), ("P03", "FOAW", 6)}).to_csv(source, index=False)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main(["analyse", str(source), "-o", str(folder / "report")])
+    return code, folder / "report", err.getvalue()
+
+
+def test_every_table_has_its_columns_and_rows(report):
+    code, out, _ = report
+    assert code == 0
+    for name, columns in TABLES.items():
+        table = pd.read_csv(out / name)
+        assert list(table.columns) == columns, name
+        assert len(table) > 0, name
+    assert len(pd.read_csv(out / "wilcoxon_adjustment.csv")) == 9 * 8 // 2
+    assert len(pd.read_csv(out / "wilcoxon_rating.csv")) == 8 * 7 // 2
+    summary = pd.read_csv(out / "summary_adjustment.csv")
+    assert set(summary["condition"]) == set(SYNTHETIC_FMAX)
+    assert summary["condition"].iloc[0] == "LVT" and summary["condition"].iloc[-1] == "FOAW"
+    rating = pd.read_csv(out / "summary_rating.csv")
+    assert set(rating["condition"]) == set(SYNTHETIC_NOISINESS)
+    assert rating["condition"].iloc[0] == "LVT" and rating["condition"].iloc[-1] == "LEVANT"
+
+
+def test_figures_written_as_png_and_svg(report):
+    _, out, _ = report
+    for name in FIGURES:
+        assert (out / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert b"<svg" in (out / f"{name}.svg").read_bytes()[:2000]
+
+
+def test_report_is_self_contained(report):
+    _, out, _ = report
+    html = (out / "report.html").read_text()
+    assert html.count("data:image/png;base64,") == len(FIGURES)
+    assert "<img" in html and 'src="fig' not in html
+    for condition in SYNTHETIC_FMAX:
+        assert condition in html
+
+
+def test_missing_trials_are_reported_not_dropped(report):
+    _, out, err = report
+    missing = pd.read_csv(out / "missing_trials.csv")
+    assert missing[["participant", "task", "condition", "expected", "present"]].values.tolist() == [
+        ["P03", "adjustment", "FOAW", 6, 4]
+    ]
+    assert missing["missing_trials"].iloc[0] == "5;6"
+    assert "P03 has 4 of 6 adjustment responses for FOAW (missing trials 5, 6)" in err
+    assert "P03 has 4 of 6 adjustment responses for FOAW" in (out / "report.html").read_text()
+    # The participant's other responses still count.
+    summary = pd.read_csv(out / "summary_adjustment.csv").set_index("condition")
+    assert summary.loc["FOAW", "n"] == 9 * 6 - 2 and summary.loc["LVT", "n"] == 9 * 6
+    assert "P03" in set(pd.read_csv(out / "spearman_participants.csv")["participant"])
+
+
+def test_participant_without_a_task_is_reported(tmp_path, capsys):
+    frame = synthetic_responses(participants=4, trials=2, seed=3)
+    frame = frame[~((frame["participant"] == "P02") & (frame["task"] == "rating"))]
+    frame.to_csv(tmp_path / "r.csv", index=False)
+    assert main(["analyse", str(tmp_path / "r.csv"), "-o", str(tmp_path / "out")]) == 0
+    missing = pd.read_csv(tmp_path / "out" / "missing_trials.csv")
+    assert set(missing["participant"]) == {"P02"} and set(missing["task"]) == {"rating"}
+    assert len(missing) == len(SYNTHETIC_NOISINESS)
+    assert capsys.readouterr().err.count("P02 has 0 of 1 rating responses") == len(SYNTHETIC_NOISINESS)
+
+
+def test_expected_trials_from_the_command_line(tmp_path):
+    synthetic_responses(participants=3, trials=4, seed=1).to_csv(tmp_path / "r.csv", index=False)
+    assert main(["analyse", str(tmp_path / "r.csv"), "--trials", "6", "-o", str(tmp_path / "out")]) == 0
+    missing = pd.read_csv(tmp_path / "out" / "missing_trials.csv", dtype={"missing_trials": str})
+    assert len(missing) == 3 * len(SYNTHETIC_FMAX)
+    assert set(missing["missing_trials"]) == {"5;6"}
+
+
+def test_holm_and_evaluation_options(tmp_path, synthetic_csv):
+    evaluation = tmp_path / "eval"
+    evaluation.mkdir()
+    names = list(SYNTHETIC_FMAX)
+    (evaluation / "evaluation.json").write_text(pd.Series({
+        "estimators": {n: {"error": [k + 1.0], "delay": [9.0 - k]} for k, n in enumerate(names)},
+        "ranking": names,
+    }).to_json())
+    assert main(["analyse", str(synthetic_csv), "-o", str(tmp_path / "plain")]) == 0
+    assert main(["analyse", str(synthetic_csv), "--holm", "--evaluation", str(evaluation),
+                 "-o", str(tmp_path / "holm")]) == 0
+    plain = pd.read_csv(tmp_path / "plain" / "wilcoxon_adjustment.csv")
+    holm = pd.read_csv(tmp_path / "holm" / "wilcoxon_adjustment.csv")
+    assert (holm["p_value"] >= plain["p_value"] - 1e-15).all() and (holm["p_value"] > plain["p_value"]).any()
+    numerical = pd.read_csv(tmp_path / "holm" / "spearman_numerical.csv")
+    assert list(numerical["comparison"]) == ["noisiness vs error", "max F_max vs delay"]
+    assert numerical["n"].tolist() == [8, 9]
+    assert "Holm-corrected" in (tmp_path / "holm" / "report.html").read_text()
+
+
+def _bad(tmp_path, capsys, frame_or_text, name="bad.csv"):
+    path = tmp_path / name
+    if isinstance(frame_or_text, str):
+        path.write_text(frame_or_text)
+    else:
+        frame_or_text.to_csv(path, index=False)
+    code = main(["analyse", str(path), "-o", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    return code, err[-1], path
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda f: f.drop(columns=["fmax"]), ["missing column 'fmax'"]),
+    (lambda f: f.assign(task=f["task"].where(f.index != 4, "ratings")), ["column 'task'", "line 6", "ratings"]),
+    (lambda f: f.assign(fmax=f["fmax"].astype(object).where(f.index != 20, "lots")), ["column 'fmax'", "line 22", "lots"]),
+    (lambda f: f.assign(rating=f["rating"].where(f.index != 0, 3.0)), ["column 'rating'", "line 2", "[0, 1]"]),
+    (lambda f: f.assign(trial=f["trial"].where(f.index != 30, 0)), ["column 'trial'", "line 32"]),
+    (lambda f: f.assign(participant=f["participant"].where(f.index != 7, None)), ["column 'participant'", "line 9"]),
+    (lambda f: f.iloc[:0], ["no responses"]),
+])
+def test_bad_input_is_one_line_naming_file_and_column(tmp_path, capsys, edit, words):
+    code, line, path = _bad(tmp_path, capsys, edit(synthetic_responses(participants=2, trials=2)))
+    assert code == 2
+    assert line.startswith("studyapp: error: ") and str(path) in line
+    for word in words:
+        assert word in line
+    assert not (tmp_path / "out" / "report.html").exists()
+
+
+def test_unreadable_inputs_exit_2(tmp_path, capsys):
+    assert main(["analyse", str(tmp_path / "absent.csv"), "-o", str(tmp_path / "out")]) == 2
+    assert "absent.csv" in capsys.readouterr().err
+    (tmp_path / "notes.txt").write_text("x")
+    assert main(["analyse", str(tmp_path / "notes.txt"), "-o", str(tmp_path / "out")]) == 2
+    assert "notes.txt" in capsys.readouterr().err
+    code, line, _ = _bad(tmp_path, capsys, "")
+    assert code == 2 and "bad.csv" in line
+    code = main(["analyse", str(tmp_path / "bad.csv"), "--alpha", "2", "-o", str(tmp_path / "out")])
+    assert code == 2 and "--alpha" in capsys.readouterr().err
