@@ -1,0 +1,64 @@
+"""``studyapp simulate``: one simulated recording of bowing the string through the closed loop."""
+
+SOURCES_HELP = "velocity source in the loop: an estimator name, LVT or TRUE (default LVT)"
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "simulate",
+        help="simulate one recording (position, LVT, acceleration, ground truth, force, audio)",
+        description="Simulate bowing the string through the closed haptic loop and write a recording "
+                    "(.h5, .npz or .csv).",
+    )
+    p.add_argument("--fmax", type=float, default=1.0, help="peak friction force F_max in N (default 1)")
+    p.add_argument("--rate", type=float, default=5000.0, help="sample rate in Hz, 1000..96000 (default 5000)")
+    p.add_argument("--duration", type=float, default=7.0, help="seconds (default 7)")
+    p.add_argument("--source", default="LVT", help=SOURCES_HELP)
+    p.add_argument("--gesture", default="strokes", help="strokes, strokes-validation or hold (default strokes)")
+    p.add_argument("--f0", type=float, default=None, help="string pitch in Hz (default: the model's)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("-o", "--output", required=True, help="output file: .h5, .npz or .csv")
+    p.set_defaults(func=run)
+
+
+def check_source(name):
+    from studyapp.errors import ParameterError
+    from studyapp.estimators import names
+
+    allowed = [n for n in names()] + ["TRUE"]
+    if name not in allowed:
+        raise ParameterError(f"--source {name!r}: allowed are {', '.join(allowed)}")
+
+
+def check_gesture(name):
+    from studyapp.errors import ParameterError
+
+    allowed = ("strokes", "strokes-validation", "hold")
+    if name not in allowed:
+        raise ParameterError(f"--gesture {name!r}: allowed are {', '.join(allowed)}")
+
+
+def run(args):
+    import sys
+
+    from studyapp import recording
+    from studyapp.estimators.spec import validate_rate
+    from studyapp.model import simulate
+    from studyapp.model.loop import check_fmax
+
+    recording.check_path(args.output)
+    validate_rate(args.rate)
+    check_fmax(args.fmax)
+    check_source(args.source)
+    check_gesture(args.gesture)
+
+    def progress(done, total):
+        print(f"\rsimulate: {100 * done // total:3d}%", end="", file=sys.stderr, flush=True)
+
+    rec = simulate(args.fmax, rate=args.rate, duration=args.duration, source=args.source,
+                   gesture=args.gesture, f0=args.f0, seed=args.seed, progress=progress)
+    print("", file=sys.stderr)
+    recording.save(rec, args.output)
+    print(f"wrote {args.output} ({len(rec)} samples at {rec.rate:g} Hz, F_max {args.fmax:g} N, source {args.source})",
+          file=sys.stderr)
+    return 0

@@ -1,0 +1,155 @@
+"""Smith's digital-waveguide bowed string, STK ``Bowed``-style, with a force output (paper Sec. 3, Fig. 1).
+
+Two delay lines meet at the bow: the bridge side (a fraction ``beta`` of the
+loop) and the nut side (``1 - beta``). Each sample
+
+    v_h      = -L(bridge line out) - (nut line out)   incoming waves at the bow
+    v_delta  = v_bow - v_h
+    u        = rho(v_delta) * v_delta                  (bow_table.py; 0 when the bow is lifted)
+    nut line   <- -L(bridge line out) + u
+    bridge line <- -(nut line out) + u
+
+with both ends inverting reflections and the string's losses lumped into the
+bridge reflection L. The string velocity at the bow is v_h + u; the wave
+arriving at the bridge drives the body filter (body.py) for the audio. The
+string-on-bow force is F = -G u (bow_table.py derives G from F_max, eqs. 2, 20).
+
+What is derived from the sample rate, and why:
+
+- Loss filter. STK uses a one-pole low-pass with gain 0.95 and pole
+  0.75 - 0.2 * 22050 / rate: designed for 22.05-44.1 kHz, its pole crosses zero
+  at 5.88 kHz and turns negative below (a high-pass tilt, not a string loss).
+  Here L(z) = loss * (1 - p) / (1 - p z^-1) with p = exp(-2 pi f_loss / rate):
+  the same analog prototype (DC gain ``loss``, corner ``f_loss`` Hz) at every
+  rate. The default f_loss = 2.1 kHz is STK's own corner at its design rate
+  22.05 kHz (p = 0.55), so at that rate the two agree.
+- Pitch. The loop delay at f0 must be rate / f0 samples: the two lines' delays
+  plus the loss filter's phase delay at f0 (computed exactly, not STK's
+  "minus 4 samples"). The lines are read with linear interpolation (STK's
+  ``DelayL``), whose phase delay at low frequency equals its fraction, so the
+  pitch is right at any rate as long as each line keeps at least one sample
+  (rate / f0 >= about 10; below that the lines are clamped and the pitch is sharp).
+
+All velocities here are string units (STK's scale, where the bow sticks for
+|v_delta| below about 0.085 at slope 3); the loop converts from m/s.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from studyapp.model import bow_table
+
+# parameter vector layout
+P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET = range(6)
+N_PARAMS = 6
+# state vector layout
+S_WRITE, S_LOSS_Y = range(2)
+N_STATE = 2
+
+MIN_LINE_DELAY = 1.0
+
+
+@dataclass(frozen=True)
+class StringDesign:
+    """The string's parameters at one sample rate; ``params()`` packs them for the compiled loop."""
+
+    rate: float
+    f0: float
+    beta: float = 0.127236  # STK Bowed betaRatio_
+    slope: float = 3.0  # STK BowTable slope (bow pressure)
+    offset: float = 0.0
+    loss: float = 0.95  # STK stringFilter_ gain: the round trip's DC gain
+    f_loss: float = 2100.0  # Hz, STK's loss corner at its design rate 22.05 kHz
+
+    def __post_init__(self):
+        if not (0.0 < self.beta < 1.0):
+            raise ValueError(f"beta = {self.beta}: allowed is 0 < beta < 1")
+        if not (self.f0 > 0.0 and math.isfinite(self.f0)):
+            raise ValueError(f"f0 = {self.f0}: allowed is a positive frequency")
+
+    @property
+    def pole(self):
+        return math.exp(-2.0 * math.pi * self.f_loss / self.rate)
+
+    def loss_phase_delay(self, f):
+        """Phase delay (samples) of the loss filter at ``f`` Hz."""
+        w = 2.0 * math.pi * f / self.rate
+        p = self.pole
+        return math.atan2(p * math.sin(w), 1.0 - p * math.cos(w)) / w
+
+    def line_delays(self):
+        """(bridge-side delay, nut-side delay) in samples, each at least ``MIN_LINE_DELAY``."""
+        total = self.rate / self.f0 - self.loss_phase_delay(self.f0)
+        return (max(MIN_LINE_DELAY, self.beta * total), max(MIN_LINE_DELAY, (1.0 - self.beta) * total))
+
+    def buffer_length(self):
+        db, dn = self.line_delays()
+        return int(math.ceil(max(db, dn))) + 2
+
+    def params(self):
+        db, dn = self.line_delays()
+        p = self.pole
+        out = np.zeros(N_PARAMS)
+        out[P_DB], out[P_DN] = db, dn
+        out[P_LOSS_B0] = self.loss * (1.0 - p)
+        out[P_LOSS_A1] = p
+        out[P_SLOPE], out[P_OFFSET] = self.slope, self.offset
+        return out
+
+    def peak_friction(self):
+        """max |rho(v) v| in string units: F_max = G * this (eq. 20)."""
+        return bow_table.peak_friction(self.slope, self.offset)
+
+    def new_state(self):
+        """(state vector, bridge-side line, nut-side line), all at rest."""
+        n = self.buffer_length()
+        return np.zeros(N_STATE), np.zeros(n), np.zeros(n)
+
+
+@njit(cache=True, inline="always")
+def read_line(buf, write, delay):
+    """The value written ``delay`` samples ago (linear interpolation), ``delay >= 1``."""
+    n = buf.shape[0]
+    i = int(delay)
+    frac = delay - i
+    a = buf[(write - i) % n]
+    b = buf[(write - i - 1) % n]
+    return a + frac * (b - a)
+
+
+@njit(cache=True, inline="always")
+def step(p, s, bridge, nut, v_bow, bowing):
+    """One sample of the string; returns ``(u, v_string, v_bridge, v_delta)``.
+
+    ``u = rho(v_delta) v_delta`` is the junction's added wave (the friction
+    force is -G u); ``v_string`` the string velocity at the bow; ``v_bridge``
+    the wave arriving at the bridge (the body filter's input).
+    """
+    write = int(s[S_WRITE])
+    v_bridge = read_line(bridge, write, p[P_DB])
+    y = p[P_LOSS_B0] * v_bridge + p[P_LOSS_A1] * s[S_LOSS_Y]
+    s[S_LOSS_Y] = y
+    bridge_refl = -y
+    nut_refl = -read_line(nut, write, p[P_DN])
+    v_h = bridge_refl + nut_refl
+    v_delta = v_bow - v_h
+    u = 0.0
+    if bowing:
+        u = bow_table.rho(v_delta, p[P_SLOPE], p[P_OFFSET]) * v_delta
+    nut[write] = bridge_refl + u
+    bridge[write] = nut_refl + u
+    s[S_WRITE] = (write + 1) % bridge.shape[0]
+    return u, v_h + u, v_bridge, v_delta
+
+
+@njit(cache=True)
+def run(p, s, bridge, nut, v_bow, bowing, u_out, v_out, bridge_out):
+    """The string alone, driven by a bow velocity array (for tests and figures)."""
+    for k in range(v_bow.shape[0]):
+        u, vs, vb, vd = step(p, s, bridge, nut, v_bow[k], bowing)
+        u_out[k] = u
+        v_out[k] = vs
+        bridge_out[k] = vb

@@ -1,0 +1,187 @@
+"""Signal recordings: the paper's data set format (Sec. 6.1), on disk and in memory.
+
+A ``Recording`` is a sample rate, a set of equally long columns and a dict of
+metadata. On disk it is one of
+
+- ``.h5``  HDF5: one dataset per column, metadata as JSON in the root attribute ``meta``;
+- ``.npz`` NumPy: one array per column plus ``__meta__`` (JSON text);
+- ``.csv`` exchange: the columns ``COLUMNS`` in that order, one row per sample, with the
+  metadata as one leading comment line ``# {json}`` (pandas reads it with ``comment="#"``).
+
+Units are SI: t (s), position (m), velocity_lvt, velocity_true, string_velocity (m/s),
+acceleration, acceleration_true (m/s^2), force (N, the force commanded on the handle),
+audio (arbitrary units, the body filter's output).
+
+Writes are atomic (``studyapp.atomic``): a failure leaves no partial file. ``load``
+raises ``InputDataError`` naming the file and what is wrong with it.
+"""
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from studyapp.atomic import atomic_open, atomic_path
+from studyapp.errors import InputDataError, UserError
+
+COLUMNS = (
+    "t", "position", "velocity_lvt", "acceleration", "velocity_true",
+    "acceleration_true", "force", "string_velocity", "audio",
+)
+SUFFIXES = (".h5", ".npz", ".csv")
+META_KEYS = ("fmax", "rate", "source", "gesture", "f0", "seed", "duration", "version")
+FORMAT_VERSION = 1  # stored as meta["format"]; meta["version"] is the app's version
+
+
+@dataclass
+class Recording:
+    """``rate`` (Hz), ``columns`` (name -> 1-D float64 array, all the same length), ``meta``."""
+
+    rate: float
+    columns: dict
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.rate = float(self.rate)
+        self.columns = {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in self.columns.items()}
+        lengths = {v.shape for v in self.columns.values()}
+        if len(lengths) > 1 or any(len(s) != 1 for s in lengths):
+            raise InputDataError(f"recording columns must be 1-D arrays of one length, got shapes {sorted(lengths)}")
+
+    def __len__(self):
+        return next(iter(self.columns.values())).shape[0] if self.columns else 0
+
+    def __getitem__(self, name):
+        return self.columns[name]
+
+
+def _suffix(path):
+    suffix = Path(path).suffix.lower()
+    if suffix not in SUFFIXES:
+        raise UserError(f"{path}: unknown recording format {suffix or '(no suffix)'!r}: allowed are {', '.join(SUFFIXES)}")
+    return suffix
+
+
+def check_path(path):
+    """Raise ``UserError`` unless ``path`` has a recording suffix (call before a long job)."""
+    _suffix(path)
+
+
+def _meta_json(recording):
+    from studyapp import __version__
+
+    meta = {"format": FORMAT_VERSION, "version": __version__, **recording.meta, "rate": recording.rate}
+    return json.dumps(meta, sort_keys=True, default=_plain)
+
+
+def _plain(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"metadata value {value!r} is not JSON")
+
+
+def save(recording, path):
+    """Write ``recording`` to ``path`` (format by suffix: .h5, .npz or .csv), atomically."""
+    suffix = _suffix(path)
+    meta = _meta_json(recording)
+    if suffix == ".npz":
+        with atomic_open(path, "wb") as f:
+            np.savez(f, __meta__=np.array(meta), **recording.columns)
+    elif suffix == ".h5":
+        import h5py
+
+        with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+            f.attrs["meta"] = meta
+            for name, values in recording.columns.items():
+                f.create_dataset(name, data=values)
+    else:
+        missing = [c for c in COLUMNS if c not in recording.columns]
+        if missing:
+            raise InputDataError(f"{path}: a CSV recording needs the columns {', '.join(COLUMNS)}; missing {', '.join(missing)}")
+        table = np.column_stack([recording.columns[c] for c in COLUMNS])
+        with atomic_open(path, "w", newline="") as f:
+            f.write(f"# {meta}\n")
+            f.write(",".join(COLUMNS) + "\n")
+            np.savetxt(f, table, delimiter=",", fmt="%.17g")
+
+
+def load(path):
+    """Read a recording written by ``save`` (or any CSV with the ``COLUMNS`` header)."""
+    path = Path(path)
+    suffix = _suffix(path)
+    if not path.is_file():
+        raise InputDataError(f"{path}: no such file")
+    try:
+        if suffix == ".npz":
+            columns, meta = _load_npz(path)
+        elif suffix == ".h5":
+            columns, meta = _load_h5(path)
+        else:
+            columns, meta = _load_csv(path)
+    except InputDataError:
+        raise
+    except Exception as exc:  # any parser failure is a bad input file, reported in one line
+        raise InputDataError(f"{path}: not a readable {suffix} recording ({type(exc).__name__}: {exc})") from None
+    rate = meta.get("rate")
+    if rate is None and "t" in columns and len(columns["t"]) > 1:
+        rate = 1.0 / float(np.median(np.diff(columns["t"])))
+    if rate is None or not np.isfinite(float(rate)) or float(rate) <= 0:
+        raise InputDataError(f"{path}: no valid sample rate (metadata 'rate' or a 't' column)")
+    try:
+        return Recording(float(rate), columns, meta)
+    except InputDataError as exc:
+        raise InputDataError(f"{path}: {exc}") from None
+
+
+def _parse_meta(text, path):
+    try:
+        meta = json.loads(text)
+    except json.JSONDecodeError:
+        raise InputDataError(f"{path}: metadata is not valid JSON") from None
+    if not isinstance(meta, dict):
+        raise InputDataError(f"{path}: metadata must be a JSON object")
+    return meta
+
+
+def _load_npz(path):
+    with np.load(path, allow_pickle=False) as data:
+        meta = _parse_meta(str(data["__meta__"]), path) if "__meta__" in data.files else {}
+        columns = {k: np.asarray(data[k], dtype=np.float64) for k in data.files if k != "__meta__"}
+    return columns, meta
+
+
+def _load_h5(path):
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        raw = f.attrs.get("meta", "{}")
+        meta = _parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), path)
+        columns = {k: np.asarray(f[k][()], dtype=np.float64) for k in f.keys()}
+    return columns, meta
+
+
+def _load_csv(path):
+    meta = {}
+    with open(path, encoding="utf-8") as f:
+        first = f.readline()
+        if first.startswith("#"):
+            meta = _parse_meta(first[1:].strip(), path)
+            header = f.readline()
+        else:
+            header = first
+        names = [h.strip() for h in header.strip().split(",")]
+        missing = [c for c in COLUMNS if c not in names]
+        if missing:
+            raise InputDataError(f"{path}: CSV header lacks the column(s) {', '.join(missing)}; expected {', '.join(COLUMNS)}")
+        try:
+            table = np.loadtxt(f, delimiter=",", ndmin=2)
+        except ValueError as exc:
+            raise InputDataError(f"{path}: bad CSV cell ({exc})") from None
+    if table.size == 0:
+        table = np.zeros((0, len(names)))
+    if table.shape[1] != len(names):
+        raise InputDataError(f"{path}: rows have {table.shape[1]} cells, header has {len(names)}")
+    return {name: table[:, i].copy() for i, name in enumerate(names)}, meta
