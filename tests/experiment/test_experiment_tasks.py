@@ -1,0 +1,113 @@
+"""Task logic: scripted event sequences give the expected logged responses."""
+
+import math
+
+import pytest
+
+from studyapp.experiment.adjustment_task import AdjustmentTask
+from studyapp.experiment.fmax_knob import fmax_from_knob, knob_from_fmax
+from studyapp.experiment.rating_task import RatingTask, normalise_ratings
+
+CONDITIONS = ("LOWPASS", "LEVANT", "KALLEV", "LVT")
+
+
+def play(task, script):
+    """Feed ``script`` (tuples like ("knob", i, v), ("pad", i), ("tick", dt)) and collect the records."""
+    records = []
+    for kind, *args in script:
+        records += getattr(task, kind)(*args)
+    return records
+
+
+def test_rating_knob_selects_and_rates():
+    task = RatingTask(CONDITIONS, fmax=1.0)
+    assert task.source is None and task.fmax == 0.0
+    records = play(task, [("knob", 2, 50), ("tick", 0.5), ("knob", 0, 10), ("tick", 0.25)])
+    assert records == [
+        {"type": "knob", "index": 2, "value": 50, "condition": "KALLEV"},
+        {"type": "knob", "index": 0, "value": 10, "condition": "LOWPASS"},
+    ]
+    assert task.source == "LOWPASS" and task.fmax == 1.0
+    assert task.dwell["KALLEV"] == 0.5 and task.dwell["LOWPASS"] == 0.25
+
+
+def test_rating_full_sequence_gives_the_normalised_response():
+    task = RatingTask(CONDITIONS, fmax=1.0, confirm_pad=3)
+    script = [
+        ("knob", 3, 127), ("tick", 1.0),  # best first: LVT at the top
+        ("knob", 1, 0), ("tick", 1.0),    # worst: LEVANT at the bottom
+        ("knob", 0, 40), ("knob", 0, 64),  # LOWPASS turned, then placed
+        ("knob", 2, 100),
+        ("pad", 0),                        # another pad: logged, ignored
+        ("pad", 3),
+    ]
+    records = play(task, script)
+    assert [r["type"] for r in records] == ["knob"] * 5 + ["pad", "pad", "response"]
+    assert records[5] == {"type": "pad", "index": 0}
+    assert records[6] == {"type": "pad", "index": 3, "accepted": True}
+    response = records[7]
+    assert task.done and response is task.response
+    assert response["task"] == "rating" and response["trial"] == 1 and response["fmax"] == 1.0
+    assert response["duration"] == 2.0
+    got = {r["condition"]: (r["knob"], r["value"], r["rating"]) for r in response["responses"]}
+    # Noisiness: 0 = the best (highest knob), 1 = the worst (lowest knob).
+    assert got == {"LOWPASS": (0, 64, pytest.approx(63 / 127)), "LEVANT": (1, 0, 1.0),
+                   "KALLEV": (2, 100, pytest.approx(27 / 127)), "LVT": (3, 127, 0.0)}
+    assert play(task, [("knob", 0, 5), ("pad", 3)]) == [{"type": "pad", "index": 3}]
+
+
+def test_rating_normalises_within_the_participants_range():
+    ratings = normalise_ratings({"A": 20, "B": 100, "C": 60})
+    assert ratings == {"A": 1.0, "B": 0.0, "C": 0.5}
+    assert all(0.0 <= r <= 1.0 for r in ratings.values())
+    with pytest.raises(ValueError):
+        normalise_ratings({"A": 3, "B": 3})
+
+
+def test_rating_confirm_is_refused_until_complete():
+    task = RatingTask(CONDITIONS, fmax=1.0)
+    records = play(task, [("knob", 0, 127), ("knob", 1, 0), ("pad", 0)])
+    assert records[-1]["accepted"] is False and "KALLEV, LVT" in records[-1]["reason"]
+    records = play(task, [("knob", 0, 30), ("knob", 1, 30), ("knob", 2, 30), ("knob", 3, 30), ("pad", 0)])
+    assert records[-1]["accepted"] is False and "same rating" in records[-1]["reason"]
+    assert not task.done
+
+
+def test_rating_ignores_unassigned_knobs_and_rejects_bad_values():
+    task = RatingTask(CONDITIONS, fmax=1.0)
+    assert task.knob(7, 10) == [] and task.source is None
+    for bad in (-1, 128, 1.5, True):
+        with pytest.raises(ValueError, match="knob value"):
+            task.knob(0, bad)
+
+
+def test_adjustment_sequence_with_overshoot():
+    task = AdjustmentTask("LOWPASS", trial=2, ceiling=40.0, decades=3.0, knob=0, confirm_pad=1)
+    assert task.fmax == 0.0 and task.source == "LOWPASS"
+    script = [("pad", 1), ("knob", 1, 99), ("knob", 0, 60), ("tick", 0.5), ("knob", 0, 100),
+              ("tick", 0.5), ("knob", 0, 96), ("pad", 0), ("pad", 1)]
+    records = play(task, script)
+    assert records[0] == {"type": "pad", "index": 1, "accepted": False, "reason": "F_max is 0: turn the knob up first"}
+    knobs = [r for r in records if r["type"] == "knob"]
+    assert [r["value"] for r in knobs] == [60, 100, 96]
+    response = records[-1]
+    expected = 40.0 * (10 ** (3 * 96 / 127) - 1) / (10**3 - 1)
+    assert response == {
+        "type": "response", "task": "adjustment", "condition": "LOWPASS", "trial": 2,
+        "fmax": pytest.approx(expected), "value": 96,
+        "peak_fmax": pytest.approx(40.0 * (10 ** (3 * 100 / 127) - 1) / 999), "duration": 1.0,
+    }
+    assert task.done and task.knob(0, 5) == [] and task.fmax == pytest.approx(expected)
+
+
+def test_fmax_knob_map_is_logarithmic_from_zero_to_the_ceiling():
+    assert fmax_from_knob(0, 40.0, 3.0) == 0.0
+    assert fmax_from_knob(127, 40.0, 3.0) == pytest.approx(40.0)
+    # Near the top, one step multiplies F_max by about 10^(d/127).
+    ratio = fmax_from_knob(120, 40.0, 3.0) / fmax_from_knob(119, 40.0, 3.0)
+    assert ratio == pytest.approx(10 ** (3 / 127), rel=2e-3)
+    values = [fmax_from_knob(k, 12.0, 2.0) for k in range(128)]
+    assert all(b > a for a, b in zip(values, values[1:]))
+    for k in (1, 17, 64, 126):
+        assert knob_from_fmax(fmax_from_knob(k, 12.0, 2.0), 12.0, 2.0) == pytest.approx(k)
+    assert math.isclose(fmax_from_knob(127 / 3, 999.0, 3.0), 9.0)  # 10^1 - 1 = 9
