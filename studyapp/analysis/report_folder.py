@@ -9,28 +9,58 @@ Names are fixed, so scripts and the GUI find them:
     missing_trials.csv                             participant, task, condition, expected, present, missing_trials
     spearman_numerical.csv                         only with an evaluation
     responses_analysed.csv                         the checked responses the numbers come from
+    analysis_settings.json                         source, Holm, alpha, expected trials, evaluation
     fig7_adjustment, fig8_rating, fig9_scatter     .png and .svg
     report.html                                    everything above in one file
 
 Each file is written atomically; report.html comes last, so its presence
-means the folder is complete.
+means the folder is complete. ``open_study`` reads a report folder back (its
+responses and settings give the same figures), or analyses a results folder or
+a responses .csv with the defaults: what the GUI's analysis view shows.
 """
 
+import json
 from pathlib import Path
 
 from studyapp.analysis.consistency import SPEARMAN_COLUMNS
 from studyapp.analysis.figures import FIGURES, render, save_figure
+from studyapp.analysis.numerical import load_evaluation
 from studyapp.analysis.rank_sum import WILCOXON_COLUMNS
 from studyapp.analysis.report import report_html
+from studyapp.analysis.responses import load_responses
+from studyapp.analysis.study import analyse
 from studyapp.analysis.summary import SUMMARY_COLUMNS
 from studyapp.atomic import atomic_open
+from studyapp.errors import InputDataError
 
 RESPONSES_FILE = "responses_analysed.csv"
+SETTINGS_FILE = "analysis_settings.json"
 REPORT_FILE = "report.html"
 
 
-def write_report_folder(study, directory, progress=None):
+def open_study(path):
+    """``StudyAnalysis`` of a report folder, a results folder or a responses .csv at ``path``."""
+    path = Path(path)
+    settings_path = path / SETTINGS_FILE
+    if not (path.is_dir() and (path / RESPONSES_FILE).is_file() and settings_path.is_file()):
+        responses, label = load_responses(path)
+        return analyse(responses, source=label)
+    try:
+        settings = json.loads(settings_path.read_text(encoding="utf-8"))
+        source, holm, alpha = str(settings["source"]), bool(settings["holm"]), float(settings["alpha"])
+        expected, evaluation = settings.get("expected"), settings.get("evaluation")
+    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError) as exc:
+        raise InputDataError(f"{settings_path}: not a valid analysis settings file ({exc})") from None
+    responses, _ = load_responses(path / RESPONSES_FILE)
+    evaluation = load_evaluation(evaluation) if evaluation and Path(evaluation).exists() else None
+    return analyse(responses, source=source, evaluation=evaluation, holm=holm, alpha=alpha, expected=expected)
+
+
+def write_report_folder(study, directory, progress=None, evaluation_path=None, expected=None):
     """Write every output of ``study`` into ``directory``; returns the paths written.
+
+    ``evaluation_path`` and ``expected`` (the analysis inputs besides the
+    responses) are recorded in the settings file for ``open_study``.
 
     ``progress`` is called with a short message before each step (or None).
     """
@@ -55,6 +85,17 @@ def write_report_folder(study, directory, progress=None):
     if study.numerical is not None:
         table("spearman_numerical.csv", study.numerical)
     table(RESPONSES_FILE, study.responses)
+    settings = {
+        "source": study.source,
+        "holm": study.holm,
+        "alpha": study.alpha,
+        "expected": expected,
+        "evaluation": None if evaluation_path is None else str(Path(evaluation_path).resolve()),
+    }
+    path = directory / SETTINGS_FILE
+    with atomic_open(path, "w", encoding="utf-8") as f:
+        json.dump(settings, f, indent=2)
+    written.append(path)
 
     pngs = {}
     for name in FIGURES:

@@ -51,6 +51,6 @@ def run(args):
         say(f"warning: {describe_missing(row)}")
     if not study.missing.empty:
         say(f"{len(study.missing)} short participant/condition combinations listed in missing_trials.csv")
-    write_report_folder(study, args.output, progress=say)
+    write_report_folder(study, args.output, progress=say, evaluation_path=args.evaluation, expected=expected)
     say(f"report: {args.output}/report.html")
     return 0
