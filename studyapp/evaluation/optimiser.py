@@ -96,6 +96,7 @@ class Optimiser:
         self.evaluated = 0
         self.seconds = 0.0
         self.resumed = False
+        self._snapshot = None
 
     # -- evaluation ----------------------------------------------------------------
     def _evaluate(self, proposals):
@@ -130,8 +131,9 @@ class Optimiser:
         }
 
     def _save(self):
-        if self.checkpoint is not None:
-            checkpoints.write(self.checkpoint, self.state())
+        """Write the state as of the last completed iteration (never a half-done one)."""
+        if self.checkpoint is not None and self._snapshot is not None:
+            checkpoints.write(self.checkpoint, self._snapshot)
 
     def resume(self, path):
         """Continue from the checkpoint at ``path`` (made by a run with the same fingerprint)."""
@@ -147,6 +149,7 @@ class Optimiser:
         self.evaluated = int(state["evaluated"])
         self.seconds = float(state["seconds"])
         self.resumed = True
+        self._snapshot = self.state()
 
     # -- the procedure ------------------------------------------------------------------
     def run(self):
@@ -161,6 +164,8 @@ class Optimiser:
             tolerance = 1e-6 * j if self.tolerance is None else float(self.tolerance)
             self.sum = ObjectiveSum(tolerance)
             self.sum.start(raws)
+            self.seconds = time.monotonic() - started
+            self._snapshot = self.state()
         try:
             while True:
                 active = self._active()
@@ -173,12 +178,12 @@ class Optimiser:
                 for name in active:
                     self.searches[name].report(proposals[name], decisions[name].accepted)
                 self.seconds = time.monotonic() - started
+                self._snapshot = self.state()
                 self._report(final=False)
                 if self.checkpoint is not None and time.monotonic() - last_save >= self.checkpoint_interval:
                     self._save()
                     last_save = time.monotonic()
         except KeyboardInterrupt:
-            self.seconds = time.monotonic() - started
             self._save()
             raise
         self.seconds = time.monotonic() - started
