@@ -1,0 +1,160 @@
+"""The engine's shared status block: one writer (the worker), any reader, never torn.
+
+A sequence lock: the writer makes the sequence number odd, writes every field,
+then makes it even again; a reader copies the fields between two reads of the
+sequence number and keeps the copy only when both reads are equal and even.
+(x86-64 keeps stores and loads in program order; see ring.py.)
+
+Beside the locked record sits one word the parent writes and the worker reads:
+``force_enable``. The watchdog clears it when the worker stops answering, so a
+worker that is merely slow, not dead, zeroes its force at its next block.
+"""
+
+import time
+from multiprocessing import shared_memory
+
+import numpy as np
+
+NUMBERS = (
+    "heartbeat",  # time.monotonic() at the end of the last block
+    "state",  # one of STATES
+    "rate",  # nominal haptic rate, Hz
+    "block",  # samples per block
+    "blocks",  # blocks run
+    "samples",  # haptic samples run
+    "achieved_rate",  # samples per second of wall time over the last second
+    "load",  # compute time of the last block / block period
+    "load_mean",  # mean of load over the last second
+    "load_max",  # largest load over the last second
+    "deadline_misses",  # blocks finished after their deadline on the pacing clock
+    "audio_underruns",  # device periods the engine did not fill in time (silence played)
+    "audio_xruns",  # xruns the audio device itself reported
+    "faults",  # faults raised so far (latched or not)
+    "fault_latched",  # 1 while a latched fault holds the force at zero
+    "fmax",  # F_max in force now, N
+    "force_scale",  # safety ramp gain, 0..1
+    "command_latency",  # last command: send -> first block run with it, s
+    "command_latency_max",  # largest of those, s
+    "midi_messages",  # MIDI messages received
+    "audio_paced",  # 1 when the audio clock paces the loop, 0 for the monotonic timer
+)
+
+TEXTS = {"source": 32, "fault": 200, "audio": 120, "midi": 120}
+
+STATES = ("starting", "running", "stopping", "stopped", "failed")
+
+_SEQ = 8
+_ENABLE = 8
+
+
+class StatusBlock:
+    """The record in shared memory. ``create()`` in the parent, ``attach(name)`` in the worker."""
+
+    def __init__(self, shm, owner):
+        self._shm = shm
+        self._owner = owner
+        buf = shm.buf
+        self._seq = np.ndarray((1,), dtype=np.int64, buffer=buf)
+        self._enable = np.ndarray((1,), dtype=np.float64, buffer=buf, offset=_SEQ)
+        offset = _SEQ + _ENABLE
+        self._numbers = np.ndarray((len(NUMBERS),), dtype=np.float64, buffer=buf, offset=offset)
+        offset += 8 * len(NUMBERS)
+        self._texts = np.ndarray((sum(TEXTS.values()),), dtype=np.uint8, buffer=buf, offset=offset)
+        self._slices = {}
+        start = 0
+        for key, size in TEXTS.items():
+            self._slices[key] = slice(start, start + size)
+            start += size
+        self.values = np.zeros(len(NUMBERS))
+        self.texts = {key: "" for key in TEXTS}
+        self._index = {key: i for i, key in enumerate(NUMBERS)}
+
+    @classmethod
+    def size(cls):
+        return _SEQ + _ENABLE + 8 * len(NUMBERS) + sum(TEXTS.values())
+
+    @classmethod
+    def create(cls):
+        shm = shared_memory.SharedMemory(create=True, size=cls.size())
+        block = cls(shm, owner=True)
+        block._seq[0] = 0
+        block._enable[0] = 1.0
+        block._numbers[:] = 0.0
+        block._texts[:] = 0
+        return block
+
+    @classmethod
+    def attach(cls, name):
+        return cls(shared_memory.SharedMemory(name=name), owner=False)
+
+    @property
+    def name(self):
+        return self._shm.name
+
+    # writer side ---------------------------------------------------------
+    def set(self, **fields):
+        """Stage fields (numbers or texts) for the next ``publish``."""
+        for key, value in fields.items():
+            if key in self.texts:
+                self.texts[key] = str(value)
+            elif key == "state":
+                self.values[self._index[key]] = STATES.index(value)
+            else:
+                self.values[self._index[key]] = value
+
+    def get(self, key):
+        """A staged number (writer side)."""
+        return self.values[self._index[key]]
+
+    def publish(self, texts=False):
+        """Copy the staged record into shared memory; ``texts=True`` copies the texts too."""
+        self._seq[0] += 1
+        self._numbers[:] = self.values
+        if texts:
+            for key, sl in self._slices.items():
+                raw = self.texts[key].encode("utf-8", "replace")[: sl.stop - sl.start]
+                field = self._texts[sl]
+                field[:] = 0
+                field[: len(raw)] = np.frombuffer(raw, dtype=np.uint8)
+        self._seq[0] += 1
+
+    # reader side ---------------------------------------------------------
+    def read(self, retries=1000):
+        """A consistent snapshot: a dict of every number and text (``state`` as its name)."""
+        for _ in range(retries):
+            before = int(self._seq[0])
+            if before % 2:
+                time.sleep(0)
+                continue
+            numbers = self._numbers.copy()
+            texts = self._texts.copy()
+            if int(self._seq[0]) == before:
+                break
+        else:
+            raise RuntimeError("status block: writer never finished a record")
+        out = {key: float(numbers[i]) for i, key in enumerate(NUMBERS)}
+        for key in ("blocks", "samples", "deadline_misses", "audio_underruns", "audio_xruns",
+                    "faults", "midi_messages", "block"):
+            out[key] = int(out[key])
+        out["state"] = STATES[int(out["state"])]
+        out["fault_latched"] = bool(out["fault_latched"])
+        out["audio_paced"] = bool(out["audio_paced"])
+        for key, sl in self._slices.items():
+            out[key] = bytes(texts[sl]).rstrip(b"\0").decode("utf-8", "replace")
+        return out
+
+    # the parent's word ---------------------------------------------------
+    @property
+    def force_enable(self):
+        return bool(self._enable[0])
+
+    @force_enable.setter
+    def force_enable(self, on):
+        self._enable[0] = 1.0 if on else 0.0
+
+    def close(self):
+        self._seq = self._enable = self._numbers = self._texts = None
+        self._shm.close()
+        if self._owner:
+            self._shm.unlink()
+            self._owner = False
