@@ -1,0 +1,74 @@
+"""Wilcoxon rank-sum tests, the Pareto front and the Fig. 5 report, against hand values and scipy."""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from studyapp.evaluation.dataset import Dataset, Take
+from studyapp.evaluation.metric import delay_and_error
+from studyapp.evaluation.pareto import pareto_front
+from studyapp.evaluation.report import evaluate, in_group
+from studyapp.evaluation.significance import not_different_from_best, pairwise, rank_sum
+from tests.evaluation.conftest import stick_slip
+
+
+def test_rank_sum_exact_p_for_separated_samples():
+    # 5 vs 5, completely separated: exact two-sided p = 2 / C(10, 5) = 2 / 252.
+    u, p = rank_sum([1, 2, 3, 4, 5], [6, 7, 8, 9, 10])
+    assert p == pytest.approx(2 / 252)
+    assert u == 0.0
+
+
+def test_rank_sum_with_ties_agrees_with_the_normal_approximation():
+    rng = np.random.default_rng(0)
+    a, b = rng.integers(0, 5, 30), rng.integers(1, 6, 30)
+    _, p = rank_sum(a, b)
+    z = stats.ranksums(a, b).pvalue  # no tie correction: close, not equal
+    assert p == pytest.approx(z, rel=0.1)
+
+
+def test_pairwise_and_best_group():
+    samples = {"A": np.array([1.0, 1.1, 0.9, 1.2, 1.0, 0.95]), "B": np.array([1.05, 1.0, 1.15, 0.9, 1.1, 1.0]),
+               "C": np.array([3.0, 3.2, 2.9, 3.1, 3.3, 3.05])}
+    rows = {(r["a"], r["b"]): r for r in pairwise(samples)}
+    assert not rows[("A", "B")]["significant"]
+    assert rows[("A", "C")]["significant"] and rows[("B", "C")]["significant"]
+    assert not_different_from_best(samples) == {"A", "B"}
+
+
+def test_pareto_front():
+    points = [[1, 5], [2, 3], [3, 3], [4, 1], [5, 2], [np.inf, 0]]
+    assert pareto_front(points).tolist() == [True, True, False, True, False, False]
+
+
+def test_groups_of_fig_5():
+    assert in_group(0.0, "a") and in_group(7.7, "a") and not in_group(9.9, "a")
+    assert in_group(2.2, "b") and in_group(12.1, "b") and not in_group(1.9, "b")
+    assert in_group(None, "a") and not in_group(None, "b")
+
+
+def test_report_matches_the_metric_and_lowpass_is_100_percent():
+    takes = []
+    for i, fmax in enumerate((0.5, 2.2, 9.9)):
+        sig = stick_slip(5000.0, 0.6, ripple=0.01 + 0.004 * fmax, seed=i)
+        takes.append(Take(f"r{i}", 5000.0, sig["position"], sig["acceleration"], sig["velocity_lvt"],
+                          sig["velocity_lvt"], fmax=fmax))
+    params = {"LOWPASS": {"cutoff_hz": 256.0}, "BDIFF": {"steps": 4}, "LEASTSQ": {"order": 2, "window": 33}}
+    result = evaluate(Dataset(takes, 0.02), params)
+    from studyapp.estimators import create
+
+    for r, take in enumerate(takes):
+        est = create("BDIFF", 5000.0, steps=4).process(take.position)
+        d, e = delay_and_error(take.reference, est, 100)
+        assert result.delays["BDIFF"][r] == d and result.errors["BDIFF"][r] == pytest.approx(e)
+    assert np.allclose(result.error_pct("LOWPASS"), 100.0)
+    assert np.allclose(result.delay_pct("LOWPASS"), 100.0)
+    assert np.allclose(result.error_pct("BDIFF"), 100 * result.errors["BDIFF"] / result.errors["LOWPASS"])
+    # Each recording's E and D are normalised to [0, 1] across the three estimators: 0 <= F_g <= 2n.
+    assert all(0.0 <= result.objective[n] <= 6.0 for n in params)
+    assert result.ranking == sorted(params, key=result.objective.get)
+    doc = result.to_json()
+    assert set(doc) >= {"estimators", "ranking"}
+    assert set(doc["estimators"]["BDIFF"]) == {"error", "delay", "error_pct_lowpass", "delay_pct_lowpass",
+                                               "objective"}
+    assert result.group_mask("b").tolist() == [False, True, True]
