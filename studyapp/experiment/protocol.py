@@ -24,7 +24,6 @@ from studyapp.errors import UserError
 TASKS = ("rating", "adjustment")
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
 NAME_ALLOWED = "1 to 32 letters, digits, '_' or '-'"
-KNOB_MAX = 127  # 7-bit MIDI controller (the paper's Akai LPD-8)
 
 
 @dataclass(frozen=True)
@@ -172,6 +171,7 @@ def parse_protocol(text, source="<protocol>"):
     from studyapp import estimators
     from studyapp.estimators.registry import spec as estimator_spec
     from studyapp.estimators.spec import RATE_MAX, RATE_MIN
+    from studyapp.model.loop import GESTURES
 
     try:
         document = tomllib.loads(text)
@@ -197,7 +197,10 @@ def parse_protocol(text, source="<protocol>"):
     rate = apparatus.number("rate", RATE_MIN, RATE_MAX, "Hz")
     knobs = apparatus.integer("knobs", 1, 64, default=8)
     pads = apparatus.integer("pads", 1, 64, default=8)
-    gesture = apparatus.string("gesture", default="strokes")
+    gestures = [g for g in GESTURES if g != "playback"]  # playback needs a recorded trajectory
+    gesture = apparatus.string("gesture", "one of " + ", ".join(gestures), default="strokes")
+    if gesture not in gestures:
+        apparatus.fail("gesture", f"= {gesture!r}", "one of " + ", ".join(gestures))
     apparatus.finish()
 
     known = estimators.names()

@@ -124,6 +124,7 @@ def test_a_task_table_may_go_with_its_task(tmp_path):
         ("study", "seed", -1, "[study] seed"),
         ("apparatus", "rate", 100.0, "[apparatus] rate"),
         ("apparatus", "knobs", 0, "[apparatus] knobs"),
+        ("apparatus", "gesture", "waltz", "[apparatus] gesture = 'waltz'"),
         ("rating", "conditions", ["LOWPASS"], "[rating] conditions"),
         ("rating", "conditions", ["LOWPASS", "NOPE"], "unknown condition 'NOPE'"),
         ("rating", "conditions", ["LVT", "LVT"], "twice"),
