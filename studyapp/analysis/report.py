@@ -86,9 +86,9 @@ def _inputs(study):
         f"Pairwise Wilcoxon rank-sum tests (normal approximation with tie correction), "
         f"significance at p &lt; {study.alpha:g}, {correction}",
     ]
-    hashes = sorted(set(responses["protocol_hash"].dropna().astype(str))) if "protocol_hash" in responses else []
+    hashes = study.protocol_hashes()
     if len(hashes) > 1:
-        items.append(f'<span class="warn">Responses come from {len(hashes)} different protocols</span>')
+        items.append(f'<span class="warn">The responses come from {len(hashes)} different protocols</span>')
     return "<h2>Inputs</h2><ul>" + "".join(f"<li>{item}</li>" for item in items) + "</ul>"
 
 
@@ -151,7 +151,8 @@ def _consistency(study):
     parts = [
         "<h2>Consistency</h2>",
         f"<h3>Each participant's ranking against the global ranking ({task}, Spearman)</h3>",
-        "<p>The paper found rho &gt; 0.9 for every participant.</p>",
+        "<p>The paper found rho &gt; 0.9 for every participant. rho is undefined (&ndash;) with fewer than "
+        "three conditions, or when the participant's medians or the global medians are all equal.</p>",
         table,
     ]
     if not study.variance.empty:
@@ -159,7 +160,8 @@ def _consistency(study):
         parts += [
             "<h3>Intra- against inter-subject variance of max F<sub>max</sub> (N<sup>2</sup>)</h3>",
             f"<p>Intra-subject variance is on average <b>{_format(lower)}%</b> lower than the total "
-            "variance of Fig. 7 (the paper: 61% lower).</p>",
+            "variance of Fig. 7 (the paper: 61% lower). Intra-subject variance needs two or more trials "
+            "per participant and condition.</p>",
             _table(
                 ["condition", "participants", "intra", "inter", "total", "intra lower (%)"],
                 [list(r[1:]) for r in study.variance.itertuples()],

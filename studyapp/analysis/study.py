@@ -17,7 +17,7 @@ import pandas as pd
 
 from studyapp.analysis.compact_letters import compact_letters
 from studyapp.analysis.consistency import participant_spearman, variance_decomposition
-from studyapp.analysis.missing_trials import find_missing_trials
+from studyapp.analysis.missing_trials import describe_missing, find_missing_trials
 from studyapp.analysis.numerical import compare_with_numerical
 from studyapp.analysis.rank_sum import pairwise_rank_sum
 from studyapp.analysis.responses import response_values
@@ -63,6 +63,20 @@ class StudyAnalysis:
     @property
     def participants(self):
         return sorted(self.responses["participant"].unique())
+
+    def protocol_hashes(self):
+        """The distinct protocol hashes of the responses (more than one: a mixed study)."""
+        if "protocol_hash" not in self.responses:
+            return []
+        return sorted(set(self.responses["protocol_hash"].dropna().astype(str)) - {""})
+
+    def warnings(self):
+        """Lines a reader must see before trusting the numbers: missing responses, mixed protocols."""
+        lines = [describe_missing(row) for row in self.missing.itertuples()]
+        hashes = self.protocol_hashes()
+        if len(hashes) > 1:
+            lines.append(f"the responses come from {len(hashes)} different protocols (protocol_hash)")
+        return lines
 
     def intra_lower_pct(self):
         """Mean over conditions of how much lower intra- than total variance is, in percent."""

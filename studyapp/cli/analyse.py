@@ -26,7 +26,6 @@ def register(subparsers):
 
 
 def run(args):
-    from studyapp.analysis.missing_trials import describe_missing
     from studyapp.analysis.numerical import load_evaluation
     from studyapp.analysis.report_folder import write_report_folder
     from studyapp.analysis.responses import load_responses
@@ -47,8 +46,8 @@ def run(args):
     expected = {"adjustment": args.trials} if args.trials else None
     study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected)
     say(f"{len(study.participants)} participants, {len(responses)} responses")
-    for row in study.missing.itertuples():
-        say(f"warning: {describe_missing(row)}")
+    for line in study.warnings():
+        say(f"warning: {line}")
     if not study.missing.empty:
         say(f"{len(study.missing)} short participant/condition combinations listed in missing_trials.csv")
     write_report_folder(study, args.output, progress=say, evaluation_path=args.evaluation, expected=expected)

@@ -24,7 +24,6 @@ from PySide6.QtWidgets import (
 )
 
 from studyapp.analysis.figures import FIGURES
-from studyapp.analysis.missing_trials import describe_missing
 from studyapp.analysis.report import tables_html
 from studyapp.analysis.report_folder import open_study
 from studyapp.errors import UserError
@@ -77,11 +76,10 @@ class AnalysisView(QWidget):
             return None
         self.study = study
         self.source_label.setText(f"{study.source}: {len(study.participants)} participants")
-        if study.missing.empty:
-            self.status_label.setText("Every participant has every expected response.")
-        else:
-            lines = [describe_missing(row) for row in study.missing.itertuples()]
-            self.status_label.setText("Missing responses: " + "; ".join(lines))
+        warnings = study.warnings()
+        self.status_label.setText(
+            "Warning: " + "; ".join(warnings) if warnings else "Every participant has every expected response."
+        )
         for name, canvas in self.canvases.items():
             canvas.figure.clear()
             FIGURES[name](canvas.figure, study)

@@ -157,3 +157,13 @@ def test_unreadable_inputs_exit_2(tmp_path, capsys):
     assert code == 2 and "bad.csv" in line
     code = main(["analyse", str(tmp_path / "bad.csv"), "--alpha", "2", "-o", str(tmp_path / "out")])
     assert code == 2 and "--alpha" in capsys.readouterr().err
+
+
+def test_mixed_protocols_are_warned_about():
+    from studyapp.analysis.responses import check_responses
+    from studyapp.analysis.study import analyse
+
+    frame = synthetic_responses(participants=3, trials=2, seed=4)
+    frame.loc[frame["participant"] == "P02", "protocol_hash"] = "h2"
+    study = analyse(check_responses(frame, "mixed.csv"))
+    assert study.warnings() == ["the responses come from 2 different protocols (protocol_hash)"]
