@@ -1,0 +1,310 @@
+"""The parent's handle on the real-time engine: start, command, watch, stop.
+
+    with Engine(EngineConfig(rate=5000, estimators={"KALLEV": {}}, source="KALLEV")) as engine:
+        engine.set_fmax(2.0)
+        engine.status()            # the shared status block (status.NUMBERS, status.TEXTS)
+        engine.telemetry(5000)     # newest samples of every channel, from the shared rings
+        engine.controls()          # MIDI control events since the last call
+
+The parent creates the shared memory (a ring for the telemetry, the status
+block), spawns the worker (``worker.main``) and, once it reports ready, runs a
+watchdog thread that also drains the worker's events. The watchdog wakes every
+``POLL`` seconds, or at once when the process ends (it waits on the process
+sentinel), so:
+
+- a worker that dies (crash, SIGKILL) is noticed within a few milliseconds;
+- a worker whose heartbeat is older than ``hang_timeout`` (default 80 ms) is
+  called hung, so detection takes at most ``hang_timeout + POLL`` (< 100 ms).
+
+Either way the fault is reported (``faults``, ``on_fault``), the
+``force_enable`` word is cleared (a worker that was only slow zeroes its force
+at its next block and latches a fault) and ``force_output`` reads 0: the
+simulated device, which lives in the worker, stops with it. ``stop()`` asks
+the worker to finish, waits for it, kills it if it will not go, and unlinks
+the shared memory: no orphan process, no leaked segment.
+"""
+
+import contextlib
+import multiprocessing
+import queue
+import threading
+import time
+from multiprocessing.connection import wait as wait_for
+
+from studyapp.engine import commands as cmd
+from studyapp.engine.audio import parse as parse_audio
+from studyapp.engine.config import EngineConfig
+from studyapp.engine.ring import Ring
+from studyapp.engine.status import StatusBlock
+from studyapp.errors import ParameterError, UserError
+
+POLL = 0.01  # s between watchdog checks
+START_TIMEOUT = 120.0  # s for the worker to import, compile and prime
+
+
+class EngineError(UserError):
+    """The worker could not start, or stopped with an error (one line)."""
+
+
+class Engine:
+    def __init__(self, config=None, on_fault=None, say=None):
+        self.config = config or EngineConfig()
+        self.on_fault = on_fault
+        self.say = say or (lambda text: None)
+        self.names = self._validate()
+        self.faults = []
+        self.fault_time = None  # time.monotonic() when the watchdog or the worker reported the first fault
+        self.tripped = False  # the watchdog found the worker dead or hung
+        self.info = {}
+        self.summary = None
+        self.process = None
+        self.ring = None
+        self.status_block = None
+        self._controls = []
+        self._lock = threading.Lock()
+        self._stop_watch = threading.Event()
+        self._watchdog = None
+        self._stopping = False
+
+    # set-up ----------------------------------------------------------------
+    def _validate(self):
+        """Cheap checks in the parent, so a bad setting is a one-line error before any process starts."""
+        from studyapp.estimators import Bank
+        from studyapp.estimators.spec import validate_rate
+
+        c = self.config
+        c.rate = validate_rate(c.rate)
+        estimators = c.estimators if isinstance(c.estimators, dict) else {n: {} for n in c.estimators}
+        names = Bank(c.rate, estimators).names
+        c.estimators = dict(zip(names, estimators.values()))
+        allowed = list(names) + ["LVT", "TRUE"]
+        if c.source not in allowed:
+            raise ParameterError(f"source {c.source!r}: allowed are {', '.join(allowed)}")
+        fmax = float(c.fmax)
+        if not 0.0 <= fmax <= c.safety.fmax_ceiling:
+            raise ParameterError(f"fmax = {c.fmax}: allowed is 0 to {c.safety.fmax_ceiling:g} N (the safety ceiling)")
+        parse_audio(c.audio)
+        c.block_size()
+        return names
+
+    def start(self, timeout=START_TIMEOUT):
+        from studyapp.engine.worker import channels_for, main
+
+        c = self.config
+        capacity = max(int(c.telemetry_seconds * c.rate), 4 * c.block_size())
+        self.ring = Ring.create(channels_for(self.names), capacity)
+        self.status_block = StatusBlock.create()
+        ctx = multiprocessing.get_context("spawn")
+        self._commands = ctx.Queue()
+        self._events = ctx.Queue()
+        self.process = ctx.Process(
+            target=main, name="studyapp-engine", daemon=True,
+            args=(c, self.ring.spec, self.status_block.name, self._commands, self._events),
+        )
+        self.process.start()
+        deadline = time.monotonic() + timeout
+        while True:
+            event = self._next_event(min(0.05, max(0.0, deadline - time.monotonic())))
+            if event is not None:
+                if event[0] == "ready":
+                    self.info = event[1]
+                    break
+                if event[0] == "error":
+                    self._cleanup()
+                    raise EngineError(f"engine: {event[1]}")
+                self._handle(event)
+            elif not self.process.is_alive():
+                code = self.process.exitcode
+                self._cleanup()
+                raise EngineError(f"engine: the worker exited while starting (exit code {code})")
+            if time.monotonic() > deadline:
+                self._cleanup()
+                raise EngineError(f"engine: the worker did not start within {timeout:g} s")
+        self._watchdog = threading.Thread(target=self._watch, name="studyapp-watchdog", daemon=True)
+        self._watchdog.start()
+        return self
+
+    def __enter__(self):
+        return self.start() if self.process is None else self
+
+    def __exit__(self, *exc):
+        self.stop()
+
+    # commands --------------------------------------------------------------
+    def send(self, kind, value=None):
+        if self.process is None or not self.process.is_alive():
+            raise EngineError("engine: not running")
+        self._commands.put(cmd.command(kind, value))
+
+    def set_source(self, name):
+        allowed = list(self.names) + ["LVT", "TRUE"]
+        if name not in allowed:
+            raise ParameterError(f"source {name!r}: allowed are {', '.join(allowed)}")
+        self.send("source", name)
+
+    def set_fmax(self, fmax):
+        self.send("fmax", float(fmax))
+
+    def set_hand_target(self, x_m):
+        self.send("hand_target", float(x_m))
+
+    def set_bowing(self, on):
+        self.send("bowing", bool(on))
+
+    def set_gesture(self, name):
+        self.send("gesture", name)
+
+    def reset_string(self):
+        self.send("reset_string")
+
+    def set_volume(self, volume):
+        self.send("volume", float(volume))
+
+    def set_mute(self, muted):
+        self.send("mute", bool(muted))
+
+    def learn(self, control):
+        self.send("learn", control)
+
+    def clear_fault(self):
+        self.send("clear_fault")
+
+    # reading ---------------------------------------------------------------
+    def status(self):
+        return self.status_block.read()
+
+    def telemetry(self, n=None, since=None):
+        """Telemetry as ``{channel: array}`` plus ``"estimates": {name: array}``, ``"start"``, ``"end"``.
+
+        ``n``: the newest n samples; ``since``: every sample from that sample
+        number on (as far as the ring still holds them).
+        """
+        if since is not None:
+            data, start, end = self.ring.read_since(since)
+        else:
+            data, start, end = self.ring.read_since(0, limit=n)
+        out = {"start": start, "end": end, "estimates": {}}
+        for i, channel in enumerate(self.ring.channels):
+            if channel.startswith("estimate:"):
+                out["estimates"][channel[9:]] = data[i]
+            else:
+                out[channel] = data[i]
+        return out
+
+    def controls(self):
+        """MIDI control events since the last call: ``(control, value, time, latency, blocks_late)``."""
+        with self._lock:
+            out, self._controls = self._controls, []
+        return out
+
+    @property
+    def alive(self):
+        return self.process is not None and self.process.is_alive() and not self.tripped
+
+    @property
+    def force_output(self):
+        """The force the device puts out now (N): 0 once the worker is gone, hung or faulted."""
+        if not self.alive:
+            return 0.0
+        snap = self.status()
+        if snap["fault_latched"] or not self.status_block.force_enable:
+            return 0.0
+        data, _ = self.ring.read_latest(1)
+        return float(data[self.ring.index("force"), -1]) if data.shape[1] else 0.0
+
+    # watchdog --------------------------------------------------------------
+    def _next_event(self, timeout):
+        try:
+            return self._events.get(timeout=timeout) if timeout > 0 else self._events.get_nowait()
+        except (queue.Empty, EOFError, OSError, ValueError):
+            return None
+
+    def _handle(self, event):
+        kind = event[0]
+        if kind == "notice":
+            self.say(event[1])
+        elif kind == "fault":
+            self._fault(event[1], event[2])
+        elif kind == "error":
+            self._fault(f"worker error: {event[1]}", time.monotonic())
+        elif kind in ("control", "learned"):
+            with self._lock:
+                self._controls.append(event[1:] if kind == "control" else event)
+        elif kind == "stopped":
+            self.summary = event[1]
+
+    def _fault(self, text, when):
+        with self._lock:
+            self.faults.append(text)
+            if self.fault_time is None:
+                self.fault_time = when
+        if self.on_fault is not None:
+            self.on_fault(text)
+
+    def _trip(self, text):
+        now = time.monotonic()
+        self.status_block.force_enable = False
+        self.tripped = True
+        self._fault(text, now)
+
+    def _watch(self):
+        sentinel = self.process.sentinel
+        timeout = self.config.hang_timeout
+        while not self._stop_watch.is_set():
+            ended = wait_for([sentinel], POLL)
+            while (event := self._next_event(0)) is not None:
+                self._handle(event)
+            if self._stopping:
+                continue
+            if ended:
+                self.process.join(0.1)
+                self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero")
+                return
+            snap = self.status_block.read()
+            if snap["state"] == "running" and time.monotonic() - snap["heartbeat"] > timeout:
+                self._trip(f"watchdog: no heartbeat for {1e3 * timeout:.0f} ms; force disabled")
+                return
+
+    # shutting down ---------------------------------------------------------
+    def stop(self, timeout=10.0):
+        """Stop the worker (politely, then by force), unlink the shared memory; returns its summary."""
+        if self.process is None:
+            return self.summary
+        self._stopping = True
+        if self.process.is_alive():
+            with contextlib.suppress(Exception):
+                self._commands.put(cmd.command("stop"))
+            end = time.monotonic() + timeout
+            while self.process.is_alive() and time.monotonic() < end:
+                event = self._next_event(0.05)
+                if event is not None:
+                    self._handle(event)
+            if self.process.is_alive():
+                self.process.terminate()
+                self.process.join(2.0)
+            if self.process.is_alive():
+                self.process.kill()
+        self.process.join(5.0)
+        self._stop_watch.set()
+        if self._watchdog is not None and self._watchdog is not threading.current_thread():
+            self._watchdog.join(2.0)
+        while (event := self._next_event(0)) is not None:
+            self._handle(event)
+        self._cleanup()
+        return self.summary
+
+    def _cleanup(self):
+        if self.process is not None and self.process.is_alive():
+            self.process.kill()
+            self.process.join(5.0)
+        for q in (getattr(self, "_commands", None), getattr(self, "_events", None)):
+            if q is not None:
+                q.close()
+                q.cancel_join_thread()
+        if self.ring is not None:
+            self.ring.close()
+        if self.status_block is not None:
+            self.status_block.close()
+        self.ring = None
+        self.status_block = None
+        self.process = None

@@ -1,0 +1,200 @@
+"""MIDI knobs and pads in: mido over python-rtmidi (JACK MIDI, else the ALSA sequencer).
+
+The paper's participants turned the knobs of an Akai LPD8 (7-bit potentiometers,
+footnote 3). ``ControlMap`` turns a MIDI message into ``(control, value)`` with
+value in [0, 1]:
+
+- ``ControlMap.lpd8()``: the LPD8 factory preset, knobs ``knob1..knob8`` on
+  control changes 1-8 and pads ``pad1..pad8`` on notes 36-43, all on channel 1;
+- ``ControlMap.from_protocol({"knob1": {"cc": 7, "channel": 1}, "pad1": {"note": 60}})``;
+- ``learn(control)``: the next control change or note binds to ``control``.
+
+``open_input(spec)`` opens an input: ``"virtual"`` makes a port others connect
+to, ``"first"`` takes the first source found, any other text picks the first
+port whose name contains it, ``"none"`` opens nothing. rtmidi calls back from
+its own thread; the callback only puts ``(message, time.monotonic(), block)``
+on a ``queue.SimpleQueue`` (whose ``put`` never blocks), ``block`` being the
+engine's block counter at arrival, and the engine drains it at block
+boundaries. Without a back-end (these machines have no ALSA sequencer,
+and JACK needs a running server) ``open_input`` prints one line and returns
+``None``: the on-screen knobs take over.
+"""
+
+import queue
+import time
+
+from studyapp.engine.native_stderr import captured_native_stderr
+from studyapp.errors import ParameterError
+
+CLIENT = "studyapp"
+VIRTUAL_PORT = "studyapp MIDI in"
+APIS = ("UNIX_JACK", "LINUX_ALSA")
+
+
+def _key(kind, channel, number):
+    if kind not in ("cc", "note"):
+        raise ParameterError(f"MIDI map: kind {kind!r} is not cc or note")
+    if not 1 <= channel <= 16:
+        raise ParameterError(f"MIDI map: channel {channel} is outside 1..16")
+    if not 0 <= number <= 127:
+        raise ParameterError(f"MIDI map: {kind} number {number} is outside 0..127")
+    return (kind, int(channel), int(number))
+
+
+class ControlMap:
+    """MIDI message -> ``(control, value in [0, 1])``; channels are 1..16 as printed on devices."""
+
+    def __init__(self, bindings=None):
+        self._by_key = {}
+        self._by_control = {}
+        self.learning = None
+        for control, key in (bindings or {}).items():
+            self.bind(control, *key)
+
+    @classmethod
+    def lpd8(cls):
+        """The Akai LPD8 factory preset: knobs CC 1-8, pads notes 36-43, channel 1."""
+        bindings = {f"knob{i}": ("cc", 1, i) for i in range(1, 9)}
+        bindings.update({f"pad{i}": ("note", 1, 35 + i) for i in range(1, 9)})
+        return cls(bindings)
+
+    @classmethod
+    def from_protocol(cls, mapping):
+        """From ``{control: {"cc": n, "channel": c}}`` or ``{"note": n}`` (channel defaults to 1)."""
+        if not isinstance(mapping, dict):
+            raise ParameterError("MIDI map: expected a table of control: {cc|note: number, channel: 1..16}")
+        bindings = {}
+        for control, entry in mapping.items():
+            if not isinstance(entry, dict) or len({"cc", "note"} & set(entry)) != 1:
+                raise ParameterError(f"MIDI map: {control} needs exactly one of cc or note")
+            unknown = set(entry) - {"cc", "note", "channel"}
+            if unknown:
+                raise ParameterError(f"MIDI map: {control} has unknown field {sorted(unknown)[0]!r}")
+            kind = "cc" if "cc" in entry else "note"
+            bindings[control] = (kind, entry.get("channel", 1), entry[kind])
+        return cls(bindings)
+
+    def bind(self, control, kind, channel, number):
+        key = _key(kind, channel, number)
+        old = self._by_control.pop(control, None)
+        if old is not None:
+            self._by_key.pop(old, None)
+        taken = self._by_key.pop(key, None)
+        if taken is not None:
+            self._by_control.pop(taken, None)
+        self._by_key[key] = control
+        self._by_control[control] = key
+
+    def learn(self, control):
+        """Bind ``control`` to the next control change or note that arrives."""
+        self.learning = str(control)
+
+    def to_dict(self):
+        return {c: {k: n, "channel": ch} for c, (k, ch, n) in self._by_control.items()}
+
+    def lookup(self, msg):
+        """``(control, value)`` for a mapped message, else ``None``; binds it first in learn mode."""
+        if msg.type == "control_change":
+            key, value = ("cc", msg.channel + 1, msg.control), msg.value / 127.0
+        elif msg.type == "note_on":
+            key, value = ("note", msg.channel + 1, msg.note), (1.0 if msg.velocity > 0 else 0.0)
+        elif msg.type == "note_off":
+            key, value = ("note", msg.channel + 1, msg.note), 0.0
+        else:
+            return None
+        if self.learning is not None and msg.type in ("control_change", "note_on"):
+            self.bind(self.learning, *key)
+            self.learning = None
+        control = self._by_key.get(key)
+        return None if control is None else (control, value)
+
+
+class MidiUnavailable(RuntimeError):
+    """No MIDI back-end or no such port."""
+
+
+class MidiInput:
+    """An open MIDI input; ``poll()`` returns the ``(message, time, block)`` received since the last poll.
+
+    ``block`` is whatever the engine last stored in ``self.block`` (its block counter).
+    """
+
+    def __init__(self, port, api):
+        self.port = port
+        self.api = api
+        self.queue = queue.SimpleQueue()
+        self.received = 0
+        self.block = 0
+        self._port = None
+
+    def _callback(self, msg):
+        # Runs on rtmidi's thread: no lock, no allocation beyond the tuple; SimpleQueue.put never blocks.
+        self.queue.put((msg, time.monotonic(), self.block))
+
+    def poll(self):
+        out = []
+        while True:
+            try:
+                out.append(self.queue.get_nowait())
+            except queue.Empty:
+                break
+        self.received += len(out)
+        return out
+
+    @property
+    def description(self):
+        return f"{self.port} ({'JACK' if self.api == 'UNIX_JACK' else 'ALSA'})"
+
+    def close(self):
+        if self._port is not None:
+            self._port.close()
+            self._port = None
+
+
+def _backend(api):
+    import mido
+
+    backend = mido.Backend(f"mido.backends.rtmidi/{api}", load=True)
+    if api not in backend.module.get_api_names():
+        raise MidiUnavailable(f"python-rtmidi was built without {api}")
+    return backend
+
+
+def _open(spec, api, client):
+    backend = _backend(api)
+    midi = MidiInput(None, api)
+    if spec == "virtual":
+        port = backend.open_input(VIRTUAL_PORT, virtual=True, callback=midi._callback, client_name=client)
+        midi.port = f"{client}:{VIRTUAL_PORT}" if api == "UNIX_JACK" else VIRTUAL_PORT
+    else:
+        names = backend.get_input_names()
+        if spec == "first":
+            match = names[:1]
+        else:
+            match = [n for n in names if spec.lower() in n.lower()]
+        if not match:
+            have = ", ".join(names) or "none"
+            raise MidiUnavailable(f"no MIDI input matches {spec!r} (inputs: {have})")
+        port = backend.open_input(match[0], callback=midi._callback)
+        midi.port = match[0]
+    midi._port = port
+    return midi
+
+
+def open_input(spec, say=print, client=CLIENT):
+    """Open the MIDI input named by ``spec`` (see module docstring), or say why not and return ``None``."""
+    spec = (spec or "none").strip()
+    if spec == "none":
+        return None
+    reasons = []
+    for api in APIS:
+        with captured_native_stderr():
+            try:
+                return _open(spec, api, client)
+            except (OSError, MidiUnavailable, ValueError, RuntimeError) as exc:
+                reasons.append(f"{'JACK' if api == 'UNIX_JACK' else 'ALSA'}: {str(exc).strip() or type(exc).__name__}")
+            except ImportError as exc:
+                reasons.append(f"python-rtmidi missing ({exc})")
+                break
+    say(f"MIDI: no input opened ({'; '.join(reasons)}); use the on-screen knobs")
+    return None

@@ -1,0 +1,167 @@
+"""Safety around the closed loop: clamps, latched faults, and a runaway detector.
+
+Three layers keep a fault from leaving the device pushing:
+
+1. Clamps. F_max is clamped to the protocol's ceiling (``SafetyLimits.fmax_ceiling``)
+   before the loop sees it; inside the loop the force is clamped to the motor
+   limits (model/device.py). After each block ``check`` verifies that no
+   sample exceeded either bound.
+2. Latched faults. A non-finite value anywhere in a block (the loop latches
+   its own fault the moment one appears and zeroes the force from that sample
+   on), a clamp found violated, or the parent's watchdog clearing the
+   ``force_enable`` word: the force scale goes to 0 and stays there until
+   ``clear()`` (an experimenter's decision, never automatic).
+3. Runaway. A sample is *suspect* when the force sits at its ceiling
+   (|F| >= ``saturation`` x min(F_max x scale, motor limit)) or the handle moves
+   faster than ``velocity_bound``. Normal bowing touches the ceiling only for
+   an instant at each slip, so when suspect samples fill at least ``fraction``
+   of the last ``window`` seconds the loop has run away: the force scale ramps
+   linearly to 0 over ``ramp`` seconds (``ClosedLoop.set_force_scale``, one
+   step per block) and the fault latches.
+
+The detector works at block boundaries, so its reaction comes one block later
+than the block that showed the problem; the loop's own non-finite check acts on
+the very sample.
+"""
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from studyapp.errors import ParameterError
+
+
+@dataclass(frozen=True)
+class SafetyLimits:
+    fmax_ceiling: float = 60.0  # N; the motors' sustained limit unless the protocol sets a lower one
+    velocity_bound: float = 0.5  # m/s; bowing strokes move at a few cm/s
+    saturation: float = 0.95  # fraction of the force ceiling that counts as saturated
+    window: float = 0.25  # s
+    fraction: float = 0.8  # of the window's samples suspect -> runaway
+    ramp: float = 0.5  # s from full force to zero
+
+
+class Safety:
+    """Watches one ``ClosedLoop`` (or anything with ``set_force_scale``, ``fault``, ``fmax``)."""
+
+    def __init__(self, loop, limits=None, motor_limit=None):
+        self.loop = loop
+        self.limits = limits or SafetyLimits()
+        self.rate = float(loop.rate)
+        self.motor_limit = float(motor_limit if motor_limit is not None else _motor_limit(loop))
+        self.latched = None  # the fault text while latched
+        self.faults = []  # every fault raised, in order
+        self.scale = 1.0
+        self._ramping = False
+        self._window = deque()  # (samples, suspect samples) per block
+        self._window_samples = 0
+        self._window_suspect = 0
+        self._previous_force_scale = 1.0
+
+    # clamps -----------------------------------------------------------------
+    def clamp_fmax(self, fmax):
+        """F_max limited to the ceiling; ``ParameterError`` for a negative or non-finite value."""
+        try:
+            value = float(fmax)
+        except (TypeError, ValueError):
+            value = float("nan")
+        if not np.isfinite(value) or value < 0:
+            raise ParameterError(f"fmax = {fmax!r}: allowed is a number from 0 to {self.limits.fmax_ceiling:g} N")
+        return min(value, self.limits.fmax_ceiling)
+
+    # faults -----------------------------------------------------------------
+    def latch(self, text):
+        """Zero the force from the next block on and hold it there until ``clear``."""
+        if self.latched is None:
+            self.latched = text
+            self.faults.append(text)
+        self.scale = 0.0
+        self.loop.set_force_scale(0.0)
+
+    def clear(self):
+        """The experimenter's reset: full force again, detector restarted."""
+        self.latched = None
+        self._ramping = False
+        self._window.clear()
+        self._window_samples = self._window_suspect = 0
+        self.scale = 1.0
+        self.loop.set_force_scale(1.0)
+
+    def check(self, block, force_enable=True):
+        """Inspect one block just run; returns the fault text raised by it, or ``None``."""
+        before = len(self.faults)
+        if not force_enable:
+            self.latch("watchdog: the parent disabled the force (worker not answering in time)")
+        loop_fault = getattr(self.loop, "fault", None)
+        if loop_fault:
+            self.latch(f"loop fault: {loop_fault}")
+        force = block["force"]
+        if self.latched is None:
+            bad = _first_nonfinite(block)
+            if bad is not None:
+                self.latch(f"non-finite {bad} in the loop")
+        if self.latched is None and force.size:
+            bound = min(self.loop.fmax, self.motor_limit) * self._previous_force_scale
+            peak = float(np.max(np.abs(force)))
+            # 1% slack: the peak of the friction curve is found numerically (model/bow_table.py)
+            if peak > bound * 1.01 + 1e-9:
+                self.latch(f"force {peak:.4g} N exceeded its clamp {bound:.4g} N")
+        self._runaway(block)
+        self._previous_force_scale = self.scale
+        return self.faults[-1] if len(self.faults) > before else None
+
+    def _runaway(self, block):
+        force = block["force"]
+        n = force.shape[0]
+        if n == 0:
+            return
+        if self._ramping or self.latched is not None:
+            if self._ramping and self.scale > 0.0:
+                self.scale = max(0.0, self.scale - n / (self.rate * self.limits.ramp))
+                self.loop.set_force_scale(self.scale)
+            return
+        ceiling = min(self.loop.fmax * self.scale, self.motor_limit)
+        velocity = block.get("velocity_true")
+        if velocity is None or not np.all(np.isfinite(velocity)):
+            velocity = block["source_velocity"]
+        suspect = np.abs(velocity) > self.limits.velocity_bound
+        if ceiling > 0:
+            suspect |= np.abs(force) >= self.limits.saturation * ceiling
+        count = int(np.count_nonzero(suspect))
+        self._window.append((n, count))
+        self._window_samples += n
+        self._window_suspect += count
+        horizon = self.limits.window * self.rate
+        while self._window and self._window_samples - self._window[0][0] >= horizon:
+            old_n, old_count = self._window.popleft()
+            self._window_samples -= old_n
+            self._window_suspect -= old_count
+        if self._window_samples >= horizon and self._window_suspect >= self.limits.fraction * self._window_samples:
+            share = self._window_suspect / self._window_samples
+            self.latched = (f"runaway: force saturated or velocity beyond {self.limits.velocity_bound:g} m/s "
+                            f"for {100 * share:.0f}% of {self.limits.window:g} s; force ramped to zero")
+            self.faults.append(self.latched)
+            self._ramping = True
+            self.scale = max(0.0, self.scale - n / (self.rate * self.limits.ramp))
+            self.loop.set_force_scale(self.scale)
+
+
+_WATCHED = ("force", "position", "velocity_lvt", "source_velocity", "string_velocity")
+
+
+def _first_nonfinite(block):
+    for key in _WATCHED:
+        values = block.get(key)
+        if values is not None and values.size and not np.all(np.isfinite(values)):
+            return key
+    estimates = block.get("estimates")
+    if estimates is not None and estimates.size and not np.all(np.isfinite(estimates)):
+        return "estimate"
+    return None
+
+
+def _motor_limit(loop):
+    device = getattr(loop, "device", None)
+    limits = getattr(device, "limits", None)
+    return float(getattr(limits, "impulsive", np.inf))

@@ -1,0 +1,347 @@
+"""The worker process: the closed loop in real time, block by block.
+
+Started by ``engine.Engine`` with the spawn context (a fresh interpreter: no
+inherited locks, threads or Qt state). It builds only what the scene names:
+the loop with the active estimators, the audio sink (no audio rendered for a
+null sink), the MIDI input if asked for. Then, for block k of B samples at
+rate R (period T = B / R):
+
+1. wait for the pacing clock: the audio device's FIFO dropping below its lead
+   (the device callback is the clock), or else the monotonic timer reaching
+   t0 + k T;
+2. apply every queued command and MIDI control (block boundary), measuring
+   the command-to-effect latency: from the command's ``sent`` time (or the
+   MIDI message's arrival) to the start of this block;
+3. run the loop for B samples; let the safety layer inspect them;
+4. push the audio to the sink, the telemetry to the ring, the status record.
+
+A block is a *deadline miss* when it finishes after its deadline: t0 + (k+1) T
+on the timer; on the audio clock, when the device had to play silence while
+the block was being made. The load of a block is its compute time over T.
+
+The worker stops on a ``stop`` command, or when its parent dies (it checks the
+parent's sentinel every 50 ms, so no orphan keeps running).
+"""
+
+import importlib
+import multiprocessing
+import os
+import queue
+import sys
+import time
+import traceback
+
+import numpy as np
+
+from studyapp.engine import commands as cmd
+from studyapp.engine.audio import open_sink
+from studyapp.engine.midi import ControlMap, open_input
+from studyapp.engine.ring import Ring
+from studyapp.engine.safety import Safety
+from studyapp.engine.status import StatusBlock
+
+# telemetry channels before the estimates ("estimate:NAME")
+CHANNELS = (
+    "t", "position", "velocity_lvt", "velocity_true", "source_velocity", "string_velocity",
+    "force", "fmax", "force_scale",
+)
+REALTIME_PRIORITY = 5  # below JACK's own threads (10 and 9 by default)
+RESYNC = 0.1  # s behind the timer after which the schedule restarts from now
+
+
+def channels_for(names):
+    return CHANNELS + tuple(f"estimate:{n}" for n in names)
+
+
+def make_device(spec, rate):
+    """A real device driver from ``"module:factory"`` (called with the rate), or ``None``."""
+    if not spec:
+        return None
+    module, _, factory = spec.partition(":")
+    return getattr(importlib.import_module(module), factory)(rate)
+
+
+def main(config, ring_spec, status_name, commands, events):
+    """Entry point of the worker process."""
+    os.environ.setdefault("JACK_NO_START_SERVER", "1")
+    status = StatusBlock.attach(status_name)
+    ring = Ring.attach(ring_spec)
+    worker = None
+    try:
+        worker = Worker(config, ring, status, commands, events)
+        worker.run()
+    except BaseException as exc:  # noqa: BLE001 - the parent must hear about every way out
+        text = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        status.set(state="failed", fault=text)
+        status.publish(texts=True)
+        events.put(("error", text, traceback.format_exc()))
+    finally:
+        if worker is not None:
+            worker.close()
+        ring.close()
+        status.close()
+        events.close()
+        events.join_thread()
+
+
+class Worker:
+    def __init__(self, config, ring, status, commands, events):
+        from studyapp.model.loop import ClosedLoop, LoopConfig
+
+        self.config = config
+        self.ring = ring
+        self.status = status
+        self.commands = commands
+        self.events = events
+        self.stopping = False
+        self.midi = None
+        self.sink = None
+        status.set(state="starting", rate=config.rate)
+        status.publish()
+        sys.setswitchinterval(0.0005)  # PortAudio's and rtmidi's threads need the GIL promptly
+
+        self.sink = open_sink(config.audio, config.rate, say=self.notice, lead=config.lead)
+        loop_config = LoopConfig(
+            rate=config.rate, estimators=config.estimators, source=config.source, fmax=1.0,
+            gesture=config.gesture, seed=config.seed, audio=self.sink.render,
+        )
+        if config.f0 is not None:
+            loop_config.f0 = config.f0
+        self.loop = ClosedLoop(loop_config, device=make_device(config.device, config.rate))
+        self.safety = Safety(self.loop, config.safety)
+        self.loop.set_fmax(self.safety.clamp_fmax(config.fmax))
+        self.channels = channels_for(self.loop.names)
+        if self.channels != ring.channels:
+            raise RuntimeError(f"telemetry channels {self.channels} differ from the ring's {ring.channels}")
+        self.cmap = ControlMap.from_protocol(config.midi_map) if config.midi_map else ControlMap.lpd8()
+        self.actions = config.actions if config.actions is not None else cmd.default_actions(config.sources())
+        self.midi = open_input(config.midi, say=self.notice)
+        self.block = config.block_size()
+        self.period = self.block / self.loop.rate
+        self.realtime = _try_realtime() if config.realtime else False
+        self.k = 0
+        self._rows = np.empty((len(self.channels), self.block))
+        self._faults_seen = 0
+        status.set(
+            block=self.block, fmax=self.loop.fmax, force_scale=1.0, source=self.loop.source,
+            audio=self.sink.description, midi=self.midi.description if self.midi else "none",
+            audio_paced=self.sink.paced,
+        )
+
+    # messages to the parent ---------------------------------------------------
+    def notice(self, text):
+        self.events.put(("notice", text))
+
+    def fault(self, text):
+        self.status.set(faults=self.status.get("faults") + 1, fault=text)
+        self.events.put(("fault", text, time.monotonic()))
+
+    # commands -------------------------------------------------------------
+    def apply(self, command, started):
+        kind, value, sent = command
+        try:
+            if kind == "source":
+                self.loop.set_source(value)
+                self.status.set(source=self.loop.source)
+            elif kind == "fmax":
+                self.loop.set_fmax(self.safety.clamp_fmax(value))
+            elif kind == "hand_target":
+                self.loop.set_hand_target(value)
+            elif kind == "bowing":
+                self.loop.set_bowing(bool(value))
+            elif kind == "gesture":
+                self.loop.set_gesture(value)
+            elif kind == "reset_string":
+                self.loop.reset_string()
+            elif kind == "volume":
+                self.sink.set_volume(float(value))
+            elif kind == "mute":
+                self.sink.set_mute(bool(value))
+            elif kind == "learn":
+                self.cmap.learn(value)
+            elif kind == "clear_fault":
+                if self.loop.fault:
+                    self.notice(f"cannot clear: the loop itself latched '{self.loop.fault}'; restart the engine")
+                else:
+                    self.safety.clear()
+                    self.status.set(fault="")
+            elif kind == "stall":
+                time.sleep(float(value))
+            elif kind == "stop":
+                self.stopping = True
+        except (ValueError, TypeError) as exc:
+            self.notice(f"command {kind}={value!r} ignored: {exc}")
+            return None
+        latency = started - sent
+        self.status.set(command_latency=latency,
+                        command_latency_max=max(self.status.get("command_latency_max"), latency))
+        return latency
+
+    def drain(self, started):
+        while True:
+            try:
+                command = self.commands.get_nowait()
+            except queue.Empty:
+                break
+            except (EOFError, OSError):
+                self.stopping = True
+                break
+            self.apply(command, started)
+        if self.midi is None:
+            return
+        for msg, arrived, block in self.midi.poll():
+            self.status.set(midi_messages=self.status.get("midi_messages") + 1)
+            learning = self.cmap.learning
+            hit = self.cmap.lookup(msg)
+            if hit is None:
+                continue
+            control, value = hit
+            if learning is not None and self.cmap.learning is None:
+                self.events.put(("learned", control, self.cmap.to_dict()[control]))
+            action = self.actions.get(control)
+            command = cmd.action_command(action, value, arrived) if action else None
+            latency = self.apply(command, started) if command else None
+            self.events.put(("control", control, value, arrived, latency, self.k - block))
+
+    # the loop -------------------------------------------------------------
+    def prime(self):
+        """Run the first blocks before any clock starts: compiled code loads, a paced sink's FIFO fills."""
+        for _ in range(2):
+            self.step(time.monotonic())
+        while self.sink.paced and self.sink.level < self.sink.lead_frames:
+            self.step(time.monotonic())
+        self.sink.start()
+
+    def step(self, started):
+        out = self.loop.run(self.block)
+        self.safety.check(out, force_enable=self.status.force_enable)
+        if self.sink.render:
+            self.sink.push(out["audio"])
+        rows = self._rows
+        for i, name in enumerate(CHANNELS):
+            if name == "fmax":
+                rows[i] = self.loop.fmax
+            elif name == "force_scale":
+                rows[i] = self.loop.force_scale
+            else:
+                rows[i] = out[name]
+        rows[len(CHANNELS):] = out["estimates"]
+        self.ring.write(rows)
+        finished = time.monotonic()
+        self.k += 1
+        if self.midi is not None:
+            self.midi.block = self.k
+        return finished, finished - started
+
+    def run(self):
+        status = self.status
+        self.prime()
+        status.set(state="running", heartbeat=time.monotonic())
+        status.publish(texts=True)
+        self.events.put(("ready", {
+            "rate": self.loop.rate, "block": self.block, "names": list(self.loop.names),
+            "audio": self.sink.description, "midi": self.midi.description if self.midi else "none",
+            "realtime": self.realtime, "paced": "audio" if self.sink.paced else "timer",
+        }))
+        parent = multiprocessing.parent_process()
+        audio_clock = self.sink.paced
+        silent_waits = 0
+        t0 = self.run_start = time.monotonic()
+        k0 = self.run_k0 = self.k
+        window_start, window_samples = t0, 0
+        loads = []
+        shortfalls = self.sink.shortfalls
+        next_parent_check = t0
+        while not self.stopping:
+            if audio_clock:
+                silent_waits = 0 if self.sink.wait(0.05) else silent_waits + 1
+                if silent_waits >= 3:
+                    audio_clock = False
+                    t0, k0 = time.monotonic(), self.k
+                    status.set(audio_paced=False)
+                    self.notice("audio: the device stopped calling back; the timer paces the loop now")
+            else:
+                start_at = t0 + (self.k - k0) * self.period
+                now = time.monotonic()
+                if start_at > now:
+                    time.sleep(start_at - now)
+                elif now - start_at > RESYNC:
+                    t0, k0 = now, self.k
+            started = time.monotonic()
+            self.drain(started)
+            if self.stopping:
+                break
+            deadline = t0 + (self.k - k0 + 1) * self.period
+            finished, compute = self.step(started)
+            load = compute / self.period
+            loads.append(load)
+            late = self.sink.shortfalls > shortfalls if audio_clock else finished > deadline
+            shortfalls = self.sink.shortfalls
+            if late:
+                status.set(deadline_misses=status.get("deadline_misses") + 1)
+            new_faults = self.safety.faults[self._faults_seen:]
+            for text in new_faults:
+                self.fault(text)
+            self._faults_seen += len(new_faults)
+            status.set(
+                heartbeat=finished, blocks=self.k, samples=self.k * self.block, load=load,
+                audio_underruns=self.sink.underruns, audio_xruns=self.sink.xruns,
+                fault_latched=self.safety.latched is not None, fmax=self.loop.fmax,
+                force_scale=self.loop.force_scale,
+            )
+            window_samples += self.block
+            if finished - window_start >= 1.0:
+                status.set(achieved_rate=window_samples / (finished - window_start),
+                           load_mean=float(np.mean(loads)), load_max=float(np.max(loads)))
+                window_start, window_samples, loads = finished, 0, []
+            status.publish(texts=self._texts_changed())
+            if finished >= next_parent_check:
+                next_parent_check = finished + 0.05
+                if parent is not None and not parent.is_alive():
+                    self.stopping = True
+        self.run_end = time.monotonic()
+        status.set(state="stopping", heartbeat=self.run_end)
+        status.publish()
+
+    def _texts_changed(self):
+        texts = self.status.texts
+        if getattr(self, "_last_texts", None) != texts:
+            self._last_texts = dict(texts)
+            return True
+        return False
+
+    def summary(self):
+        s = self.status
+        start = getattr(self, "run_start", None)
+        end = getattr(self, "run_end", None) or time.monotonic()
+        achieved = (self.k - self.run_k0) * self.block / (end - start) if start and end > start else 0.0
+        return {
+            "rate": self.loop.rate, "blocks": self.k, "samples": self.k * self.block,
+            "seconds": end - start if start else 0.0, "achieved_rate": achieved, "deadline_misses": int(s.get("deadline_misses")),
+            "audio_underruns": self.sink.underruns, "audio_xruns": self.sink.xruns,
+            "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
+            "command_latency_max": float(s.get("command_latency_max")),
+            "load_max": float(s.get("load_max")), "realtime": self.realtime,
+        }
+
+    def close(self):
+        if self.sink is not None:
+            self.sink.close()
+        if self.midi is not None:
+            self.midi.close()
+        if getattr(self, "loop", None) is not None:
+            self.events.put(("stopped", self.summary()))
+            self.status.set(state="stopped", heartbeat=time.monotonic())
+            self.status.publish(texts=True)
+        sounddevice = sys.modules.get("sounddevice")
+        if sounddevice is not None:
+            # PortAudio must let go of JACK now: a JACK server stopping first would abort us at exit
+            sounddevice._terminate()
+
+
+def _try_realtime():
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
+    except (OSError, AttributeError):
+        return False
+    return True
