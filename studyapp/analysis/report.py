@@ -98,8 +98,8 @@ def _missing(study):
     lines = "".join(f"<li>{html.escape(describe_missing(row))}</li>" for row in study.missing.itertuples())
     return (
         "<h2>Missing trials</h2>"
-        f'<p class="warn">{len(study.missing)} participant and condition combinations are short of '
-        "responses. Their remaining responses are included in every statistic.</p>"
+        f'<p class="warn">Responses are missing ({len(study.missing)} participant, task and condition '
+        "combinations). Every response that exists is included in every statistic.</p>"
         f"<ul>{lines}</ul>"
     )
 
@@ -157,10 +157,14 @@ def _consistency(study):
     ]
     if not study.variance.empty:
         lower = study.intra_lower_pct()
+        headline = (
+            f"Intra-subject variance is on average <b>{lower:.0f}%</b> lower than the total variance of Fig. 7"
+            if math.isfinite(lower)
+            else "Intra-subject variance cannot be computed here"
+        )
         parts += [
             "<h3>Intra- against inter-subject variance of max F<sub>max</sub> (N<sup>2</sup>)</h3>",
-            f"<p>Intra-subject variance is on average <b>{_format(lower)}%</b> lower than the total "
-            "variance of Fig. 7 (the paper: 61% lower). Intra-subject variance needs two or more trials "
+            f"<p>{headline} (the paper: 61% lower). Intra-subject variance needs two or more trials "
             "per participant and condition.</p>",
             _table(
                 ["condition", "participants", "intra", "inter", "total", "intra lower (%)"],

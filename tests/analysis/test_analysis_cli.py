@@ -62,6 +62,8 @@ def test_report_is_self_contained(report):
     assert "<img" in html and 'src="fig' not in html
     for condition in SYNTHETIC_FMAX:
         assert condition in html
+    lower = pd.read_csv(out / "variance_adjustment.csv")["intra_lower_pct"].mean()
+    assert f"Intra-subject variance is on average <b>{lower:.0f}%</b> lower" in html
 
 
 def test_missing_trials_are_reported_not_dropped(report):
