@@ -65,7 +65,8 @@ def check_responses(frame, label, csv_rows=False):
             f"{label}: missing column '{missing[0]}' (the analysis needs {', '.join(REQUIRED_COLUMNS)})"
         )
     if len(frame) == 0:
-        raise InputDataError(f"{label}: no responses (the file has a header but no rows)")
+        where = "the file has a header but no rows" if csv_rows else "no session in it holds a response"
+        raise InputDataError(f"{label}: no responses ({where})")
     frame = frame.reset_index(drop=True).copy()
 
     def where(index):

@@ -159,6 +159,9 @@ def test_unreadable_inputs_exit_2(tmp_path, capsys):
     assert code == 2 and "bad.csv" in line
     code = main(["analyse", str(tmp_path / "bad.csv"), "--alpha", "2", "-o", str(tmp_path / "out")])
     assert code == 2 and "--alpha" in capsys.readouterr().err
+    (tmp_path / "results").mkdir()
+    assert main(["analyse", str(tmp_path / "results"), "-o", str(tmp_path / "out")]) == 2
+    assert "results: no responses (no session in it holds a response)" in capsys.readouterr().err
 
 
 def test_mixed_protocols_are_warned_about():
