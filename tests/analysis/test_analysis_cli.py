@@ -172,3 +172,14 @@ def test_mixed_protocols_are_warned_about():
     frame.loc[frame["participant"] == "P02", "protocol_hash"] = "h2"
     study = analyse(check_responses(frame, "mixed.csv"))
     assert study.warnings() == ["the responses come from 2 different protocols (protocol_hash)"]
+
+
+def test_a_study_with_one_task():
+    from studyapp.analysis.responses import check_responses
+    from studyapp.analysis.study import analyse
+
+    frame = synthetic_responses(participants=4, trials=2, seed=6)
+    study = analyse(check_responses(frame[frame["task"] == "rating"], "rating_only.csv"))
+    assert study.adjustment.conditions == [] and study.adjustment.wilcoxon.empty and study.variance.empty
+    assert study.spearman_task == "rating" and len(study.participant_spearman) == 4
+    assert len(study.rating.wilcoxon) == 8 * 7 // 2 and study.missing.empty
