@@ -23,6 +23,8 @@ def register(sub):
                    help="parameters to tune: the paper's Table 2 list, or every numeric one (default paper)")
     p.add_argument("--max-lag", type=float, default=0.02, metavar="SECONDS",
                    help="longest delay searched by the cross-correlation (default 0.02 s)")
+    p.add_argument("--range", action="append", default=[], metavar="NAME.PARAM=LOW:HIGH",
+                   help="search range of one parameter, within its allowed range (e.g. FOAW.window=1:128)")
     p.add_argument("--max-sets", type=int, metavar="N", help="also stop an estimator after N new sets")
     p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores; 1: in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -58,14 +60,16 @@ def run(args):
     paths = expand_paths(args.recordings)
     takes = load_takes(paths, args.reference)  # checks every file before any work starts
     rate = min(t.rate for t in takes)
-    spaces = {name: Space(name, rate, args.tune) for name in names}
+    ranges = parse_ranges(args.range)
+    spaces = {name: Space(name, rate, args.tune, ranges=ranges.get(name)) for name in names}
     source = RecordingFiles(tuple(paths), args.reference, args.max_lag, tuple(names))
     checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
     if args.resume and not checkpoint.is_file():
         raise UserError(f"--resume: no checkpoint at {checkpoint}")
 
-    warm_up(names, rate)  # compile (or load from numba's cache) once before any worker starts
-    executor = make_executor(args.workers, args.scheduler, warm_up, (tuple(names), rate))
+    # Compile the fast loops once here: forked workers inherit them; spawned ones compile their own.
+    warm_up(names, rate, fast=True)
+    executor = make_executor(args.workers, args.scheduler, warm_up, (tuple(names), rate, True))
     fingerprint = {
         "recordings": [t.sha256 for t in takes], "reference": args.reference,
         "max_lag_s": args.max_lag, "tune": args.tune,
@@ -96,3 +100,23 @@ def run(args):
         print(f"studyapp optimise: wrote {output} ({result.iterations} iterations, "
               f"{result.evaluated} parameter sets, {result.seconds:.1f} s)", file=sys.stderr)
     return 0
+
+
+def parse_ranges(items):
+    """``NAME.PARAM=LOW:HIGH`` items as {NAME: {PARAM: (low, high)}}."""
+    from studyapp.errors import UserError
+    from studyapp.estimators.registry import spec
+
+    ranges = {}
+    for item in items:
+        key, _, bounds = item.partition("=")
+        name, _, param = key.partition(".")
+        low, _, high = bounds.partition(":")
+        try:
+            pair = (float(low), float(high))
+        except ValueError:
+            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=1:128") from None
+        if not name or not param:
+            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=1:128")
+        ranges.setdefault(spec(name).name, {})[param] = pair
+    return ranges

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.evaluation import kernels
 from studyapp.evaluation.metric import Reference
 
 REFERENCE_COLUMNS = {"lvt": "velocity_lvt", "true": "velocity_true"}
@@ -38,6 +39,9 @@ class Take:
     reference: np.ndarray
     fmax: float | None = None
     sha256: str | None = None
+
+    def __post_init__(self):
+        self.finite = all(np.isfinite(a).all() for a in (self.position, self.acceleration, self.velocity))
 
 
 def reference_column(reference):
@@ -88,9 +92,14 @@ def load_takes(paths, reference="lvt"):
 
 
 class Dataset:
-    """Takes plus the delay bound; measures raw objectives (eq. 28) of a parameter set."""
+    """Takes plus the delay bound; measures raw objectives (eq. 28) of a parameter set.
 
-    def __init__(self, takes, max_lag_s=DEFAULT_MAX_LAG_S):
+    ``fast=True`` runs the estimators through ``kernels.run`` (same output,
+    compiled once per process: for long runs such as the optimiser's).
+    """
+
+    def __init__(self, takes, max_lag_s=DEFAULT_MAX_LAG_S, fast=False):
+        self.fast = bool(fast)
         if not takes:
             raise UserError("no recordings given")
         self.takes = list(takes)
@@ -116,6 +125,8 @@ class Dataset:
         from studyapp.estimators import create
 
         estimator = create(name, take.rate, **params)
+        if self.fast:
+            return kernels.run(estimator, take.position, take.acceleration, take.velocity, take.finite)
         return estimator.process(take.position, take.acceleration, take.velocity)
 
     def delays_and_errors(self, name, params):
@@ -135,13 +146,17 @@ class Dataset:
         return raw
 
 
-def warm_up(names, rate=5000.0):
-    """Run each estimator once on a few samples, so numba's compiled code is loaded in this process."""
+def warm_up(names, rate=5000.0, fast=False):
+    """Run each estimator once on a few samples, so its compiled code is loaded (or compiled) in this process."""
     from studyapp.estimators import create
 
     x = np.zeros(16)
     for name in names:
-        create(name, rate).process(x, x, x)
+        estimator = create(name, rate)
+        if fast:
+            kernels.run(estimator, x, x, x, True)
+        else:
+            estimator.process(x, x, x)
 
 
 _LOADED = {}
@@ -155,12 +170,13 @@ class RecordingFiles:
     reference: str = "lvt"
     max_lag_s: float = DEFAULT_MAX_LAG_S
     warm: tuple = ()
+    fast: bool = True
 
     def load(self):
         dataset = _LOADED.get(self)
         if dataset is None:
-            warm_up(self.warm)
-            dataset = Dataset(load_takes(self.paths, self.reference), self.max_lag_s)
+            warm_up(self.warm, fast=self.fast)
+            dataset = Dataset(load_takes(self.paths, self.reference), self.max_lag_s, self.fast)
             _LOADED.clear()
             _LOADED[self] = dataset
         return dataset

@@ -1,0 +1,61 @@
+"""Fast whole-recording runs for the optimiser: each estimator's own compiled step in a compiled loop.
+
+The optimiser runs every candidate set over every recording, so the cost per
+sample is its budget. ``Estimator.process`` goes through the dispatch's
+streaming form (a switch on the estimator kind and the non-finite input
+guard at every sample); here the kernel itself is passed to a compiled loop,
+which numba specialises for that kernel. The output is the same: the kernel
+sees the same state and samples, and recordings with a non-finite sample,
+or estimators this table does not know, take ``Estimator.process`` instead
+(tests check the equality for every estimator).
+
+The loop is compiled once per process and kernel (numba cannot cache a
+function compiled for another compiled function as argument), so it pays
+off in long runs: the optimiser's worker processes warm it up at start.
+"""
+
+import numpy as np
+from numba import njit
+
+from studyapp.estimators.dispatch import GUARD
+
+
+@njit
+def run_kernel(step, s, p, xs, acc, vel, out):
+    for i in range(xs.shape[0]):
+        out[i] = step(s, p, xs[i], acc[i], vel[i])
+
+
+_KERNELS = None
+
+
+def kernels():
+    """Estimator name -> its compiled step (the same functions the dispatch calls)."""
+    global _KERNELS
+    if _KERNELS is None:
+        from studyapp.estimators import bdiff, complementary, foaw, hybrids, kalman, leastsq, levant, lowpass, lvt
+
+        _KERNELS = {
+            "BDIFF": bdiff.step, "LOWPASS": lowpass.step, "LEASTSQ": leastsq.step, "FOAW": foaw.step,
+            "LEVANT": levant.step_levant, "LEVANTLP": levant.step_levantlp,
+            "KALPOS": kalman.step_kalpos, "KALMAN": kalman.step_kalman,
+            "KALLEV": hybrids.step_kallev, "KALLEVACC": hybrids.step_kallevacc,
+            "KALFOAW": hybrids.step_kalfoaw, "KALFOAWACC": hybrids.step_kalfoawacc,
+            "COMP1": complementary.step, "COMP2": complementary.step, "LVT": lvt.step,
+        }
+    return _KERNELS
+
+
+def run(estimator, position, acceleration, velocity, finite=None):
+    """The estimate of a fresh ``estimator`` over whole arrays (float64, C-contiguous, equal length).
+
+    ``finite`` says whether all three inputs are known to be finite (checked here when None).
+    """
+    step = kernels().get(estimator.name)
+    if finite is None:
+        finite = all(np.isfinite(arr).all() for arr in (position, acceleration, velocity))
+    if step is None or not finite:
+        return estimator.process(position, acceleration, velocity)
+    out = np.empty(position.shape[0])
+    run_kernel(step, estimator.state[GUARD:], estimator.p, position, acceleration, velocity, out)
+    return out
