@@ -82,13 +82,9 @@ def levant_core(s, alpha, lam, period, x):
         s[1] = x
         s[2] = 0.0
     e = s[1] - x
-    if e > 0.0:
-        sign = 1.0
-    elif e < 0.0:
-        sign = -1.0
-    else:
-        sign = 0.0
-    u = s[2] - lam * math.sqrt(abs(e)) * sign
+    # Branch-free: in the sliding regime the sign of e flips at random, which a branch mispredicts.
+    sign = np.sign(e)
+    u = s[2] - lam * math.copysign(math.sqrt(abs(e)), e)
     s[1] += period * u
     s[2] -= period * alpha * sign
     return u
