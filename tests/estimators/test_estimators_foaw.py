@@ -1,0 +1,112 @@
+"""FOAW (best-fit) against numpy: backward difference, straight lines, and a brute-force window search."""
+
+import numpy as np
+import pytest
+from numba import njit
+
+from studyapp.estimators import create
+from studyapp.estimators.dispatch import GUARD
+from studyapp.estimators.foaw import CHOSEN, foaw_core, foaw_state_size
+
+
+def brute_force(y, window, margin, rate):
+    """The best-fit rule with numpy.polyfit on every window: (velocity, chosen n) per sample."""
+    hist = np.concatenate((np.full(window, y[0]), y))  # history before the first sample = first sample
+    vel = np.empty(len(y))
+    chosen = np.empty(len(y), dtype=int)
+    for k in range(len(y)):
+        newest = k + window
+        best, best_n = 0.0, 1
+        for n in range(1, window + 1):
+            ages = np.arange(n + 1)
+            samples = hist[newest - ages]
+            slope = np.polyfit(-ages / rate, samples, 1)[0]  # m/s
+            line = samples[0] - slope * ages / rate
+            if np.any(np.abs(samples[1:n] - line[1:n]) > margin):
+                break
+            best, best_n = slope, n
+        vel[k], chosen[k] = best, best_n
+    return vel, chosen
+
+
+def stepped(est, x):
+    """Per-sample velocity and the chosen window read from the documented state slot."""
+    vel, chosen = np.empty(len(x)), np.empty(len(x), dtype=int)
+    for k, xk in enumerate(x):
+        vel[k] = est.step(xk)
+        chosen[k] = int(est.state[GUARD + CHOSEN])
+    return vel, chosen
+
+
+@pytest.mark.parametrize("rate", [1000.0, 5000.0, 96_000.0])
+def test_foaw_window_1_is_the_backward_difference(rate):
+    x = 0.01 + np.cumsum(np.random.default_rng(3).normal(0.0, 1e-5, 3000))
+    got = create("FOAW", rate, window=1, margin=1e-9).process(x)
+    assert got[0] == 0.0
+    np.testing.assert_allclose(got[1:], np.diff(x) * rate, rtol=1e-13, atol=0.0)
+
+
+@pytest.mark.parametrize("rate", [1000.0, 96_000.0])
+@pytest.mark.parametrize("window", [1, 2, 5, 17, 64])
+def test_foaw_is_exact_on_straight_lines(rate, window):
+    t = np.arange(400) / rate
+    for slope in (-2.0, -1e-3, 0.0, 0.37, 5.0):
+        est = create("FOAW", rate, window=window, margin=1e-9)
+        vel, chosen = stepped(est, 0.0137 + slope * t)
+        settled = slice(window, None)  # the at-rest history has left every window
+        np.testing.assert_allclose(vel[settled], slope, rtol=1e-8, atol=1e-12)
+        assert np.all(chosen[settled] == window)
+
+
+def test_foaw_window_is_the_samples_since_a_slope_change():
+    """Clean kink at sample K: at K + m the longest window within the margin spans exactly m steps."""
+    rate, kink, window = 5000.0, 100, 17
+    k = np.arange(200)
+    x = 0.02 + np.where(k < kink, 0.3 * k, 0.3 * kink - 0.8 * (k - kink)) / rate
+    vel, chosen = stepped(create("FOAW", rate, window=window, margin=1e-9), x)
+    for m in range(1, window + 1):
+        assert chosen[kink + m] == m
+        assert vel[kink + m] == pytest.approx(-0.8, rel=1e-9)
+
+
+@pytest.mark.parametrize("rate, window, noise, margin", [(5000.0, 17, 6.4e-5, 1.001e-4), (40_000.0, 12, 2e-6, 3e-6)])
+def test_foaw_picks_the_longest_window_within_the_margin(rate, window, noise, margin):
+    rng = np.random.default_rng(11)
+    t = np.arange(1500) / rate
+    # a noisy line whose slope changes now and then, so every window length occurs
+    slope = np.repeat(rng.uniform(-0.5, 0.5, 15), 100)
+    x = 0.011 + np.cumsum(slope) / rate + rng.uniform(-noise, noise, t.size)
+    vel, chosen = stepped(create("FOAW", rate, window=window, margin=margin), x)
+    ref_vel, ref_chosen = brute_force(x, window, margin, rate)
+    np.testing.assert_array_equal(chosen, ref_chosen)
+    np.testing.assert_allclose(vel, ref_vel, rtol=1e-7, atol=1e-9)
+    assert len(np.unique(chosen)) >= window // 2 and np.any(chosen == window) and np.any(chosen < 4)
+
+
+def test_foaw_blocks_continue_the_stream():
+    rate = 5000.0
+    x = 0.01 + np.cumsum(np.random.default_rng(5).normal(0.0, 3e-5, 2000))
+    whole = create("FOAW", rate).process(x)
+    est = create("FOAW", rate)
+    parts = np.concatenate([est.process(x[a:b]) for a, b in [(0, 3), (3, 4), (4, 1200), (1200, 2000)]])
+    assert np.array_equal(parts, whole)
+    assert est.state_size == foaw_state_size(17)
+
+
+@njit
+def _double_foaw(xs, window, margin, margin_vel, rate):
+    n = foaw_state_size(window)
+    s = np.zeros(2 * n)
+    out = np.empty_like(xs)
+    for i in range(xs.shape[0]):
+        v = foaw_core(s[0:n], window, margin, rate, xs[i])
+        out[i] = foaw_core(s[n:], window, margin_vel, rate, v)
+    return out
+
+
+def test_foaw_core_chains_into_a_second_derivative():
+    """F(F(x)), as the hybrids use it: a clean parabola has a constant second derivative."""
+    rate = 5000.0
+    t = np.arange(2000) / rate
+    acc = _double_foaw(0.004 + 0.5 * 3.0 * t**2, 12, 1e-4, 0.5, rate)
+    np.testing.assert_allclose(acc[30:], 3.0, rtol=1e-6)
