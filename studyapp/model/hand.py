@@ -1,19 +1,23 @@
 """The virtual hand: an arm impedance that couples a gesture to the handle.
 
-The arm moves the hand along the gesture's target x_g(t) (gestures.py) and the
-grasp couples hand and handle through a spring and a damper:
+The hand holds the handle; its effective mass moves with it (loop.py adds
+``mass`` to the device's). It follows the gesture's target x_g(t) (gestures.py)
+with a feedforward of the intended motion plus a spring and a damper around it:
 
-    F_hand = K (x_g - x) + B (v_g - v)
+    F_hand = M a_g + K (x_g - x) + B (v_g - v)
 
-with the hand's moving mass lumped into the handle's (loop.py adds ``mass`` to
-the device's). This is the classic mass-spring-damper model of a hand holding
-a haptic handle (Hogan 1984; Kuchenbecker, Park and Niemeyer 2003, "Characterizing
-the human wrist for improved haptic interaction", who fit exactly this form). The
-values used are in calibration.py with their sources.
+M is the whole moving mass (device plus hand): people move a familiar load
+with an internal model of its dynamics (Shadmehr and Mussa-Ivaldi 1994,
+"Adaptive representation of dynamics during learning of a motor task",
+J. Neurosci. 14), so without outside forces the handle follows the target
+exactly; K and B are the arm's impedance about that motion, the classic
+mass-spring-damper model of a hand on a handle (Hogan 1984; Tsuji et al. 1995,
+"Human hand impedance characteristics during maintained posture", Biol. Cybern. 72;
+Kuchenbecker, Park and Niemeyer 2003, who fit this form at the wrist). The values
+are in calibration.py with their sources.
 
-A spring to a moving target means the handle lags it by F / K while a force
-(the bow's friction) resists the stroke; the gesture still sets the handle's
-speed, which is what the string hears.
+Under the bow's friction the handle lags the target by about F / K but keeps
+the stroke's speed, which is what the string hears.
 """
 
 from dataclasses import dataclass
@@ -28,14 +32,24 @@ class HandImpedance:
     stiffness: float  # N/m
     damping: float  # N s/m
 
-    def params(self):
-        return np.array([self.stiffness, self.damping])
+    reaction: float = 0.05  # s, time constant of the push against felt friction
+
+    def params(self, moving_mass, rate):
+        """Packed for the compiled loop; ``moving_mass`` is device plus hand (kg)."""
+        alpha = 0.0 if self.reaction <= 0 else 1.0 - np.exp(-1.0 / (rate * self.reaction))
+        return np.array([self.stiffness, self.damping, moving_mass, alpha])
 
 
-HP_K, HP_B = range(2)
+HP_K, HP_B, HP_M, HP_ALPHA = range(4)
 
 
 @njit(cache=True, inline="always")
-def force(p, x_target, v_target, x, v):
-    """The hand's force on the handle (N)."""
-    return p[HP_K] * (x_target - x) + p[HP_B] * (v_target - v)
+def force(p, x_target, v_target, a_target, x, v, push):
+    """The hand's force on the handle (N); ``push`` is its learned push against friction."""
+    return p[HP_M] * a_target + p[HP_K] * (x_target - x) + p[HP_B] * (v_target - v) + push
+
+
+@njit(cache=True, inline="always")
+def learn_push(p, push, friction):
+    """Move the push toward cancelling the felt friction force (first-order, ``reaction`` s)."""
+    return push + p[HP_ALPHA] * (-friction - push)

@@ -51,17 +51,18 @@ FMAX_LIMIT = 200.0  # N: nothing above the motors' impulsive limit makes sense
 F0_RANGE = (20.0, 2000.0)
 
 # control vector
-C_GAIN, C_SCALE, C_FORCE_SCALE, C_BOWING, C_SOURCE, C_USE_ACC, C_USE_AUDIO = range(7)
-N_CONTROL = 7
+C_GAIN, C_SCALE, C_FORCE_SCALE, C_BOWING, C_SOURCE, C_USE_ACC, C_USE_AUDIO, C_PEAK = range(8)
+N_CONTROL = 8
 # loop state
-L_FAULT, L_FAULT_SAMPLE = range(2)
+L_FAULT, L_FAULT_SAMPLE, L_PUSH = range(3)
 FAULT_SENSOR, FAULT_ESTIMATE, FAULT_STRING, FAULT_DEVICE = 1, 2, 3, 4
 # output rows
 (O_POSITION, O_VELOCITY_LVT, O_ACCELERATION, O_VELOCITY_TRUE, O_ACCELERATION_TRUE,
- O_FORCE, O_STRING_VELOCITY, O_AUDIO, O_SOURCE_VELOCITY, O_V_DELTA, O_STICK, O_HAND_FORCE) = range(12)
+ O_FORCE, O_STRING_VELOCITY, O_AUDIO, O_SOURCE_VELOCITY, O_V_DELTA, O_STICK, O_HAND_FORCE,
+ O_FRICTION) = range(13)
 OUTPUTS = (
     "position", "velocity_lvt", "acceleration", "velocity_true", "acceleration_true",
-    "force", "string_velocity", "audio", "source_velocity", "v_delta", "stick", "hand_force",
+    "force", "string_velocity", "audio", "source_velocity", "v_delta", "stick", "hand_force", "friction",
 )
 
 GESTURES = ("strokes", "strokes-validation", "hold", "live", "playback")
@@ -91,7 +92,7 @@ def make_gesture(name, rate, trajectory=None, position=0.0):
     if name == "strokes-validation":
         return Strokes(**calibration.VALIDATION_STROKES)
     if name == "hold":
-        return Hold()
+        return Hold(0.0, calibration.TREMOR_AMPLITUDE, calibration.TREMOR_HZ)
     if name == "live":
         return Live(position)
     if name == "playback":
@@ -170,6 +171,7 @@ def control_step(ctl, state, k, kinds, est_s, est_p, est_out, sp, ss, bridge, nu
     out[O_STRING_VELOCITY, k] = v_string / ctl[C_SCALE]
     out[O_AUDIO, k] = audio
     out[O_V_DELTA, k] = v_delta
+    out[O_FRICTION, k] = u / ctl[C_PEAK]
     out[O_STICK, k] = 1.0 if bowing and abs(v_delta) <= ss_breakaway(sp) else 0.0
     if faulted:
         return 0.0
@@ -196,7 +198,7 @@ def _section(p, s, x):
 
 @njit(cache=True)
 def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
-              body_sec, body_s, target, target_v, noise_x, noise_v, noise_a, out, est_out):
+              body_sec, body_s, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
     """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
     n = target.shape[0]
     use_acc = ctl[C_USE_ACC] != 0.0
@@ -213,7 +215,8 @@ def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bri
         f = control_step(ctl, state, k, kinds, est_s, est_p, est_out, sp, ss, bridge, nut,
                          body_sec, body_s, x_m, a_m, v_m, v, out)
         f = mechanics.clamp_force(dp, ds, f)
-        f_hand = hand.force(hp, target[k], target_v[k], x, v)
+        f_hand = hand.force(hp, target[k], target_v[k], target_a[k], x, v, state[L_PUSH])
+        state[L_PUSH] = hand.learn_push(hp, state[L_PUSH], f)
         if state[L_FAULT] == 0.0 and (_bad(f) or _bad(f_hand)):
             state[L_FAULT] = FAULT_DEVICE
             state[L_FAULT_SAMPLE] = k
@@ -285,20 +288,22 @@ class ClosedLoop:
             raise ParameterError(f"device rate {dev.rate:g} Hz differs from the loop rate {self.rate:g} Hz")
         self.string = bowed_string.StringDesign(self.rate, f0)
         self.sensor_spec = sensors.SensorSpec()
-        self.hand = hand.HandImpedance(calibration.HAND_MASS, calibration.HAND_STIFFNESS, calibration.HAND_DAMPING)
+        self.hand = hand.HandImpedance(calibration.HAND_MASS, calibration.HAND_STIFFNESS, calibration.HAND_DAMPING,
+                                       calibration.HAND_REACTION)
         self.velocity_scale = calibration.VELOCITY_SCALE
         use_acc = ("acceleration" in self.reads) if config.accelerometer is None else bool(config.accelerometer)
         self._ctl = np.zeros(N_CONTROL)
         self._ctl[C_SCALE] = self.velocity_scale
+        self._ctl[C_PEAK] = self.string.peak_friction()
         self._ctl[C_FORCE_SCALE] = 1.0
         self._ctl[C_BOWING] = 1.0
         self._ctl[C_USE_ACC] = 1.0 if use_acc else 0.0
         self._ctl[C_USE_AUDIO] = 1.0 if config.audio else 0.0
-        self._state = np.zeros(2)
+        self._state = np.zeros(3)
         # the hand's mass moves with the handle (hand.py)
         self._dp = dev.params(extra_mass=self.hand.mass) if self.simulated else _limits_params(self.rate, dev.limits)
         self._ds = np.zeros(mechanics.N_STATE)
-        self._hp = self.hand.params()
+        self._hp = self.hand.params(self._dp[mechanics.DP_MASS], self.rate) if self.simulated else np.zeros(4)
         self._snp = self.sensor_spec.params(self.rate)
         self._sns = np.zeros(sensors.N_STATE)
         self._sp = self.string.params()
@@ -316,7 +321,7 @@ class ClosedLoop:
         self.gesture_name = None
         self._trajectory = config.trajectory
         self.set_gesture(config.gesture)
-        self.monitor = StabilityMonitor(self.rate, f0, self.string.beta)
+        self.monitor = StabilityMonitor(self.rate)
 
     # settings -------------------------------------------------------------
     def set_source(self, name):
@@ -400,18 +405,19 @@ class ClosedLoop:
         result["t"] = (self._sample + np.arange(n)) / self.rate
         result["estimates"] = est
         self._sample += n
-        self.monitor.update(result, self.fmax, self.velocity_scale)
+        self.monitor.update(result)
         return result
 
     def _run_simulated(self, n, out, est):
-        target, target_v = self._gesture.block(self._sample - self._gesture_start, n, self.rate)
+        target, target_v, target_a = self._gesture.block(self._sample - self._gesture_start, n, self.rate)
         nx = self._rng_x.standard_normal(n)
         nv = self._rng_v.standard_normal(n)
         na = self._rng_a.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
         run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._snp, self._sns,
                   self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss,
                   self._bridge, self._nut, self._body, self._body_s,
-                  np.ascontiguousarray(target), np.ascontiguousarray(target_v), nx, nv, na, out, est)
+                  np.ascontiguousarray(target), np.ascontiguousarray(target_v), np.ascontiguousarray(target_a),
+                  nx, nv, na, out, est)
 
     def _run_external(self, n, out, est):
         dev = self.device
