@@ -141,6 +141,7 @@ class Sink:
         self.underruns = 0  # device periods played with a gap, for whatever reason
         self.shortfalls = 0  # ... because the FIFO ran dry (the engine was late)
         self.xruns = 0  # ... because the device reported an underflow
+        self.frames_played = 0
 
     @property
     def description(self):
@@ -298,6 +299,7 @@ class DeviceSink(Sink):
         self.gain.apply(self._scratch)
         outdata[:] = self._scratch[:, None]
         self.callbacks += 1
+        self.frames_played += frames
         self._wanted.set()
 
     def push(self, audio):

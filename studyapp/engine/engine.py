@@ -192,7 +192,16 @@ class Engine:
         return out
 
     def controls(self):
-        """MIDI control events since the last call: ``(control, value, time, latency, blocks_late)``."""
+        """MIDI control events since the last call.
+
+        ``(control, value, arrived, latency, blocks_late, applied_block)``: the
+        control's name and value in [0, 1], its arrival (``time.monotonic()``),
+        the seconds from arrival to the start of the block that applied its
+        action (``None`` when the control has no action), how many block
+        boundaries it waited for (0 or 1 unless the engine fell behind), and
+        that block's number (its first sample is ``applied_block * block``).
+        A learn-mode binding comes as ``("learned", control, binding)``.
+        """
         with self._lock:
             out, self._controls = self._controls, []
         return out

@@ -201,7 +201,7 @@ class Worker:
             action = self.actions.get(control)
             command = cmd.action_command(action, value, arrived) if action else None
             latency = self.apply(command, started) if command else None
-            self.events.put(("control", control, value, arrived, latency, self.k - block))
+            self.events.put(("control", control, value, arrived, latency, self.k - block, self.k))
 
     # the loop -------------------------------------------------------------
     def prime(self):
@@ -319,7 +319,7 @@ class Worker:
             "rate": self.loop.rate, "blocks": self.k, "samples": self.k * self.block,
             "seconds": end - start if start else 0.0, "achieved_rate": achieved, "deadline_misses": int(s.get("deadline_misses")),
             "audio_underruns": self.sink.underruns, "audio_xruns": self.sink.xruns,
-            "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
+            "audio_frames": self.sink.frames_played, "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
             "command_latency_max": float(s.get("command_latency_max")),
             "load_max": float(s.get("load_max")), "realtime": self.realtime,
         }
