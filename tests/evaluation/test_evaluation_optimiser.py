@@ -108,3 +108,20 @@ def test_space_follows_table_2_and_keeps_choices_fixed():
     assert cutoff.log and cutoff.low == 1.0 and cutoff.high == pytest.approx(NYQUIST_FRACTION * 5000.0)
     window = Space("LEASTSQ", RATE).dims[1]
     assert window.integer and not window.log
+
+
+def test_search_ranges_narrow_foaw_and_follow_range_options():
+    foaw = {d.name: d for d in Space("FOAW", RATE).dims}
+    assert (foaw["window"].low, foaw["window"].high) == (1.0, 64.0)
+    assert (foaw["margin"].low, foaw["margin"].high) == (1e-7, 1e-2)
+    from studyapp.cli.optimise import parse_ranges
+
+    ranges = parse_ranges(["FOAW.window=20:30", "LOWPASS.cutoff_hz=100:400"])
+    space = Space("FOAW", RATE, ranges=ranges["FOAW"])
+    assert (space.dims[0].low, space.dims[0].high) == (20.0, 30.0)
+    assert space.start["window"] == 20  # Table 1's 17 moved into the range
+    assert Space("LOWPASS", RATE, ranges=ranges["LOWPASS"]).dims[0].high == 400.0
+    with pytest.raises(UserError, match="LOWPASS.cutoff_hz"):
+        Space("LOWPASS", RATE, ranges={"cutoff_hz": (0.5, 100.0)})
+    with pytest.raises(UserError, match="NAME.PARAM=LOW:HIGH"):
+        parse_ranges(["FOAW.window=20"])
