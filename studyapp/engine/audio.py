@@ -71,12 +71,15 @@ def load_sounddevice():
 
 
 class Gain:
-    """Volume and mute, ramped linearly over one block on every change so changes never click."""
+    """Volume and mute, ramped linearly over one block on every change so changes never click.
+
+    Settings made before the first block apply at once (there is nothing to click against).
+    """
 
     def __init__(self, volume=1.0):
         self.volume = float(volume)
         self.muted = False
-        self._now = self.target
+        self._now = None
 
     @property
     def target(self):
@@ -84,6 +87,8 @@ class Gain:
 
     def apply(self, block):
         target = self.target
+        if self._now is None:
+            self._now = target
         if target == self._now:
             block *= target
         else:
