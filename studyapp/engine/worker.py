@@ -27,6 +27,7 @@ import importlib
 import multiprocessing
 import os
 import queue
+import signal
 import sys
 import time
 import traceback
@@ -63,6 +64,8 @@ def make_device(spec, rate):
 
 def main(config, ring_spec, status_name, commands, events):
     """Entry point of the worker process."""
+    # Ctrl-C reaches the whole process group; the parent decides when the worker stops.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.environ.setdefault("JACK_NO_START_SERVER", "1")
     status = StatusBlock.attach(status_name)
     ring = Ring.attach(ring_spec)

@@ -1,0 +1,125 @@
+"""``studyapp live``: the haptic loop in real time, headless, with a scripted gesture.
+
+Prints the engine's status once a second on stderr; with ``--json`` prints one
+JSON object on stdout at exit:
+``{"rate", "achieved_rate", "deadline_misses", "audio_underruns", "faults", "midi_messages", ...}``.
+Stops after ``--seconds`` or on Ctrl-C / SIGTERM, always cleanly (no orphan
+process, no shared memory left behind).
+"""
+
+
+def register(sub):
+    p = sub.add_parser("live", help="run the haptic loop in real time (audio out, MIDI knobs in)")
+    p.add_argument("--rate", type=float, default=5000.0, help="haptic rate in Hz (default 5000)")
+    p.add_argument("--source", default="LVT", help="velocity source: an estimator, LVT or TRUE (default LVT)")
+    p.add_argument("--fmax", type=float, default=1.0, help="F_max in N (default 1)")
+    p.add_argument("--estimators", default=None,
+                   help="active estimators: comma-separated names or 'all' (default: just the source)")
+    p.add_argument("--audio", default="device",
+                   help="device | device:NAME | wav:FILE | null (default device; null if none is usable)")
+    p.add_argument("--midi", default="first", help="PORT (name or part of it) | first | virtual | none (default first)")
+    p.add_argument("--seconds", type=float, default=None, help="stop after this long (default: run until Ctrl-C)")
+    p.add_argument("--gesture", default="strokes", help="scripted gesture (default strokes)")
+    p.add_argument("--block", type=int, default=None, help="samples per block (default: 2 ms worth)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    p.add_argument("--json", action="store_true", help="print one JSON object at exit")
+    p.set_defaults(func=run)
+
+
+def _estimators(text, source):
+    from studyapp import estimators
+    from studyapp.errors import ParameterError
+
+    if text is None:
+        if source in ("LVT", "TRUE"):
+            return {}
+        if source not in estimators.names():
+            raise ParameterError(f"source {source!r}: allowed are LVT, TRUE or an estimator "
+                                 f"({', '.join(n for n in estimators.names() if n != 'LVT')})")
+        return {source: {}}
+    if text.strip().lower() == "all":
+        return {n: {} for n in estimators.names() if n != "LVT"}
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    unknown = [n for n in names if n not in estimators.names()]
+    if unknown:
+        raise ParameterError(f"--estimators: unknown {unknown[0]!r}; allowed are {', '.join(estimators.names())} or all")
+    return {n: {} for n in names}
+
+
+def _line(snap, elapsed):
+    return (f"live: {elapsed:5.0f} s  rate {snap['achieved_rate']:.0f}/{snap['rate']:.0f} Hz  "
+            f"load {100 * snap['load_mean']:.0f}% (max {100 * snap['load_max']:.0f}%)  "
+            f"misses {snap['deadline_misses']}  underruns {snap['audio_underruns']}  "
+            f"faults {snap['faults']}  F_max {snap['fmax']:.2f} N  source {snap['source']}")
+
+
+def run(args):
+    import json
+    import signal
+    import sys
+    import time
+
+    from studyapp.engine.config import EngineConfig
+    from studyapp.engine.engine import Engine
+    from studyapp.errors import ParameterError
+
+    if args.seconds is not None and not args.seconds > 0:
+        raise ParameterError(f"--seconds {args.seconds}: allowed is a positive number")
+
+    def say(text):
+        print(text, file=sys.stderr, flush=True)
+
+    config = EngineConfig(
+        rate=args.rate, estimators=_estimators(args.estimators, args.source), source=args.source,
+        fmax=args.fmax, gesture=args.gesture, seed=args.seed, block=args.block, audio=args.audio,
+        midi=args.midi,
+    )
+    engine = Engine(config, say=say, on_fault=lambda text: say(f"live: fault: {text}"))
+
+    def terminate(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, terminate)
+    summary = None
+    try:
+        engine.start()
+        info = engine.info
+        say(f"live: {info['rate']:g} Hz, block {info['block']}, paced by the {info['paced']}, "
+            f"audio {info['audio']}, MIDI {info['midi']}, real-time priority {'yes' if info['realtime'] else 'no'}")
+        started = time.monotonic()
+        next_line = started + 1.0
+        while engine.alive:
+            now = time.monotonic()
+            if args.seconds is not None and now - started >= args.seconds:
+                break
+            if now >= next_line:
+                say(_line(engine.status(), now - started))
+                next_line += 1.0
+            wake = next_line if args.seconds is None else min(next_line, started + args.seconds)
+            time.sleep(max(0.0, min(0.1, wake - time.monotonic())))
+    except KeyboardInterrupt:
+        say("live: stopping")
+    finally:
+        summary = engine.stop() or {}
+        signal.signal(signal.SIGTERM, previous)
+    result = {
+        "rate": config.rate,
+        "achieved_rate": summary.get("achieved_rate", 0.0),
+        "deadline_misses": summary.get("deadline_misses", 0),
+        "audio_underruns": summary.get("audio_underruns", 0),
+        "faults": list(engine.faults),
+        "midi_messages": summary.get("midi_messages", 0),
+        "seconds": summary.get("seconds", 0.0),
+        "block": engine.info.get("block"),
+        "load_max": summary.get("load_max", 0.0),
+        "audio_xruns": summary.get("audio_xruns", 0),
+        "command_latency_max": summary.get("command_latency_max", 0.0),
+        "audio": engine.info.get("audio"),
+        "midi": engine.info.get("midi"),
+    }
+    if args.json:
+        print(json.dumps(result))
+    else:
+        say(f"live: done: {result['achieved_rate']:.0f} Hz achieved, {result['deadline_misses']} deadline misses, "
+            f"{result['audio_underruns']} underruns, {len(result['faults'])} faults")
+    return 1 if engine.tripped else 0
