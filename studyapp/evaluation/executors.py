@@ -29,6 +29,23 @@ class InlineExecutor(Executor):
         return future
 
 
+class ClusterExecutor(Executor):
+    """A dask.distributed ``Client``'s executor that also closes the client on shutdown."""
+
+    def __init__(self, client):
+        self.client = client
+        self.executor = client.get_executor()
+
+    def submit(self, fn, /, *args, **kwargs):
+        return self.executor.submit(fn, *args, **kwargs)
+
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        try:
+            self.executor.shutdown(wait=wait)
+        finally:
+            self.client.close()
+
+
 def cpu_count():
     try:
         return len(os.sched_getaffinity(0))
@@ -49,7 +66,7 @@ def make_executor(workers=None, scheduler=None, initializer=None, initargs=()):
             client = Client(scheduler)
         except (OSError, TimeoutError, ValueError) as exc:
             raise UserError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
-        return client.get_executor()
+        return ClusterExecutor(client)
     workers = cpu_count() if workers is None else int(workers)
     if workers < 1:
         raise UserError(f"--workers {workers}: allowed is an integer of at least 1")
