@@ -228,7 +228,8 @@ class Optimiser:
         if self.progress is None:
             return
         done = {name for name in self.spaces if name not in self._active()}
-        self.progress(self.sum.iteration, self.evaluated, self.sum.objectives(), done, final=final)
+        waiting = {name: s.since_improvement for name, s in self.searches.items()}
+        self.progress(self.sum.iteration, self.evaluated, self.sum.objectives(), done, final=final, waiting=waiting)
 
 
 def _jsonable(value):

@@ -2,7 +2,9 @@
 
 One line at most every ``interval`` seconds (and a last one at the end):
 iteration, parameter sets evaluated, elapsed time, then for each estimator its
-best F_g under the scale in force, with ``*`` once it has stopped searching.
+best F_g under the scale in force and, after a slash, how many new sets in a
+row have not improved it (it stops at the patience), or ``*`` once it has
+stopped searching.
 On a terminal the line is redrawn in place; in a log each update is a line.
 """
 
@@ -19,12 +21,16 @@ class Progress:
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
         self.drawn = False
 
-    def __call__(self, iteration, evaluated, objectives, done, final=False):
+    def __call__(self, iteration, evaluated, objectives, done, final=False, waiting=None):
         now = time.monotonic()
         if not final and now - self.last < self.interval:
             return
         self.last = now
-        parts = [f"{name} {value:.4g}{'*' if name in done else ''}" for name, value in objectives.items()]
+        waiting = waiting or {}
+        parts = [
+            f"{name} {value:.4g}" + ("*" if name in done else f"/{waiting[name]}" if name in waiting else "")
+            for name, value in objectives.items()
+        ]
         line = f"iter {iteration} sets {evaluated} {now - self.started:.0f}s | " + "  ".join(parts)
         if self.tty:
             self.stream.write("\r\033[K" + line + ("\n" if final else ""))

@@ -125,3 +125,19 @@ def test_search_ranges_narrow_foaw_and_follow_range_options():
         Space("LOWPASS", RATE, ranges={"cutoff_hz": (0.5, 100.0)})
     with pytest.raises(UserError, match="NAME.PARAM=LOW:HIGH"):
         parse_ranges(["FOAW.window=20"])
+
+
+def test_progress_shows_best_objective_per_estimator():
+    import io
+
+    from studyapp.evaluation.progress import Progress
+
+    stream = io.StringIO()
+    result = _optimiser(InlineExecutor(), patience=10, progress=Progress(stream, interval=0.0)).run()
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == result.iterations + 1  # one per iteration, and the final one
+    last = lines[-1]
+    assert last.startswith(f"iter {result.iterations} ")
+    for name, value in result.objectives.items():
+        assert f"{name} {value:.4g}*" in last
+    assert "/" in lines[0]  # sets without improvement while searching
