@@ -69,7 +69,10 @@ def test_foaw_window_is_the_samples_since_a_slope_change():
         assert vel[kink + m] == pytest.approx(-0.8, rel=1e-9)
 
 
-@pytest.mark.parametrize("rate, window, noise, margin", [(5000.0, 17, 6.4e-5, 1.001e-4), (40_000.0, 12, 2e-6, 3e-6)])
+@pytest.mark.parametrize(
+    "rate, window, noise, margin",
+    [(5000.0, 17, 6.4e-5, 1.001e-4), (40_000.0, 12, 2e-6, 3e-6), (1000.0, 40, 1e-6, 1e-4)],
+)
 def test_foaw_picks_the_longest_window_within_the_margin(rate, window, noise, margin):
     rng = np.random.default_rng(11)
     t = np.arange(1500) / rate
