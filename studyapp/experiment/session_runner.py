@@ -49,6 +49,7 @@ class SessionRunner:
         self.task = None
         self.loop = None
         self.bowing = False
+        self.gesture = None
         self._loop_source = None
         self._loop_fmax = None
         self._broken = False
@@ -97,6 +98,7 @@ class SessionRunner:
         self._broken = False
         self._fault = None
         self.bowing = False
+        self.gesture = p.gesture
         self.log({"type": "trial_start", "trial": trial.trial, "condition": trial.condition,
                   "conditions": list(trial.conditions), "restart": bool(earlier),
                   "restored_knobs": restored, "loop_seed": seed})
@@ -148,6 +150,13 @@ class SessionRunner:
             self.loop.set_bowing(on)
             self.bowing = on
             self.log({"type": "bowing", "on": on})
+
+    def set_gesture(self, name):
+        """Change how the virtual hand moves the handle (e.g. ``strokes``, or ``hold`` to rest the bow)."""
+        if self.loop is not None and name != self.gesture:
+            self.loop.set_gesture(name)
+            self.gesture = name
+            self.log({"type": "gesture", "name": name})
 
     def advance(self, seconds):
         """Run the loop for ``seconds`` (whole samples), tick the task, and return the loop's block."""

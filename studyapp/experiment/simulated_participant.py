@@ -17,12 +17,17 @@ best (least noisy) knob to the top first, then the worst to the bottom, then
 places the rest linearly in log-noise between them, each with a little hand
 jitter (``hand_jitter`` knob steps), and presses the confirm pad.
 
-Adjustment task (Sec. 8.2). Bowing from F_max = 0, it raises the knob in
-coarse steps (6 to 10 positions, drawn per trial), bowing ``probe_time``
-seconds after each, until the loop's stability monitor flags breakdown (or
-the loop faults). It then turns back one or two positions at a time until the
-monitor no longer flags it, never below the last position it found stable.
-It confirms there, moved by its personal criterion (a bias of
+Adjustment task (Sec. 8.2). It rests the bow on the string and holds the
+handle (gesture ``hold``: the model's oscillation shows when the bow rests or
+moves slowly, while regular strokes mask it; see studyapp.model.stability),
+then from F_max = 0 raises the knob in steps of 3 to 5 positions (drawn per
+trial), listening ``probe_time`` seconds after each, until the loop's
+stability monitor flags breakdown (it reacts within ``reaction_time``) or the
+loop faults. The oscillation, once started, outlives a small turn back
+(hysteresis, as the paper's participants found), so it then works down in a
+staircase: lift the bow until the string is calm (at most ``rest_time``),
+turn back 2 or 3 positions, bow again and listen, until the string holds. It
+confirms there, moved by its personal criterion (a bias of
 ``criterion_spread`` knob positions drawn once per session: participants
 judge "breakdown" differently, Sec. 9.1) and a per-trial jitter of
 ``hand_jitter`` positions. If the string never breaks down it confirms at the
@@ -41,11 +46,16 @@ from studyapp.experiment.noisiness import velocity_noise
 
 
 class SimulatedParticipant:
-    def __init__(self, seed, bow_time=0.25, probe_time=0.08, rating_jitter=0.05,
+    def __init__(self, seed, bow_time=0.25, probe_time=0.4, reaction_time=0.05, rest_time=1.0,
+                 retries=12, adjust_gesture="hold", rating_jitter=0.05,
                  hand_jitter=1.5, criterion_spread=2.0):
         self.seed = int(seed)
         self.bow_time = bow_time
         self.probe_time = probe_time
+        self.reaction_time = reaction_time
+        self.rest_time = rest_time
+        self.retries = retries
+        self.adjust_gesture = adjust_gesture
         self.rating_jitter = rating_jitter
         self.hand_jitter = hand_jitter
         self.criterion = float(np.random.default_rng([self.seed, 0x5EED]).normal(0.0, criterion_spread))
@@ -106,33 +116,48 @@ class SimulatedParticipant:
     def _broken(self, runner):
         return bool(runner.loop.monitor.broken) or runner.loop.fault is not None
 
+    def _listen(self, runner, seconds):
+        """Bow for up to ``seconds``; True as soon as the string breaks down (a person reacts at once)."""
+        chunk = self.reaction_time
+        for _ in range(max(1, int(round(seconds / chunk)))):
+            runner.advance(chunk)
+            if self._broken(runner):
+                return True
+        return False
+
+    def _rest(self, runner):
+        """Lift the bow until the string is calm again (at most ``rest_time`` s), then bow again."""
+        runner.set_bowing(False)
+        waited = 0.0
+        while waited < self.rest_time:
+            runner.advance(self.reaction_time)
+            waited += self.reaction_time
+            if not self._broken(runner):
+                break
+        runner.set_bowing(True)
+
     def adjust(self, runner, rng):
         knob = runner.task.knob_index
-        coarse = int(rng.integers(6, 11))
-        value, stable = 0, 0
+        step = int(rng.integers(3, 6))
         self.knob_values[knob] = 0
+        runner.set_gesture(self.adjust_gesture)
         runner.set_bowing(True)
-        runner.advance(self.probe_time)
-        broken = False
-        while value < KNOB_MAX:
-            value = min(KNOB_MAX, value + coarse)
+        runner.advance(self.reaction_time)
+        value, broken = 0, False
+        while value < KNOB_MAX and not broken:
+            value = min(KNOB_MAX, value + step)
             self.turn(runner, knob, value, rng)
-            runner.advance(self.probe_time)
-            broken = self._broken(runner)
-            if broken:
-                break
-            stable = value
-        if broken and runner.loop.fault is None:
-            while value > stable + 1:
-                value = max(stable, value - int(rng.integers(1, 3)))
-                self.turn(runner, knob, value, rng)
-                runner.advance(self.probe_time)
-                if not self._broken(runner):
-                    break
+            broken = self._listen(runner, self.probe_time)
+        if broken and runner.loop.fault is not None:
+            value -= step
         elif broken:
-            value = stable
+            for _ in range(self.retries):
+                value = max(1, value - int(rng.integers(2, 4)))
+                self._rest(runner)
+                self.turn(runner, knob, value, rng)
+                if not self._listen(runner, self.probe_time) or value == 1:
+                    break
         if broken:
             value = round(value + self.criterion + rng.normal(0.0, self.hand_jitter))
         self.turn(runner, knob, int(np.clip(value, 1, KNOB_MAX)), rng)
-        runner.advance(self.probe_time / 2)
         runner.pad(runner.task.confirm_pad)

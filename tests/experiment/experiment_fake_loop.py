@@ -1,7 +1,7 @@
 """A stand-in for studyapp.model.ClosedLoop with known noise and breakdown levels.
 
 Duck-typed like the loop (names, rate, run, set_source, set_fmax, set_bowing,
-monitor, fault), so the session runner and the simulated participant can be
+set_gesture, monitor, fault), so the session runner and the simulated participant can be
 tested against known answers: each condition's estimate is the true velocity
 plus white noise of a given RMS, and the monitor flags breakdown exactly when
 F_max exceeds the condition's threshold while bowing.
@@ -43,6 +43,9 @@ class FakeLoop:
     def set_bowing(self, on):
         self.bowing = on
         self.calls.append(("bowing", on))
+
+    def set_gesture(self, name):
+        self.calls.append(("gesture", name))
 
     def run(self, n):
         t = (self.samples + np.arange(n)) / self.rate

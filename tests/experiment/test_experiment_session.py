@@ -113,7 +113,8 @@ def test_simulated_participant_rates_by_noise_and_finds_breakdown(tmp_path, prot
     for response in responses[1:]:
         threshold = THRESHOLD[response["condition"]]
         # Confirmed within a few knob steps of the breakdown level.
-        assert fmax_from_knob(response["value"] - 8, 40.0, 3.0) < threshold < fmax_from_knob(response["value"] + 8, 40.0, 3.0)
+        knob = protocol.adjustment.ceiling, protocol.adjustment.decades
+        assert fmax_from_knob(response["value"] - 8, *knob) < threshold < fmax_from_knob(response["value"] + 8, *knob)
         assert response["peak_fmax"] > threshold
     # Every knob event of the rating trial drove the loop: selection and F_max.
     rating_loop = made[0]
