@@ -91,6 +91,8 @@ class Optimiser:
         self.seed = int(seed)
         self.tolerance = tolerance
         self.max_sets = None if max_sets is None else int(max_sets)
+        if self.max_sets is not None and self.max_sets < 1:
+            raise UserError(f"--max-sets {max_sets}: allowed is an integer of at least 1")
         self.checkpoint = checkpoint
         self.checkpoint_interval = float(checkpoint_interval)
         self.progress = progress

@@ -52,6 +52,7 @@ def test_bad_toml(recording, tmp_path, capsys):
 def test_bad_settings(recording, tmp_path, capsys):
     out = tmp_path / "P.toml"
     _fails(capsys, ["optimise", str(recording), "-o", str(out), "--patience", "0"], "--patience")
+    _fails(capsys, ["optimise", str(recording), "-o", str(out), "--max-sets", "0"], "--max-sets")
     _fails(capsys, ["optimise", str(recording), "-o", str(tmp_path / "P.txt")], ".toml")
     _fails(capsys, ["optimise", str(recording), "-o", str(out), "--resume"], "checkpoint")
     _fails(capsys, ["tradeoff", "--rates", "500", "-o", str(tmp_path / "t")], "rate")
