@@ -108,13 +108,13 @@ def foaw_core(s, window, margin, rate, x):
             bound = max(bound + abs(b - best) * (n - 2), abs(ring[head + n - 1] - x + b * (n - 1)))
             if bound > margin:
                 bound = 0.0
+                r = 0.0
                 for j in range(1, n):
                     r = abs(ring[head + j] - x + b * j)
-                    if r > bound:
-                        bound = r
-                        if r > margin:
-                            break
-                if bound > margin:
+                    if r > margin:
+                        break
+                    bound = max(bound, r)
+                if r > margin:
                     break
         best = b
         chosen = n
