@@ -40,7 +40,9 @@ EDGE = RHO_MAX ** -0.25 - 0.75  # |slope (v + offset)| at the clip's edge
 @njit(cache=True, inline="always")
 def rho(v, slope, offset):
     """The reflection coefficient for a velocity difference ``v`` (string units)."""
-    r = (abs(slope * (v + offset)) + 0.75) ** -4.0
+    t = abs(slope * (v + offset)) + 0.75
+    t2 = t * t
+    r = 1.0 / (t2 * t2)
     if r > RHO_MAX:
         return RHO_MAX
     if r < RHO_MIN:

@@ -111,13 +111,18 @@ class StringDesign:
 
 @njit(cache=True, inline="always")
 def read_line(buf, write, delay):
-    """The value written ``delay`` samples ago (linear interpolation), ``delay >= 1``."""
+    """The value written ``delay`` samples ago (linear interpolation), ``1 <= delay <= len(buf) - 2``."""
     n = buf.shape[0]
     i = int(delay)
     frac = delay - i
-    a = buf[(write - i) % n]
-    b = buf[(write - i - 1) % n]
-    return a + frac * (b - a)
+    ia = write - i
+    if ia < 0:
+        ia += n
+    ib = ia - 1
+    if ib < 0:
+        ib += n
+    a = buf[ia]
+    return a + frac * (buf[ib] - a)
 
 
 @njit(cache=True, inline="always")
@@ -141,7 +146,8 @@ def step(p, s, bridge, nut, v_bow, bowing):
         u = bow_table.rho(v_delta, p[P_SLOPE], p[P_OFFSET]) * v_delta
     nut[write] = bridge_refl + u
     bridge[write] = nut_refl + u
-    s[S_WRITE] = (write + 1) % bridge.shape[0]
+    write += 1
+    s[S_WRITE] = 0 if write == bridge.shape[0] else write
     return u, v_h + u, v_bridge, v_delta
 
 

@@ -17,11 +17,47 @@ handle along it.
 Stroke amplitudes and speeds are in calibration.py with their reasons.
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from studyapp.errors import ParameterError
+
+
+@njit(cache=True)
+def _segment(u, start, length, direction, v, tr):
+    """Position, velocity, acceleration ``u`` s into one stroke of ``length`` from ``start``."""
+    tc = max(length - v * tr, 0.0) / v
+    if u < tr:
+        w = math.pi * u / tr
+        return (start + direction * 0.5 * v * (u - tr / math.pi * math.sin(w)),
+                direction * 0.5 * v * (1.0 - math.cos(w)), direction * 0.5 * v * math.pi / tr * math.sin(w))
+    if u < tr + tc:
+        return start + direction * (0.5 * v * tr + v * (u - tr)), direction * v, 0.0
+    if u < 2.0 * tr + tc:
+        q = u - tr - tc
+        w = math.pi * q / tr
+        return (start + direction * (0.5 * v * tr + v * tc + 0.5 * v * (q + tr / math.pi * math.sin(w))),
+                direction * 0.5 * v * (1.0 + math.cos(w)), -direction * 0.5 * v * math.pi / tr * math.sin(w))
+    return start + direction * length, 0.0, 0.0
+
+
+@njit(cache=True)
+def strokes_at(t, amplitude, speed, ramp, dwell, pos, vel, acc):
+    """Fill ``pos``, ``vel``, ``acc`` with the strokes at the times ``t``."""
+    first = 2.0 * ramp + max(amplitude - speed * ramp, 0.0) / speed + dwell
+    half = 2.0 * ramp + max(2.0 * amplitude - speed * ramp, 0.0) / speed + dwell
+    for k in range(t.shape[0]):
+        if t[k] < first:
+            pos[k], vel[k], acc[k] = _segment(t[k], 0.0, amplitude, 1.0, speed, ramp)
+        else:
+            c = (t[k] - first) % (2.0 * half)
+            if c < half:
+                pos[k], vel[k], acc[k] = _segment(c, amplitude, 2.0 * amplitude, -1.0, speed, ramp)
+            else:
+                pos[k], vel[k], acc[k] = _segment(c - half, -amplitude, 2.0 * amplitude, 1.0, speed, ramp)
 
 
 @dataclass(frozen=True)
@@ -31,45 +67,16 @@ class Strokes:
     ramp: float  # s
     dwell: float  # s
 
-    def _segment(self, u, start, length, direction):
-        """Position and velocity ``u`` seconds into one stroke of ``length`` from ``start``."""
-        v, tr = self.speed, self.ramp
-        tc = max(length - v * tr, 0.0) / v
-        pos = np.full_like(u, start + direction * length)
-        vel = np.zeros_like(u)
-        acc = np.zeros_like(u)
-        a = u < tr
-        pos[a] = start + direction * 0.5 * v * (u[a] - tr / np.pi * np.sin(np.pi * u[a] / tr))
-        vel[a] = direction * 0.5 * v * (1.0 - np.cos(np.pi * u[a] / tr))
-        acc[a] = direction * 0.5 * v * np.pi / tr * np.sin(np.pi * u[a] / tr)
-        b = (u >= tr) & (u < tr + tc)
-        pos[b] = start + direction * (0.5 * v * tr + v * (u[b] - tr))
-        vel[b] = direction * v
-        c = (u >= tr + tc) & (u < 2.0 * tr + tc)
-        w = u[c] - tr - tc
-        pos[c] = start + direction * (0.5 * v * tr + v * tc + 0.5 * v * (w + tr / np.pi * np.sin(np.pi * w / tr)))
-        vel[c] = direction * 0.5 * v * (1.0 + np.cos(np.pi * w / tr))
-        acc[c] = -direction * 0.5 * v * np.pi / tr * np.sin(np.pi * w / tr)
-        return pos, vel, acc
-
     def duration(self, length):
+        """Seconds for one stroke of ``length`` m, dwell included."""
         return 2.0 * self.ramp + max(length - self.speed * self.ramp, 0.0) / self.speed + self.dwell
 
     def at(self, t):
         """Target position, velocity and acceleration at the times ``t`` (s, an array)."""
-        t = np.asarray(t, dtype=np.float64)
-        a = self.amplitude
-        first = self.duration(a)
-        half = self.duration(2.0 * a)
-        out = np.empty((3, t.shape[0]))
-        lead = t < first
-        out[:, lead] = self._segment(t[lead], 0.0, a, 1.0)
-        rest = np.flatnonzero(~lead)
-        cycle = np.mod(t[rest] - first, 2.0 * half)
-        down = cycle < half
-        out[:, rest[down]] = self._segment(cycle[down], a, 2.0 * a, -1.0)
-        out[:, rest[~down]] = self._segment(cycle[~down] - half, -a, 2.0 * a, 1.0)
-        return out[0], out[1], out[2]
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        pos, vel, acc = np.empty_like(t), np.empty_like(t), np.empty_like(t)
+        strokes_at(t, self.amplitude, self.speed, self.ramp, self.dwell, pos, vel, acc)
+        return pos, vel, acc
 
     def block(self, start, n, rate):
         return self.at((start + np.arange(n)) / rate)

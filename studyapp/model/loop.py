@@ -40,7 +40,7 @@ from studyapp.estimators import Bank
 from studyapp.estimators.dispatch import step_guarded
 from studyapp.estimators.registry import SPECS
 from studyapp.estimators.spec import validate_rate
-from studyapp.model import body, bowed_string, calibration, hand, sensors
+from studyapp.model import body, bow_table, bowed_string, calibration, hand, sensors, stability
 from studyapp.model import device as mechanics
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
 from studyapp.model.stability import StabilityMonitor
@@ -51,18 +51,19 @@ FMAX_LIMIT = 200.0  # N: nothing above the motors' impulsive limit makes sense
 F0_RANGE = (20.0, 2000.0)
 
 # control vector
-C_GAIN, C_SCALE, C_FORCE_SCALE, C_BOWING, C_SOURCE, C_USE_ACC, C_USE_AUDIO, C_PEAK = range(8)
-N_CONTROL = 8
+C_GAIN, C_SCALE, C_FORCE_SCALE, C_BOWING, C_SOURCE, C_USE_ACC, C_USE_AUDIO, C_PEAK, C_BREAKAWAY = range(9)
+N_CONTROL = 9
 # loop state
 L_FAULT, L_FAULT_SAMPLE, L_PUSH = range(3)
 FAULT_SENSOR, FAULT_ESTIMATE, FAULT_STRING, FAULT_DEVICE = 1, 2, 3, 4
 # output rows
 (O_POSITION, O_VELOCITY_LVT, O_ACCELERATION, O_VELOCITY_TRUE, O_ACCELERATION_TRUE,
  O_FORCE, O_STRING_VELOCITY, O_AUDIO, O_SOURCE_VELOCITY, O_V_DELTA, O_STICK, O_HAND_FORCE,
- O_FRICTION) = range(13)
+ O_FRICTION, O_POSITION_TRUE) = range(14)
 OUTPUTS = (
     "position", "velocity_lvt", "acceleration", "velocity_true", "acceleration_true",
     "force", "string_velocity", "audio", "source_velocity", "v_delta", "stick", "hand_force", "friction",
+    "position_true",
 )
 
 GESTURES = ("strokes", "strokes-validation", "hold", "live", "playback")
@@ -128,80 +129,75 @@ def _bad(x):
 
 
 @njit(cache=True, inline="always")
-def control_step(ctl, state, k, kinds, est_s, est_p, est_out, sp, ss, bridge, nut,
-                 body_sec, body_s, x_m, a_m, v_m, v_true, out):
-    """Estimators, source, string, force for one sample; returns the unclamped force (N)."""
-    for e in range(kinds.shape[0]):
-        est_out[e, k] = step_guarded(kinds[e], est_s[e], est_p[e], x_m, a_m, v_m)
-    src = int(ctl[C_SOURCE])
-    if src == SOURCE_TRUE:
-        v_src = v_true
-    elif src == SOURCE_LVT:
-        v_src = v_m
-    else:
-        v_src = est_out[src, k]
-    faulted = state[L_FAULT] != 0.0
-    if not faulted and _bad(v_src):
-        state[L_FAULT] = FAULT_ESTIMATE
+def _fault(state, code, k):
+    if state[L_FAULT] == 0.0:
+        state[L_FAULT] = code
         state[L_FAULT_SAMPLE] = k
-        faulted = True
+
+
+@njit(cache=True, inline="always")
+def bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp, ms, out):
+    """The string and the force for one sample of the source velocity; returns the unclamped force (N)."""
+    if _bad(v_src):
+        _fault(state, FAULT_ESTIMATE, k)
+    faulted = state[L_FAULT] != 0.0
     bowing = ctl[C_BOWING] != 0.0 and not faulted
     v_bow = ctl[C_SCALE] * v_src if bowing else 0.0
     u, v_string, v_bridge, v_delta = bowed_string.step(sp, ss, bridge, nut, v_bow, bowing)
-    if not faulted and (_bad(u) or _bad(v_string) or _bad(v_bridge)):
-        state[L_FAULT] = FAULT_STRING
-        state[L_FAULT_SAMPLE] = k
-        faulted = True
-    if faulted:
-        # keep the string finite: a poisoned string is reset to rest
-        if _bad(u) or _bad(v_bridge):
-            bridge[:] = 0.0
-            nut[:] = 0.0
-            ss[:] = 0.0
+    if _bad(u) or _bad(v_string) or _bad(v_bridge):
+        _fault(state, FAULT_STRING, k)
+        # a poisoned string is set back to rest so every output stays finite
+        bridge[:] = 0.0
+        nut[:] = 0.0
+        ss[:] = 0.0
         u = 0.0
         v_string = 0.0
         v_bridge = 0.0
+        v_delta = 0.0
+    if state[L_FAULT] != 0.0:
+        u = 0.0
     audio = 0.0
     if ctl[C_USE_AUDIO] != 0.0:
-        y = v_bridge
-        for j in range(body_sec.shape[0]):
-            y = _section(body_sec[j], body_s[j], y)
-        audio = y
+        audio = v_bridge
+        for j in range(body_s.shape[0] // 2):
+            audio = sensors.section_at(body_p, 5 * j, body_s, 2 * j, audio)
+    friction = u / ctl[C_PEAK]
+    stability.observe(mp, ms, friction)
     out[O_SOURCE_VELOCITY, k] = v_src
     out[O_STRING_VELOCITY, k] = v_string / ctl[C_SCALE]
     out[O_AUDIO, k] = audio
     out[O_V_DELTA, k] = v_delta
-    out[O_FRICTION, k] = u / ctl[C_PEAK]
-    out[O_STICK, k] = 1.0 if bowing and abs(v_delta) <= ss_breakaway(sp) else 0.0
-    if faulted:
-        return 0.0
+    out[O_FRICTION, k] = friction
+    out[O_STICK, k] = 1.0 if bowing and abs(v_delta) <= ctl[C_BREAKAWAY] else 0.0
     return -ctl[C_GAIN] * u * ctl[C_FORCE_SCALE]
 
 
-@njit(cache=True, inline="always")
-def ss_breakaway(sp):
-    return bow_edge() / sp[bowed_string.P_SLOPE] + abs(sp[bowed_string.P_OFFSET])
+@njit(cache=True)
+def observe_others(src, kinds, est_s, est_p, out, est_out):
+    """Advance every estimator but the source over the block, from the recorded sensor rows.
 
-
-@njit(cache=True, inline="always")
-def bow_edge():
-    return 0.98 ** -0.25 - 0.75
-
-
-@njit(cache=True, inline="always")
-def _section(p, s, x):
-    y = p[0] * x + s[0]
-    s[0] = p[1] * x - p[3] * y + s[1]
-    s[1] = p[2] * x - p[4] * y
-    return y
+    They only observe the stream, so stepping each over the whole block in turn
+    gives exactly the per-sample result (DESIGN.md, "Data flow").
+    """
+    n = out.shape[1]
+    for e in range(kinds.shape[0]):
+        if e == src:
+            continue
+        kind = kinds[e]
+        s = est_s[e]
+        p = est_p[e]
+        for k in range(n):
+            est_out[e, k] = step_guarded(kind, s, p, out[O_POSITION, k], out[O_ACCELERATION, k],
+                                         out[O_VELOCITY_LVT, k])
 
 
 @njit(cache=True)
 def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
-              body_sec, body_s, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
+              body_p, body_s, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
     """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
     n = target.shape[0]
     use_acc = ctl[C_USE_ACC] != 0.0
+    src = int(ctl[C_SOURCE])
     for k in range(n):
         x = ds[mechanics.DS_X]
         v = ds[mechanics.DS_V]
@@ -209,44 +205,52 @@ def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bri
         x_m = sensors.lvdt(snp, x, noise_x[k])
         v_m = sensors.lvt(snp, sns, v, noise_v[k])
         a_m = sensors.accelerometer(snp, sns, a, noise_a[k]) if use_acc else 0.0
-        if state[L_FAULT] == 0.0 and (_bad(x_m) or _bad(v_m) or _bad(a_m)):
-            state[L_FAULT] = FAULT_SENSOR
-            state[L_FAULT_SAMPLE] = k
-        f = control_step(ctl, state, k, kinds, est_s, est_p, est_out, sp, ss, bridge, nut,
-                         body_sec, body_s, x_m, a_m, v_m, v, out)
+        if _bad(x_m) or _bad(v_m) or _bad(a_m):
+            _fault(state, FAULT_SENSOR, k)
+        if src >= 0:
+            v_src = step_guarded(kinds[src], est_s[src], est_p[src], x_m, a_m, v_m)
+            est_out[src, k] = v_src
+        elif src == SOURCE_TRUE:
+            v_src = v
+        else:
+            v_src = v_m
+        f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp, ms, out)
         f = mechanics.clamp_force(dp, ds, f)
         f_hand = hand.force(hp, target[k], target_v[k], target_a[k], x, v, state[L_PUSH])
-        state[L_PUSH] = hand.learn_push(hp, state[L_PUSH], f)
-        if state[L_FAULT] == 0.0 and (_bad(f) or _bad(f_hand)):
-            state[L_FAULT] = FAULT_DEVICE
-            state[L_FAULT_SAMPLE] = k
+        if _bad(f) or _bad(f_hand):
+            _fault(state, FAULT_DEVICE, k)
         if state[L_FAULT] != 0.0:
             f = 0.0
-            if _bad(f_hand):
+            if _bad(f_hand) or _bad(state[L_PUSH]):
                 f_hand = 0.0
+                state[L_PUSH] = 0.0
+                ds[mechanics.DS_X] = 0.0
                 ds[mechanics.DS_V] = 0.0
-                if _bad(x):
-                    ds[mechanics.DS_X] = 0.0
+                ds[mechanics.DS_A] = 0.0
+        state[L_PUSH] = hand.learn_push(hp, state[L_PUSH], f)
         out[O_POSITION, k] = x_m
         out[O_VELOCITY_LVT, k] = v_m
         out[O_ACCELERATION, k] = a_m
         out[O_VELOCITY_TRUE, k] = v
         out[O_ACCELERATION_TRUE, k] = a
+        out[O_POSITION_TRUE, k] = x
         out[O_FORCE, k] = f
         out[O_HAND_FORCE, k] = f_hand
         mechanics.advance(dp, ds, f + f_hand)
+    observe_others(src, kinds, est_s, est_p, out, est_out)
 
 
 @njit(cache=True)
 def run_external_sample(ctl, state, k, dp, ds, kinds, est_s, est_p, sp, ss, bridge, nut,
-                        body_sec, body_s, x_m, a_m, v_m, out, est_out):
+                        body_p, body_s, mp, ms, x_m, a_m, v_m, out, est_out):
     """One sample for a device outside the simulation: returns the clamped force command."""
-    if state[L_FAULT] == 0.0 and (_bad(x_m) or _bad(v_m) or _bad(a_m)):
-        state[L_FAULT] = FAULT_SENSOR
-        state[L_FAULT_SAMPLE] = k
-    x_m = x_m if np.isfinite(x_m) else 0.0
-    f = control_step(ctl, state, k, kinds, est_s, est_p, est_out, sp, ss, bridge, nut,
-                     body_sec, body_s, x_m, a_m, v_m, np.nan, out)
+    if _bad(x_m) or _bad(v_m) or _bad(a_m):
+        _fault(state, FAULT_SENSOR, k)
+    for e in range(kinds.shape[0]):
+        est_out[e, k] = step_guarded(kinds[e], est_s[e], est_p[e], x_m, a_m, v_m)
+    src = int(ctl[C_SOURCE])
+    v_src = est_out[src, k] if src >= 0 else v_m
+    f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp, ms, out)
     f = mechanics.clamp_force(dp, ds, f)
     if state[L_FAULT] != 0.0 or _bad(f):
         f = 0.0
@@ -255,6 +259,7 @@ def run_external_sample(ctl, state, k, dp, ds, kinds, est_s, est_p, sp, ss, brid
     out[O_ACCELERATION, k] = a_m
     out[O_VELOCITY_TRUE, k] = np.nan
     out[O_ACCELERATION_TRUE, k] = np.nan
+    out[O_POSITION_TRUE, k] = np.nan
     out[O_FORCE, k] = f
     out[O_HAND_FORCE, k] = np.nan
     return f
@@ -295,6 +300,7 @@ class ClosedLoop:
         self._ctl = np.zeros(N_CONTROL)
         self._ctl[C_SCALE] = self.velocity_scale
         self._ctl[C_PEAK] = self.string.peak_friction()
+        self._ctl[C_BREAKAWAY] = bow_table.breakaway(self.string.slope, self.string.offset)
         self._ctl[C_FORCE_SCALE] = 1.0
         self._ctl[C_BOWING] = 1.0
         self._ctl[C_USE_ACC] = 1.0 if use_acc else 0.0
@@ -308,8 +314,8 @@ class ClosedLoop:
         self._sns = np.zeros(sensors.N_STATE)
         self._sp = self.string.params()
         self._ss, self._bridge, self._nut = self.string.new_state()
-        self._body = body.sections(self.rate) if config.audio else np.zeros((0, 5))
-        self._body_s = np.zeros((self._body.shape[0], 2))
+        self._body = body.sections(self.rate).ravel() if config.audio else np.zeros(0)
+        self._body_s = np.zeros(2 * (self._body.shape[0] // 5))
         seeds = np.random.SeedSequence(int(config.seed)).spawn(3)
         self._rng_x, self._rng_v, self._rng_a = (np.random.default_rng(s) for s in seeds)
         self._sample = 0
@@ -405,7 +411,7 @@ class ClosedLoop:
         result["t"] = (self._sample + np.arange(n)) / self.rate
         result["estimates"] = est
         self._sample += n
-        self.monitor.update(result)
+        self.monitor.judge()
         return result
 
     def _run_simulated(self, n, out, est):
@@ -415,7 +421,7 @@ class ClosedLoop:
         na = self._rng_a.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
         run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._snp, self._sns,
                   self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss,
-                  self._bridge, self._nut, self._body, self._body_s,
+                  self._bridge, self._nut, self._body, self._body_s, self.monitor.params, self.monitor.state,
                   np.ascontiguousarray(target), np.ascontiguousarray(target_v), np.ascontiguousarray(target_a),
                   nx, nv, na, out, est)
 
@@ -425,7 +431,8 @@ class ClosedLoop:
             x_m, a_m, v_m = dev.read_sensors()
             f = run_external_sample(self._ctl, self._state, k, self._dp, self._ds, self.bank.kinds,
                                     self.bank.states, self.bank.params, self._sp, self._ss, self._bridge,
-                                    self._nut, self._body, self._body_s, float(x_m), float(a_m), float(v_m),
+                                    self._nut, self._body, self._body_s, self.monitor.params, self.monitor.state,
+                                    float(x_m), float(a_m), float(v_m),
                                     out, est)
             dev.write_force(f)
 

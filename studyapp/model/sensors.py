@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from studyapp.estimators.biquad import butter_section, section_step
+from studyapp.estimators.biquad import butter_section
 from studyapp.estimators.spec import NYQUIST_FRACTION
 
 
@@ -96,12 +96,24 @@ def lvdt(p, x_true, noise):
 
 
 @njit(cache=True, inline="always")
+def section_at(p, i, s, j, x):
+    """A section with coefficients p[i:i+5] and state s[j:j+2] (transposed direct form II).
+
+    Indexing instead of slicing keeps the per-sample path free of array views.
+    """
+    y = p[i] * x + s[j]
+    s[j] = p[i + 1] * x - p[i + 3] * y + s[j + 1]
+    s[j + 1] = p[i + 2] * x - p[i + 4] * y
+    return y
+
+
+@njit(cache=True, inline="always")
 def lvt(p, s, v_true, noise):
     """One tachometer sample."""
-    return section_step(p[SP_LVT:SP_LVT + 5], s[SS_LVT:SS_LVT + 2], v_true) + p[SP_LVT_NOISE] * noise
+    return section_at(p, SP_LVT, s, SS_LVT, v_true) + p[SP_LVT_NOISE] * noise
 
 
 @njit(cache=True, inline="always")
 def accelerometer(p, s, a_true, noise):
     """One accelerometer sample."""
-    return section_step(p[SP_ACC:SP_ACC + 5], s[SS_ACC:SS_ACC + 2], a_true) + p[SP_ACC_BIAS] + p[SP_ACC_NOISE] * noise
+    return section_at(p, SP_ACC, s, SS_ACC, a_true) + p[SP_ACC_BIAS] + p[SP_ACC_NOISE] * noise

@@ -57,7 +57,10 @@ def simulate(fmax, rate=5000.0, duration=7.0, source="LVT", gesture="strokes", f
         if progress is not None:
             progress(done, total)
     columns = {name: np.concatenate(parts[name]) if parts[name] else np.zeros(0) for name in COLUMNS}
+    from studyapp import __version__
+
     meta = {
+        "version": __version__,
         "fmax": loop.fmax, "rate": loop.rate, "source": source, "gesture": gesture, "f0": float(f0),
         "seed": int(seed), "duration": total / loop.rate, "estimators": list(loop.names),
         "velocity_scale": loop.velocity_scale, "fault": loop.fault,

@@ -31,7 +31,9 @@ A self-sustained oscillation is large and steady: it saturates between about
 bowing, whose friction keeps one sign (level 0.1-0.2), and estimator noise,
 which the string's resonance filters into a narrow-band random force: its
 envelope fluctuates like a Rayleigh variable (cv 0.2-0.35 measured) even when
-its level is high. Noise so large that it saturates the bow table at any gain
+its level is high. An oscillation that starts is itself an envelope change:
+cv falls below CV_MAX about a second after the onset, so the verdict lags
+the onset by about that long (a participant also needs a moment). Noise so large that it saturates the bow table at any gain
 (BDIFF at 5 kHz) is steady too, and is judged broken: that string never
 sounds like a bowed string.
 
@@ -41,8 +43,13 @@ grows; it appears when the bow rests or moves slowly. Breakdown searches
 (``calibration.breakdown_fmax``) therefore hold the handle, with tremor.
 """
 
+import math
+
 import numpy as np
+from numba import njit
 from scipy import signal
+
+from studyapp.model.sensors import section_at
 
 WINDOW = 0.25  # s
 ENVELOPE = 0.012  # s
@@ -50,29 +57,62 @@ HIGHPASS_HZ = 40.0
 LEVEL_MIN = 0.3
 CV_MAX = 0.15
 
+# parameter vector: high-pass section (5), long and short smoothing factors
+MP_HP, MP_LONG, MP_SHORT = 0, 5, 6
+N_PARAMS = 7
+# state: high-pass (2), long mean of r^2, short mean of r^2, long mean of e, long mean of e^2
+MS_HP, MS_MS, MS_ENV_MS, MS_ENV_MEAN, MS_ENV_SQ = 0, 2, 3, 4, 5
+N_STATE = 6
 
-def _ema(x, alpha, last):
-    """Exponential mean y[k] = y[k-1] + alpha (x[k] - y[k-1]) from ``last``; returns (y, new last)."""
-    y, _ = signal.lfilter([alpha], [1.0, alpha - 1.0], x, zi=[(1.0 - alpha) * last])
-    return y, (float(y[-1]) if y.size else last)
+
+@njit(cache=True, inline="always")
+def observe(mp, ms, r):
+    """Advance the monitor by one sample of the friction ratio ``r`` (non-finite counts as 0)."""
+    if not np.isfinite(r):
+        r = 0.0
+    y = section_at(mp, MP_HP, ms, MS_HP, r)
+    sq = y * y
+    a = mp[MP_LONG]
+    ms[MS_MS] += a * (sq - ms[MS_MS])
+    ms[MS_ENV_MS] += mp[MP_SHORT] * (sq - ms[MS_ENV_MS])
+    e = math.sqrt(ms[MS_ENV_MS])
+    ms[MS_ENV_MEAN] += a * (e - ms[MS_ENV_MEAN])
+    ms[MS_ENV_SQ] += a * (e * e - ms[MS_ENV_SQ])
+
+
+@njit(cache=True)
+def observe_block(mp, ms, friction, level, cv):
+    """``observe`` over a block, writing the running level and cv per sample."""
+    for k in range(friction.shape[0]):
+        observe(mp, ms, friction[k])
+        level[k], cv[k] = verdict(ms)
+
+
+@njit(cache=True, inline="always")
+def verdict(ms):
+    """(level, cv) from the monitor's state."""
+    level = math.sqrt(max(ms[MS_MS], 0.0))
+    mean = ms[MS_ENV_MEAN]
+    if mean <= 0.0:
+        return level, 1.0
+    return level, math.sqrt(max(ms[MS_ENV_SQ] - mean * mean, 0.0)) / mean
 
 
 class StabilityMonitor:
-    """Updated by ``ClosedLoop.run`` with each block: ``.broken``, ``.score`` (= ``.level``), ``.cv``."""
+    """``.broken``, ``.score`` (= ``.level``), ``.cv``; the loop advances ``.state`` sample by sample."""
 
     def __init__(self, rate):
         self.rate = float(rate)
-        self._hp = signal.butter(2, min(HIGHPASS_HZ, 0.45 * rate), "high", fs=rate, output="sos")
-        self._a_long = 1.0 - np.exp(-1.0 / (WINDOW * rate))
-        self._a_short = 1.0 - np.exp(-1.0 / (ENVELOPE * rate))
+        hp = signal.butter(2, min(HIGHPASS_HZ, 0.45 * rate), "high", fs=rate, output="sos")[0]
+        self.params = np.zeros(N_PARAMS)
+        self.params[MP_HP:MP_HP + 5] = np.array([hp[0], hp[1], hp[2], hp[4], hp[5]]) / hp[3]
+        self.params[MP_LONG] = 1.0 - np.exp(-1.0 / (WINDOW * rate))
+        self.params[MP_SHORT] = 1.0 - np.exp(-1.0 / (ENVELOPE * rate))
+        self.state = np.zeros(N_STATE)
         self.reset()
 
     def reset(self):
-        self._hp_z = np.zeros((self._hp.shape[0], 2))
-        self._ms = 0.0  # long mean of r^2
-        self._env_ms = 0.0  # short mean of r^2
-        self._env_mean = 0.0  # long mean of e
-        self._env_sq = 0.0  # long mean of e^2
+        self.state[:] = 0.0
         self.level = 0.0
         self.cv = 1.0
         self.broken = False
@@ -81,25 +121,17 @@ class StabilityMonitor:
     def score(self):
         return self.level
 
-    def measure(self, friction):
-        """Per-sample (level, cv) for one block of the friction ratio F / F_max; advances the state."""
-        r = np.nan_to_num(np.asarray(friction, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
-        hf, self._hp_z = signal.sosfilt(self._hp, r, zi=self._hp_z)
-        sq = hf * hf
-        ms, self._ms = _ema(sq, self._a_long, self._ms)
-        env_ms, self._env_ms = _ema(sq, self._a_short, self._env_ms)
-        env = np.sqrt(np.maximum(env_ms, 0.0))
-        mean, self._env_mean = _ema(env, self._a_long, self._env_mean)
-        msq, self._env_sq = _ema(env * env, self._a_long, self._env_sq)
-        level = np.sqrt(np.maximum(ms, 0.0))
-        spread = np.sqrt(np.maximum(msq - mean * mean, 0.0))
-        cv = np.where(mean > 0.0, spread / np.maximum(mean, 1e-300), 1.0)
-        return level, cv
-
-    def update(self, block):
-        if block["friction"].shape[0] == 0:
-            return
-        level, cv = self.measure(block["friction"])
-        self.level = float(level[-1])
-        self.cv = float(cv[-1])
+    def judge(self):
+        """Update ``level``, ``cv`` and ``broken`` from the state (the loop calls this after each block)."""
+        self.level, self.cv = verdict(self.state)
         self.broken = bool(self.level > LEVEL_MIN and self.cv < CV_MAX)
+        return self.broken
+
+    def measure(self, friction):
+        """Feed a block of friction ratios (e.g. from a recording); returns per-sample (level, cv)."""
+        r = np.ascontiguousarray(friction, dtype=np.float64)
+        level = np.empty_like(r)
+        cv = np.empty_like(r)
+        observe_block(self.params, self.state, r, level, cv)
+        self.judge()
+        return level, cv
