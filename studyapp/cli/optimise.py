@@ -56,6 +56,12 @@ def run(args):
         raise UserError(f"-o {output}: expected a .toml file")
     if args.max_lag <= 0:
         raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
+    if args.patience < 1:
+        raise UserError(f"--patience {args.patience}: allowed is an integer of at least 1")
+    if args.max_sets is not None and args.max_sets < 1:
+        raise UserError(f"--max-sets {args.max_sets}: allowed is an integer of at least 1")
+    if args.workers is not None and args.workers < 1:
+        raise UserError(f"--workers {args.workers}: allowed is an integer of at least 1")
     names = estimator_names(args.estimators, PAPER_ESTIMATORS)
     paths = expand_paths(args.recordings)
     takes = load_takes(paths, args.reference)  # checks every file before any work starts
@@ -67,24 +73,26 @@ def run(args):
     if args.resume and not checkpoint.is_file():
         raise UserError(f"--resume: no checkpoint at {checkpoint}")
 
-    # Compile the fast loops once here: forked workers inherit them; spawned ones compile their own.
-    warm_up(names, rate, fast=True)
-    executor = make_executor(args.workers, args.scheduler, warm_up, (tuple(names), rate, True))
     fingerprint = {
         "recordings": [t.sha256 for t in takes], "reference": args.reference,
         "max_lag_s": args.max_lag, "tune": args.tune,
     }
     optimiser = Optimiser(
-        spaces, partial(raw_objectives_task, source), executor, patience=args.patience, seed=args.seed,
+        spaces, partial(raw_objectives_task, source), None, patience=args.patience, seed=args.seed,
         max_sets=args.max_sets, checkpoint=checkpoint, fingerprint=fingerprint,
         progress=None if args.quiet else Progress(sys.stderr),
     )
     if args.resume:
         optimiser.resume(checkpoint)
+    optimiser.executor = make_executor(args.workers, args.scheduler, warm_up, (tuple(names), rate, True))
     try:
+        if not args.scheduler:
+            # Compile the fast loops once here, before the first task starts the worker processes:
+            # forked workers inherit them (spawned ones run the initializer).
+            warm_up(names, rate, fast=True)
         result = optimiser.run()
     finally:
-        executor.shutdown(wait=True, cancel_futures=True)
+        optimiser.executor.shutdown(wait=True, cancel_futures=True)
     info = provenance(
         command="studyapp optimise", seed=args.seed, patience=args.patience, tune=args.tune,
         reference=args.reference, max_lag_s=args.max_lag, rate=rate, recordings=paths,

@@ -70,7 +70,8 @@ class Optimiser:
     """Tune several estimators together.
 
     ``spaces``: name -> ``Space``; ``objective(name, params) -> raw vector`` is a
-    picklable callable run by ``executor`` (an object with ``submit``).
+    picklable callable run by ``executor`` (an object with ``submit``; it may
+    be set later, before ``run``).
     ``tolerance`` is the least fall of F_g that counts as an improvement (the
     default, ``TOLERANCE`` per objective, is far below any difference that
     matters; without it, ever smaller gains from zooming in on a continuous
