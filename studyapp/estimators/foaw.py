@@ -27,19 +27,16 @@ incrementally as n grows), the least-squares slope per sample is
 
 and the test for interior j is |d_j + b_n j| <= d.
 
-Cost. Checking every interior sample of every window is O(N^2) per sample. A
-bound skips most of it: if R >= max_j |d_j + b_{n-1} j| over j = 1 .. n-2
-(the previous window's interior), then for the new slope
+Cost. Checked sample by sample, every window costs O(n) and a step O(N^2).
+But the test is linear in b: |d_j + b j| <= d for every interior j is
 
-    max_j |d_j + b_n j| <= R + |b_n - b_{n-1}| (n - 2)   over j = 1 .. n-2,
+    L_n = max_{1<=j<n} (-d - d_j) / j  <=  b_n  <=  min_{1<=j<n} (d - d_j) / j = U_n,
 
-so with the new interior sample j = n-1 checked directly, window n certainly
-passes while this bound is within the margin, at O(1) cost. Only when the
-bound exceeds the margin are the interior samples checked one by one (which
-also makes R exact again). The decision is the rule's own, not an
-approximation (it can differ from a sample-by-sample check only when a
-residual equals the margin to within rounding). Smooth or clean stretches cost O(N) per sample; noise right at
-the margin costs up to O(N^2).
+and growing the window adds one interior sample, j = n-1, so L_n and U_n are
+running extremes updated in O(1). A step is O(N) whatever the signal, and the
+search also stops once L_n > U_n (no later window can pass). The decision is
+the rule's own; it can differ from a sample-by-sample check only when a
+residual equals the margin to within rounding.
 
 ``foaw_core`` is the reusable compiled step; the hybrids KALFOAW and KALFOAWACC
 chain it twice, F(F(x)), the second time on velocity with a margin in m/s: the
@@ -49,8 +46,9 @@ Bad input: handled centrally by ``dispatch.step_guarded`` (a non-finite sample
 is replaced by the last finite one and counted), so the kernel only ever sees
 finite input.
 
-State (``foaw_state_size(N)`` = 3 + 2 (N + 1) slots):
-``[started, head, chosen n, ring of N+1 samples stored twice]``; slot
+State (``foaw_state_size(N)`` = 3 + 4 (N + 1) slots):
+``[started, head, chosen n, ring of N+1 samples stored twice, 1/j table, 6/(n(n+1)(n+2)) table]``
+(the tables are filled at the first sample); slot
 ``CHOSEN`` (= 2) holds the window n chosen at the last step. The ring is
 written at ``head`` and ``head + N + 1`` so that the samples of ages 0 .. N
 are contiguous from ``head`` (no modulo in the inner loop).
@@ -70,7 +68,7 @@ _RING = 3  # first slot of the ring
 @njit(cache=True)
 def foaw_state_size(window):
     """Number of state slots ``foaw_core`` needs for a largest window ``window`` (callable compiled or not)."""
-    return _RING + 2 * (int(window) + 1)
+    return _RING + 4 * (int(window) + 1)
 
 
 def build(rate, params):
@@ -84,10 +82,15 @@ def foaw_core(s, window, margin, rate, x):
     big = int(window)
     m = big + 1
     ring = s[_RING:_RING + 2 * m]
+    inv = s[_RING + 2 * m:_RING + 3 * m]  # 1 / j: the inner loop multiplies, never divides
+    fit = s[_RING + 3 * m:_RING + 4 * m]  # 6 / (n (n+1) (n+2))
     if s[0] == 0.0:
         s[0] = 1.0
         s[1] = 0.0
         ring[:] = x
+        for j in range(1, m):
+            inv[j] = 1.0 / j
+            fit[j] = 6.0 / (j * (j + 1.0) * (j + 2.0))
     head = int(s[1]) - 1
     if head < 0:
         head = m - 1
@@ -98,24 +101,20 @@ def foaw_core(s, window, margin, rate, x):
     s1 = 0.0
     best = 0.0
     chosen = 1
-    bound = 0.0  # >= max |d_j + best j| over the interior of the last window that passed
+    low = -np.inf  # L_n: the slope must be at least this for every interior sample to pass
+    high = np.inf  # U_n: ... and at most this
     for n in range(1, big + 1):
         d = ring[head + n] - x
         s0 += d
         s1 += n * d
-        b = 6.0 * (n * s0 - 2.0 * s1) / (n * (n + 1.0) * (n + 2.0))
+        b = (n * s0 - 2.0 * s1) * fit[n]
         if n > 1:
-            bound = max(bound + abs(b - best) * (n - 2), abs(ring[head + n - 1] - x + b * (n - 1)))
-            if bound > margin:
-                bound = 0.0
-                r = 0.0
-                for j in range(1, n):
-                    r = abs(ring[head + j] - x + b * j)
-                    if r > margin:
-                        break
-                    bound = max(bound, r)
-                if r > margin:
-                    break
+            j = n - 1
+            dj = ring[head + j] - x
+            low = max(low, (-margin - dj) * inv[j])
+            high = min(high, (margin - dj) * inv[j])
+            if b < low or b > high:
+                break
         best = b
         chosen = n
     s[CHOSEN] = chosen
