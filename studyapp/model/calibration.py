@@ -4,20 +4,23 @@ The issue asks for, at 5 kHz: Helmholtz motion with TRUE or LVT over most of
 the paper's F_max range and strokes inside +-11 mm; a stick-slip ripple that
 moves the handle by tens of micrometres; and LOWPASS breaking down at a lower
 F_max than LVT (paper Fig. 7: the tachometer reached about twice the range of
-any estimator). docs/model.md reports what the model does; in short:
+any estimator). docs/model.md reports what the model does, with figures.
 
-Two invariants decide most of it. (1) While the bow sticks the string acts
+Two invariants decide most of it. (1) While the bow sticks, the string acts
 on the handle like a damper B = 0.98 G s = F_max / v_break, where
 v_break = breakaway / s (m/s) is the handle speed at which a bow on a string
-at rest starts to slip. (2) The loop's breakdown F_max scales as
-M * v_break (M the moving mass), because the gain that matters is B / (M w).
-So only M * v_break and v_break itself are free: v_break sets the stroke
-speeds that give Helmholtz motion (about 0.12 to 1.2 v_break, from the bow
-table's Helmholtz range 0.01-0.1 string units at slope 3), and the strokes
-must fit +-11 mm, which caps v_break at a few tenths of m/s; M * v_break then
-places the breakdowns. The ripple at breakdown, 0.5 F_b / (M w0^2), is then
-fixed by v_break too: a few micrometres, below the LVDT noise (15 um RMS),
-not the "tens of micrometres" hoped for; see docs/model.md.
+at rest starts to slip. (2) The loop's breakdown F_max scales as M * v_break
+(M the moving mass): the gain that matters is B / (M w) near the string's
+resonance. So only v_break and M * v_break are free. v_break sets the stroke
+speeds that give Helmholtz motion (about 0.12-1.2 v_break: the bow table's
+Helmholtz range is 0.01-0.1 string units at slope 3), and strokes must fit
++-11 mm, which caps v_break at a few tenths of m/s; M * v_break then places
+the breakdowns (LVT near 10 N here). The stick-slip ripple of the handle,
+about 0.5 F / (M w0^2), is then small: about 1 um RMS (4-7 um peak to peak)
+at the paper's gains, below the LVDT noise (15 um RMS), not the "tens of
+micrometres" hoped for. A 10 times lighter handle gives 10 times the ripple
+but moves every breakdown 10 times lower (LVT near 1 N); the paper's two
+figures cannot both be had with strokes that fit the device.
 
 Constants (SI):
 

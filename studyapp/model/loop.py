@@ -4,8 +4,8 @@ One sample k of the loop:
 
     hand + device state x[k], v[k]        (device.py, hand.py)
     -> sensors: LVDT x_m, LVT v_m, accelerometer a_m    (sensors.py)
-    -> every active estimator steps on (x_m, a_m, v_m)  (studyapp.estimators.dispatch.step_guarded)
-    -> the source velocity: an estimator's output, the LVT sensor, or TRUE v[k]
+    -> the source velocity: the selected estimator stepped on (x_m, a_m, v_m)
+       (studyapp.estimators.dispatch.step_guarded), the LVT sensor, or TRUE v[k]
     -> bow: v_bow = s * v_source (string units; s = VELOCITY_SCALE, calibration.py)
     -> string step (bowed_string.py): u = rho(v_delta) v_delta
     -> force F[k] = -G u * force_scale, clamped to the motor limits (device.py)
@@ -15,11 +15,18 @@ so the position sampled at k+1 is the first to feel F[k] (one-step delay).
 G = F_max / max|rho(v) v| makes the peak friction force F_max (bow_table.py,
 paper eqs. 2 and 20).
 
+The other active estimators only observe the stream, so they are stepped
+after the block over its recorded sensor samples: exactly the per-sample
+result (a test checks it against the Bank's block form), without a dispatch
+per estimator per sample inside the loop, and every estimator is warm when
+the source switches at a block boundary.
+
+The stability monitor (stability.py) is advanced per sample inside the block.
 Python runs only at block boundaries: it draws the block's sensor noise from
 seeded generators (one per sensor, so the stream does not depend on how the
 run is cut into blocks), computes the gesture's target, applies setting
-changes (source, F_max, force scale, bowing, gesture) and updates the
-stability monitor. Everything inside a block is one ``@njit`` function.
+changes (source, F_max, force scale, bowing, gesture) and reads the
+monitor's verdict. Everything inside a block is one ``@njit`` function.
 
 Built only as needed: no accelerometer (filter, noise) when no active
 estimator reads acceleration (unless ``accelerometer=True``), and no body
