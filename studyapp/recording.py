@@ -5,8 +5,9 @@ metadata. On disk it is one of
 
 - ``.h5``  HDF5: one dataset per column, metadata as JSON in the root attribute ``meta``;
 - ``.npz`` NumPy: one array per column plus ``__meta__`` (JSON text);
-- ``.csv`` exchange: the columns ``COLUMNS`` in that order, one row per sample, with the
-  metadata as one leading comment line ``# {json}`` (pandas reads it with ``comment="#"``).
+- ``.csv`` exchange: a header with the columns ``COLUMNS`` in that order, then one row per
+  sample, nothing else (any CSV reader takes it as is). It carries no metadata: ``load``
+  recovers the rate from ``t``. A leading ``# {json}`` comment line is accepted on input.
 
 Units are SI: t (s), position (m), velocity_lvt, velocity_true, string_velocity (m/s),
 acceleration, acceleration_true (m/s^2), force (N, the force commanded on the handle),
@@ -103,7 +104,6 @@ def save(recording, path):
             raise InputDataError(f"{path}: a CSV recording needs the columns {', '.join(COLUMNS)}; missing {', '.join(missing)}")
         table = np.column_stack([recording.columns[c] for c in COLUMNS])
         with atomic_open(path, "w", newline="") as f:
-            f.write(f"# {meta}\n")
             f.write(",".join(COLUMNS) + "\n")
             np.savetxt(f, table, delimiter=",", fmt="%.17g")
 
@@ -127,7 +127,9 @@ def load(path):
         raise InputDataError(f"{path}: not a readable {suffix} recording ({type(exc).__name__}: {exc})") from None
     rate = meta.get("rate")
     if rate is None and "t" in columns and len(columns["t"]) > 1:
-        rate = 1.0 / float(np.median(np.diff(columns["t"])))
+        # t is k / rate printed to 17 digits: the rate comes back to within rounding
+        span = float(columns["t"][-1] - columns["t"][0])
+        rate = round((len(columns["t"]) - 1) / span, 6) if span > 0 else None
     if rate is None or not np.isfinite(float(rate)) or float(rate) <= 0:
         raise InputDataError(f"{path}: no valid sample rate (metadata 'rate' or a 't' column)")
     try:

@@ -48,12 +48,14 @@ def simulate(fmax, rate=5000.0, duration=7.0, source="LVT", gesture="strokes", f
     total = int(round(duration * loop.rate))
     parts = {name: [] for name in COLUMNS}
     done = 0
+    broken = False
     while done < total:
         n = min(BLOCK, total - done)
         block = loop.run(n)
         for name in COLUMNS:
             parts[name].append(block[name])
         done += n
+        broken = broken or loop.monitor.broken
         if progress is not None:
             progress(done, total)
     columns = {name: np.concatenate(parts[name]) if parts[name] else np.zeros(0) for name in COLUMNS}
@@ -64,7 +66,7 @@ def simulate(fmax, rate=5000.0, duration=7.0, source="LVT", gesture="strokes", f
         "fmax": loop.fmax, "rate": loop.rate, "source": source, "gesture": gesture, "f0": float(f0),
         "seed": int(seed), "duration": total / loop.rate, "estimators": list(loop.names),
         "velocity_scale": loop.velocity_scale, "fault": loop.fault,
-        "broken": bool(loop.monitor.broken),
+        "broken": bool(broken),  # the stability monitor flagged breakdown at some block
         "model": calibration.describe(),
     }
     return Recording(loop.rate, columns, meta)
