@@ -86,7 +86,7 @@ class LoopConfig:
     source: str = "LVT"
     fmax: float = 1.0
     gesture: str = "strokes"
-    f0: float = calibration.F0
+    f0: float | None = calibration.F0  # None: the default
     seed: int = 0
     audio: bool = True
     accelerometer: bool | None = None  # None: only when an active estimator reads it
@@ -285,7 +285,7 @@ class ClosedLoop:
         dev = device
         self.config = config
         self.rate = validate_rate(config.rate)
-        f0 = check_f0(config.f0)
+        f0 = check_f0(calibration.F0 if config.f0 is None else config.f0)
         estimators = config.estimators
         if not isinstance(estimators, dict):
             estimators = {name: {} for name in estimators}
@@ -384,10 +384,12 @@ class ClosedLoop:
         self._gesture.set(x_m)
 
     def reset_string(self):
+        """Put the string (and the body filter) at rest; the stability monitor starts afresh with it."""
         self._ss[:] = 0.0
         self._bridge[:] = 0.0
         self._nut[:] = 0.0
         self._body_s[:] = 0.0
+        self.monitor.reset()
 
     @property
     def fault(self):
