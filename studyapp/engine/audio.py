@@ -7,6 +7,7 @@ stores it. Choose one with ``open_sink(spec, haptic_rate)``::
     "device" | "device:NAME"   PortAudio output (sounddevice), NAME a substring of the device name
     "wav:FILE"                 16-bit mono WAV at 48 kHz, written atomically when the sink closes
     "null"                     nothing rendered at all
+    "discard"                  rendered and resampled, then dropped (what audio costs, for benchmarks)
 
 A device sink plays from a FIFO that the engine keeps filled ``lead`` seconds
 ahead; PortAudio's callback reads it. When the FIFO cannot fill a device
@@ -45,8 +46,8 @@ class AudioUnavailable(RuntimeError):
 def parse(spec):
     """``(kind, argument)`` of a sink spec; raises ``ParameterError`` naming ``--audio``."""
     spec = (spec or "null").strip()
-    if spec == "null":
-        return "null", None
+    if spec in ("null", "discard"):
+        return spec, None
     if spec == "device":
         return "device", None
     if spec.startswith("device:") and len(spec) > 7:
@@ -57,7 +58,7 @@ def parse(spec):
         if not os.path.isdir(folder):
             raise ParameterError(f"--audio {spec}: folder {folder} does not exist")
         return "wav", path
-    raise ParameterError(f"--audio {spec!r}: use device, device:NAME, wav:FILE or null")
+    raise ParameterError(f"--audio {spec!r}: use device, device:NAME, wav:FILE, null or discard")
 
 
 def load_sounddevice():
@@ -342,6 +343,8 @@ def open_sink(spec, haptic_rate, say=print, lead=0.03):
     kind, arg = parse(spec)
     if kind == "null":
         return Sink()
+    if kind == "discard":
+        return DiscardSink(haptic_rate)
     if kind == "wav":
         return WavSink(arg, haptic_rate)
     try:

@@ -17,7 +17,10 @@ rate R (period T = B / R):
 
 A block is a *deadline miss* when it finishes after its deadline: t0 + (k+1) T
 on the timer; on the audio clock, when the device had to play silence while
-the block was being made. The load of a block is its compute time over T.
+the block was being made. The load of a block is its compute time over T. A
+miss is an *overrun* when the block's own compute took longer than T; the
+other misses come from starting late (the OS woke the worker late, or an
+earlier block overran): the summary's ``wake_late_max`` says how late.
 
 The worker stops on a ``stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
@@ -123,6 +126,9 @@ class Worker:
         self.period = self.block / self.loop.rate
         self.realtime = _try_realtime() if config.realtime else False
         self.k = 0
+        self.loads = []  # every timed block's load, for the summary's percentiles
+        self.wake_late_max = 0.0  # the timer's worst wake-up delay: the OS's share of a miss
+        self.overruns = 0  # misses whose block alone took longer than its period
         self._rows = np.empty((len(self.channels), self.block))
         self._faults_seen = 0
         status.set(
@@ -268,6 +274,7 @@ class Worker:
                 now = time.monotonic()
                 if start_at > now:
                     time.sleep(start_at - now)
+                    self.wake_late_max = max(self.wake_late_max, time.monotonic() - start_at)
                 elif now - start_at > RESYNC:
                     t0, k0 = now, self.k
             started = time.monotonic()
@@ -278,10 +285,13 @@ class Worker:
             finished, compute = self.step(started)
             load = compute / self.period
             loads.append(load)
+            self.loads.append(load)
             late = self.sink.shortfalls > shortfalls if audio_clock else finished > deadline
             shortfalls = self.sink.shortfalls
             if late:
                 status.set(deadline_misses=status.get("deadline_misses") + 1)
+                if compute > self.period:
+                    self.overruns += 1
             new_faults = self.safety.faults[self._faults_seen:]
             for text in new_faults:
                 self.fault(text)
@@ -324,7 +334,11 @@ class Worker:
             "audio_underruns": self.sink.underruns, "audio_xruns": self.sink.xruns,
             "audio_frames": self.sink.frames_played, "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
             "command_latency_max": float(s.get("command_latency_max")),
-            "load_max": float(s.get("load_max")), "realtime": self.realtime,
+            "load_mean": float(np.mean(self.loads)) if self.loads else 0.0,
+            "load_p99": float(np.percentile(self.loads, 99)) if self.loads else 0.0,
+            "load_max": float(np.max(self.loads)) if self.loads else 0.0, "realtime": self.realtime,
+            "block": self.block, "paced": "audio" if self.sink.paced else "timer",
+            "wake_late_max": self.wake_late_max, "overruns": self.overruns,
         }
 
     def close(self):
