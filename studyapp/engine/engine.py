@@ -167,10 +167,18 @@ class Engine:
         self.send("learn", control)
 
     def clear_fault(self):
+        """Unlatch a safety fault in the worker; after a watchdog trip only a restart helps."""
+        if self.tripped:
+            raise EngineError("engine: the watchdog stopped this engine; start a new one")
         self.send("clear_fault")
 
     # reading ---------------------------------------------------------------
+    def _shared(self):
+        if self.status_block is None:
+            raise EngineError("engine: not running")
+
     def status(self):
+        self._shared()
         return self.status_block.read()
 
     def telemetry(self, n=None, since=None):
@@ -179,6 +187,7 @@ class Engine:
         ``n``: the newest n samples; ``since``: every sample from that sample
         number on (as far as the ring still holds them).
         """
+        self._shared()
         if since is not None:
             data, start, end = self.ring.read_since(since)
         else:
