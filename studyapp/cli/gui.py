@@ -1,0 +1,47 @@
+"""``studyapp gui``: the experimenter console (also what ``studyapp`` alone runs).
+
+    studyapp gui [--protocol FILE] [--participant ID] [--results DIR] [--resume]
+                 [--simulated-participant] [--start] [--seed N] [--audio SPEC] [--midi SPEC]
+                 [--participant-window] [--screenshot FILE] [--measure-scope SECONDS]
+
+``--screenshot FILE`` starts the console, lets it run, saves it as a PNG and
+exits; ``--measure-scope SECONDS`` prints the live scope's frame rate with
+every trace on and exits. See docs/gui.md.
+"""
+
+
+def register(sub):
+    parser = sub.add_parser("gui", help="the experimenter console (the default command)")
+    parser.add_argument("--protocol", metavar="FILE",
+                        help="study protocol (default: protocols/sinclair2014.toml, else the first in protocols/)")
+    parser.add_argument("--participant", metavar="ID", help="participant pseudonym to fill in")
+    parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
+    parser.add_argument("--resume", action="store_true", help="tick 'resume the unfinished session'")
+    parser.add_argument("--simulated-participant", action="store_true", help="a simulated participant plays")
+    parser.add_argument("--start", action="store_true", help="start the session at once (needs --participant)")
+    parser.add_argument("--seed", type=int, default=None, metavar="N", help="session seed (with --start)")
+    parser.add_argument("--audio", default="device", metavar="SPEC",
+                        help="device | device:NAME | wav:FILE | null (default: device, or no sound if none is found)")
+    parser.add_argument("--midi", default="first", metavar="SPEC",
+                        help="PORT | first | virtual | none (default: first, or the on-screen knobs if none is found)")
+    parser.add_argument("--participant-window", action="store_true", help="open the participant's window too")
+    parser.add_argument("--screenshot", metavar="FILE", help="save the running console as a PNG and exit")
+    parser.add_argument("--measure-scope", type=float, metavar="SECONDS",
+                        help="measure the scope's frame rate with every trace on for SECONDS, print it and exit")
+    parser.set_defaults(func=run)
+
+
+def run(args):
+    from studyapp.errors import UserError
+
+    if args.start and not args.participant:
+        raise UserError("--start: allowed only with --participant ID")
+    if args.measure_scope is not None and not 0.5 <= args.measure_scope <= 600:
+        raise UserError(f"--measure-scope {args.measure_scope:g}: allowed is 0.5 to 600 seconds")
+    if args.screenshot and not args.screenshot.lower().endswith(".png"):
+        raise UserError(f"--screenshot {args.screenshot}: allowed is a file name ending in .png")
+    try:
+        from studyapp.gui.app import main
+    except ImportError as exc:
+        raise UserError(f"the GUI cannot start: {exc} (install PySide6-Essentials and pyqtgraph)") from None
+    return main(args)

@@ -1,0 +1,85 @@
+"""The GUI application: Qt set-up, the console, and what the command line asked for.
+
+``main(args)`` builds the ``QApplication`` (or reuses one, e.g. under
+pytest-qt), the ``SessionController`` (audio and MIDI as asked, falling back
+to no sound and the on-screen knobs when nothing is found), and the console;
+loads the protocol (``--protocol``, else ``protocols/sinclair2014.toml`` or the
+first protocol in ``protocols/``); fills in the participant; starts the
+session at once with ``--start``; and runs the event loop. ``--screenshot`` and
+``--measure-scope`` run the console unattended and exit.
+"""
+
+import signal
+from pathlib import Path
+
+from PySide6.QtWidgets import QApplication
+
+from studyapp.errors import UserError
+from studyapp.gui.setup_panel import find_protocols
+
+DEFAULT_PROTOCOL = "protocols/sinclair2014.toml"
+
+
+def application():
+    """The process's ``QApplication`` (made once)."""
+    app = QApplication.instance()
+    if app is None:
+        app = QApplication(["studyapp"])
+        app.setApplicationName("studyapp")
+    return app
+
+
+def default_protocol():
+    if Path(DEFAULT_PROTOCOL).is_file():
+        return DEFAULT_PROTOCOL
+    found = find_protocols()
+    return found[0] if found else None
+
+
+def build(args):
+    """The controller and console for ``args`` (not yet shown); ``UserError`` for bad arguments."""
+    from studyapp.gui.console import Console
+    from studyapp.gui.session_controller import SessionController
+
+    application()
+    controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"))
+    console = Console(controller)
+    protocol = getattr(args, "protocol", None) or default_protocol()
+    if protocol is not None:
+        controller.load_protocol(protocol)
+        console.setup.select_protocol(protocol)
+    if getattr(args, "participant", None):
+        console.setup.participant.setText(args.participant)
+    console.setup.results.setText(str(getattr(args, "results", "results")))
+    console.setup.resume.setChecked(bool(getattr(args, "resume", False)))
+    console.setup.simulated.setChecked(bool(getattr(args, "simulated_participant", False)))
+    return controller, console
+
+
+def main(args):
+    """Run the console until it is closed; returns the exit code."""
+    app = application()
+    controller, console = build(args)
+    console.show()
+    if getattr(args, "participant_window", False):
+        console.show_participant.setChecked(True)
+    if getattr(args, "screenshot", None):
+        from studyapp.gui.screenshot import Screenshot
+
+        console.unattended = Screenshot(console, args.screenshot)
+    elif getattr(args, "measure_scope", None):
+        from studyapp.gui.scope_benchmark import ScopeBenchmark
+
+        console.unattended = ScopeBenchmark(console, args.measure_scope)
+    elif getattr(args, "start", False):
+        _start_when_possible(console, getattr(args, "seed", None))
+    # Ctrl-C in the terminal closes the console cleanly (Python sees signals between Qt events)
+    signal.signal(signal.SIGINT, lambda *_: console.close())
+    code = app.exec()
+    console.close()
+    return code
+
+
+def _start_when_possible(console, seed):
+    if console.start_session(seed=seed) is None:
+        raise UserError(console.setup.error.text())

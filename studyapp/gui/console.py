@@ -1,0 +1,375 @@
+"""The experimenter console: one window to set up, run, watch and stop a study session.
+
+Left: session set-up and the apparatus found, the session's buttons (Start,
+Pause/Resume, Abort, EMERGENCY STOP), and its progress (task, trial x of y,
+the current condition, which a tick hides for blinding). Right, in tabs: the
+live scope with the on-screen knobs and pads and the bowing pad; the
+analysis view (``AnalysisView``) of a results folder; the session's log.
+Bottom: the status bar (loop rate, load, deadline misses, audio underruns,
+faults, scope frame rate).
+
+Every widget is a view of the ``SessionController`` (no Qt in it): widgets
+call its methods, and its events update the widgets. A ``QTimer`` calls
+``controller.poll()`` every ``POLL_PERIOD``; the poll never waits, so the UI
+thread never blocks on the engine.
+"""
+
+from pathlib import Path
+
+from PySide6.QtCore import Qt, QTimer
+from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QMainWindow,
+    QPlainTextEdit,
+    QProgressBar,
+    QPushButton,
+    QSplitter,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from studyapp.errors import UserError
+from studyapp.gui.analysis_view import AnalysisView
+from studyapp.gui.bowing_pad import BowingPad
+from studyapp.gui.gui_thread import GuiThreadCaller
+from studyapp.gui.knobs import KnobPanel
+from studyapp.gui.participant_window import ParticipantWindow
+from studyapp.gui.scope import Scope
+from studyapp.gui.setup_panel import SetupPanel
+from studyapp.gui.simulated_session import SimulatedSession
+from studyapp.gui.status_bar import StatusBar
+
+POLL_PERIOD_MS = 10
+STOP_STYLE = ("QPushButton { background: #c00; color: white; font-weight: bold; font-size: 14pt; "
+              "padding: 10px; border-radius: 4px; } QPushButton:pressed { background: #800; }")
+LOG_LINES = 2000
+
+
+class Console(QMainWindow):
+    def __init__(self, controller, parent=None):
+        super().__init__(parent)
+        self.controller = controller
+        self.simulated = None
+        self.notices = {}
+        self.caller = GuiThreadCaller(self)
+        self.setWindowTitle("studyapp — experimenter console")
+
+        self.setup = SetupPanel()
+        self.setup.protocol_chosen.connect(self.choose_protocol)
+        self.start_button = QPushButton("Start session")
+        self.start_button.clicked.connect(self.start_session)
+        self.pause_button = QPushButton("Pause")
+        self.pause_button.clicked.connect(self._pause_or_resume)
+        self.abort_button = QPushButton("Abort")
+        self.abort_button.clicked.connect(self.abort_session)
+        self.stop_button = QPushButton("EMERGENCY STOP")
+        self.stop_button.setStyleSheet(STOP_STYLE)
+        self.stop_button.setToolTip("zero the force now (Esc)")
+        self.stop_button.clicked.connect(controller.emergency_stop)
+        stop_key = QAction("Emergency stop", self)
+        stop_key.setShortcut(QKeySequence(Qt.Key.Key_Escape))
+        stop_key.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
+        stop_key.triggered.connect(controller.emergency_stop)
+        self.addAction(stop_key)
+
+        self.state_label = QLabel("No session")
+        self.state_label.setStyleSheet("font-weight: bold;")
+        self.task_label = QLabel("")
+        self.trial_label = QLabel("")
+        self.progress_bar = QProgressBar()
+        self.progress_bar.setTextVisible(True)
+        self.condition_label = QLabel("")
+        self.condition_label.setWordWrap(True)
+        self.blind = QCheckBox("Hide the condition (blinding)")
+        self.blind.toggled.connect(self._blinding)
+        self.response_label = QLabel("")
+        self.response_label.setWordWrap(True)
+        self._condition_text = ""
+        self._captions = []
+
+        buttons = QHBoxLayout()
+        buttons.addWidget(self.start_button)
+        buttons.addWidget(self.pause_button)
+        buttons.addWidget(self.abort_button)
+        progress = QGroupBox("Progress")
+        p = QVBoxLayout(progress)
+        p.addWidget(self.state_label)
+        p.addWidget(self.task_label)
+        p.addWidget(self.trial_label)
+        p.addWidget(self.progress_bar)
+        p.addWidget(QLabel("Current condition:"))
+        p.addWidget(self.condition_label)
+        p.addWidget(self.blind)
+        p.addWidget(self.response_label)
+        left = QWidget()
+        lv = QVBoxLayout(left)
+        lv.addWidget(self.setup)
+        lv.addLayout(buttons)
+        lv.addWidget(self.stop_button)
+        lv.addWidget(progress)
+        lv.addStretch(1)
+        left.setMinimumWidth(340)
+        left.setMaximumWidth(440)
+
+        self.scope = Scope()
+        self.knobs = KnobPanel()
+        self.knobs.knob_turned.connect(controller.knob)
+        self.knobs.pad_pressed.connect(controller.pad)
+        self.bowing_pad = BowingPad()
+        self.bowing_pad.bow_pressed.connect(controller.bow_press)
+        self.bowing_pad.bow_moved.connect(controller.bow_move)
+        self.bowing_pad.bow_released.connect(controller.bow_release)
+        self.auto_bow = QPushButton("Auto strokes")
+        self.auto_bow.setCheckable(True)
+        self.auto_bow.setStyleSheet("QPushButton:checked { background: #bcd7f0; font-weight: bold; }")
+        self.auto_bow.setToolTip("the virtual hand bows with the protocol's scripted strokes")
+        self.auto_bow.toggled.connect(controller.set_auto_bowing)
+        knob_box = QGroupBox("Knobs and pads (mirror the MIDI controller)")
+        QVBoxLayout(knob_box).addWidget(self.knobs)
+        bow_box = QGroupBox("Bowing")
+        bv = QVBoxLayout(bow_box)
+        bv.addWidget(self.bowing_pad)
+        bv.addWidget(self.auto_bow)
+        controls = QHBoxLayout()
+        controls.addWidget(knob_box, 3)
+        controls.addWidget(bow_box, 1)
+        live = QWidget()
+        lv2 = QVBoxLayout(live)
+        lv2.addWidget(self.scope, 1)
+        lv2.addLayout(controls)
+
+        self.analysis = AnalysisView()
+        self.log = QPlainTextEdit()
+        self.log.setReadOnly(True)
+        self.log.setMaximumBlockCount(LOG_LINES)
+        self.tabs = QTabWidget()
+        self.tabs.addTab(live, "Live")
+        self.tabs.addTab(self.analysis, "Analysis")
+        self.tabs.addTab(self.log, "Log")
+
+        splitter = QSplitter()
+        splitter.addWidget(left)
+        splitter.addWidget(self.tabs)
+        splitter.setStretchFactor(1, 1)
+        self.setCentralWidget(splitter)
+        self.status = StatusBar()
+        self.setStatusBar(self.status)
+
+        self.participant_window = ParticipantWindow()
+        self.participant_window.knobs.knob_turned.connect(controller.knob)
+        self.participant_window.knobs.pad_pressed.connect(controller.pad)
+        self.show_participant = QAction("Participant window", self, checkable=True)
+        self.show_participant.toggled.connect(self.participant_window.setVisible)
+        analyse = QAction("Analyse the results folder", self)
+        analyse.triggered.connect(self.analyse_results)
+        view_menu = self.menuBar().addMenu("&View")
+        view_menu.addAction(self.show_participant)
+        view_menu.addAction(analyse)
+
+        e = controller.events
+        e.protocol.connect(self._on_protocol)
+        e.engine.connect(self._on_engine)
+        e.state.connect(self._on_state)
+        e.trial.connect(self._on_trial)
+        e.knob.connect(self._on_knob)
+        e.selection.connect(self._on_selection)
+        e.bowing.connect(self._on_bowing)
+        e.telemetry.connect(self._on_telemetry)
+        e.status.connect(self._on_status)
+        e.message.connect(self._on_message)
+        e.response.connect(self._on_response)
+
+        self.timer = QTimer(self)
+        self.timer.setInterval(POLL_PERIOD_MS)
+        self.timer.timeout.connect(self._tick)
+        self.timer.start()
+        self._on_state(state=controller.state, emergency=controller.emergency)
+        self.resize(1500, 940)
+
+    # actions --------------------------------------------------------------
+    def choose_protocol(self, path):
+        try:
+            self.controller.load_protocol(path)
+        except (UserError, RuntimeError) as exc:
+            self.setup.show_error(str(exc))
+            return False
+        self.setup.select_protocol(path)
+        self.setup.show_error("")
+        return True
+
+    def start_session(self, seed=None):
+        try:
+            session = self.controller.start_session(
+                self.setup.participant_id, self.setup.results_folder, resume=self.setup.resume.isChecked(),
+                seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"})
+        except (UserError, RuntimeError) as exc:
+            self.setup.show_error(str(exc))
+            return None
+        self.setup.show_error("")
+        if self.setup.simulated.isChecked():
+            self.simulated = SimulatedSession(self.controller, self, self.caller, session.seed).start()
+        return session
+
+    def abort_session(self):
+        self._stop_simulated()
+        self.controller.abort()
+
+    def _pause_or_resume(self):
+        c = self.controller
+        if c.emergency or c.state == "paused":
+            c.resume()
+        else:
+            c.pause()
+
+    def analyse_results(self):
+        self.tabs.setCurrentWidget(self.analysis)
+        self.analysis.load(self.setup.results_folder)
+
+    # the controls the simulated participant uses (on the GUI thread) --------------
+    def turn_knob(self, index, value):
+        self.knobs.turn(index, value)
+
+    def press_pad(self, index):
+        self.knobs.press(index)
+
+    def set_auto_bowing(self, on):
+        if self.auto_bow.isChecked() == bool(on):
+            self.controller.set_auto_bowing(on)
+        else:
+            self.auto_bow.setChecked(bool(on))
+
+    # the timer --------------------------------------------------------------
+    def _tick(self):
+        self.controller.poll()
+        self.status.show_frame_rate(self.scope.frame_rate())
+        sim = self.simulated
+        if sim is not None and sim.done:
+            if sim.error:
+                self._on_message(text=sim.error, level="fault")
+            self.simulated = None
+
+    # views of the controller's events --------------------------------------------
+    def _on_protocol(self, protocol):
+        self.participant_window.show_title(protocol.title)
+        self.setWindowTitle(f"studyapp — experimenter console — {protocol.title}")
+        self._captions = []
+        self.knobs.set_captions([])
+
+    def _on_engine(self, state, info, config):
+        if state == "starting":
+            self.notices = {}
+        self.setup.show_engine(state, info, config, self.notices)
+        self.status.show_engine(state, info)
+        if state == "running":
+            self.scope.set_scene(info["rate"], info["names"])
+        self._on_state(self.controller.state, self.controller.emergency)
+
+    def _on_state(self, state, emergency):
+        words = {"idle": "No session", "starting": "Starting the session's engine…", "running": "Running",
+                 "paused": "Paused", "finished": "Session complete", "aborted": "Session aborted"}
+        text = words[state]
+        if emergency:
+            text = "EMERGENCY STOP — force zeroed"
+        self.state_label.setText(text)
+        self.state_label.setStyleSheet("font-weight: bold;" + (" color: #c00;" if emergency else ""))
+        active = state in ("starting", "running", "paused")
+        self.start_button.setEnabled(not active and not emergency)
+        self.abort_button.setEnabled(active)
+        self.pause_button.setEnabled(state in ("running", "paused") or emergency)
+        self.pause_button.setText("Resume" if emergency or state == "paused" else "Pause")
+        self.setup.set_editable(not active)
+        accepting = self.controller.accepting and not emergency
+        self.knobs.setEnabled(accepting)
+        self.bowing_pad.setEnabled(accepting)
+        self.auto_bow.setEnabled(accepting)
+        self.participant_window.show_state(state, emergency)
+        if state in ("idle", "finished", "aborted"):
+            self.task_label.setText("")
+            self.knobs.set_captions([])
+            if state != "idle":
+                self.trial_label.setText(words[state])
+
+    def _on_trial(self, trial, step, total, instructions):
+        if trial.task == "rating":
+            self.task_label.setText(f"Task: rating of {len(trial.conditions)} conditions")
+            self._captions = list(trial.conditions)
+        else:
+            self.task_label.setText(f"Task: adjustment, repetition {trial.trial}")
+            self._captions = ["F_max" if i == self.controller.runner.task.knob_index else ""
+                              for i in range(len(self.knobs.dials))]
+        self.trial_label.setText(f"Trial {step + 1} of {total}")
+        self.progress_bar.setRange(0, total)
+        self.progress_bar.setValue(step)
+        self.participant_window.show_trial(step, total, instructions)
+        self._blinding(self.blind.isChecked())
+
+    def _on_knob(self, index, value):
+        self.knobs.show_knob(index, value)
+        self.participant_window.knobs.show_knob(index, value)
+
+    def _on_selection(self, source, fmax):
+        text = source or "none selected yet"
+        if fmax is not None:
+            text += f" at F_max = {fmax:.3g} N"
+        self._condition_text = text
+        self._blinding(self.blind.isChecked())
+
+    def _blinding(self, hidden):
+        self.condition_label.setText("hidden (blinding)" if hidden else self._condition_text)
+        if self.controller.runner is not None and self.controller.runner.trial is not None:
+            trial = self.controller.runner.trial
+            if trial.task == "rating":
+                self.knobs.set_captions([] if hidden else self._captions)
+            else:
+                self.knobs.set_captions(self._captions)
+
+    def _on_bowing(self, on):
+        self.auto_bow.blockSignals(True)
+        self.auto_bow.setChecked(bool(on) and not self.bowing_pad.bowing)
+        self.auto_bow.blockSignals(False)
+
+    def _on_telemetry(self, block):
+        self.scope.add(block)
+        if len(block["position"]):
+            self.bowing_pad.show_handle(block["position"][-1])
+
+    def _on_status(self, status, lost):
+        self.status.show_status(status, lost)
+
+    def _on_message(self, text, level):
+        for prefix in ("audio", "MIDI"):
+            if text.startswith(prefix + ":"):
+                self.notices[prefix] = text
+        colour = {"fault": "#c00", "notice": "#a60"}.get(level)
+        self.log.appendPlainText(("[fault] " if level == "fault" else "") + text)
+        if colour:
+            self.statusBar().showMessage(text, 8000)
+
+    def _on_response(self, response, step):
+        if response["task"] == "rating":
+            text = "Ratings recorded."
+        else:
+            text = f"Response recorded: F_max = {response['fmax']:.3g} N."
+        self.response_label.setText(text)
+        self.progress_bar.setValue(step + 1)
+
+    # closing ------------------------------------------------------------------
+    def _stop_simulated(self):
+        if self.simulated is not None:
+            self.simulated.stop()
+            self.simulated = None
+
+    def closeEvent(self, event):
+        self.timer.stop()
+        self._stop_simulated()
+        self.controller.close()
+        self.participant_window.close()
+        super().closeEvent(event)
+
+    def results_path(self):
+        return Path(self.setup.results_folder)

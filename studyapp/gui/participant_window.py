@@ -1,0 +1,62 @@
+"""The participant's window: the task's instructions, progress, and nothing that reveals the condition.
+
+Shown on a second screen (or not at all). It never names an estimator, a
+condition, F_max or a knob's meaning: only the study's title, the current
+task's instructions from the protocol, "trial x of y", and whether the session
+is paused. It carries its own on-screen knobs and pads (without captions) for
+a participant who has no MIDI controller; they act exactly like the
+console's.
+"""
+
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
+
+from studyapp.gui.knobs import KnobPanel
+
+MESSAGES = {
+    "idle": "Please wait: the session has not started yet.",
+    "starting": "Please wait: the session is starting.",
+    "paused": "Paused. Please wait for the experimenter.",
+    "finished": "Thank you! The session is complete.",
+    "aborted": "The session has been stopped. Thank you.",
+}
+
+
+class ParticipantWindow(QWidget):
+    def __init__(self, knobs=8, pads=8, parent=None):
+        super().__init__(parent, Qt.WindowType.Window)
+        self.setWindowTitle("Study")
+        self.title = QLabel("")
+        self.title.setStyleSheet("font-size: 20pt; font-weight: bold;")
+        self.progress = QLabel("")
+        self.progress.setStyleSheet("font-size: 14pt; color: #444;")
+        self.instructions = QLabel("")
+        self.instructions.setWordWrap(True)
+        self.instructions.setStyleSheet("font-size: 16pt;")
+        self.instructions.setAlignment(Qt.AlignmentFlag.AlignTop | Qt.AlignmentFlag.AlignLeft)
+        self.notice = QLabel(MESSAGES["idle"])
+        self.notice.setStyleSheet("font-size: 16pt; color: #a60;")
+        self.knobs = KnobPanel(knobs, pads)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.title)
+        layout.addWidget(self.progress)
+        layout.addWidget(self.instructions, 1)
+        layout.addWidget(self.notice)
+        layout.addWidget(self.knobs)
+        self.resize(900, 560)
+
+    def show_title(self, title):
+        self.title.setText(title)
+
+    def show_trial(self, step, total, instructions):
+        self.progress.setText(f"Trial {step + 1} of {total}")
+        self.instructions.setText(instructions)
+
+    def show_state(self, state, emergency=False):
+        if emergency:
+            self.notice.setText(MESSAGES["paused"])
+        else:
+            self.notice.setText(MESSAGES.get(state, ""))
+        if state in ("finished", "aborted", "idle"):
+            self.instructions.setText("")
+        self.knobs.setEnabled(state == "running" and not emergency)

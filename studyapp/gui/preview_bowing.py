@@ -1,0 +1,66 @@
+"""Bow the preview engine through the console's own controls, then act: for screenshots and benchmarks.
+
+When the engine runs and no session is in progress, ``PreviewBowing`` turns
+knob 1 (the preview's live F_max knob, ``studyapp.engine.commands``) to
+F_max = 1 N and presses "Auto strokes", as an experimenter checking the set-up
+would. Once the scope holds ``settle`` seconds of that, it calls ``ready()``
+(subclasses say what to do). If the engine fails, or nothing runs within
+``timeout`` seconds, it prints one line on stderr and exits the application
+with code 1.
+"""
+
+import sys
+import time
+
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QApplication
+
+from studyapp.engine.commands import fmax_to_knob
+from studyapp.experiment.fmax_knob import KNOB_MAX
+
+PREVIEW_FMAX = 1.0  # N, the rating task's F_max
+
+
+class PreviewBowing:
+    def __init__(self, console, settle=1.5, timeout=120.0, clock=time.monotonic):
+        self.console = console
+        self.settle = float(settle)
+        self.clock = clock
+        self.deadline = clock() + float(timeout)
+        self.bowing_since = None
+        self.timer = QTimer(console)
+        self.timer.setInterval(50)
+        self.timer.timeout.connect(self._check)
+        self.timer.start()
+
+    def fail(self, text):
+        self.timer.stop()
+        print(f"studyapp gui: error: {text}", file=sys.stderr)
+        QApplication.instance().exit(1)
+
+    def _check(self):
+        c = self.console.controller
+        host = c.host
+        state = host.state if host is not None else "not started (no protocol)"
+        if state == "failed":
+            self.fail(f"the engine failed: {host.error or 'its worker stopped'}")
+            return
+        if self.clock() > self.deadline:
+            self.fail(f"the engine is {state} after {self.deadline:g} s")
+            return
+        if state != "running" or not self.console.knobs.isEnabled():
+            return
+        if self.bowing_since is None:
+            if c.state not in ("starting", "running", "paused"):
+                self.console.turn_knob(0, round(fmax_to_knob(PREVIEW_FMAX) * KNOB_MAX))
+                self.console.set_auto_bowing(True)
+            self.bowing_since = self.clock()
+            return
+        enough = self.console.scope.samples >= self.settle * host.config.rate
+        if self.clock() - self.bowing_since < self.settle or not enough:
+            return
+        self.timer.stop()
+        self.ready()
+
+    def ready(self):
+        raise NotImplementedError

@@ -1,0 +1,161 @@
+"""Session set-up: who, which protocol, where results go, and what apparatus was found.
+
+The apparatus lines say what the engine really opened, in words: the device
+(the simulated 1-DOF device unless a driver is configured), the audio output
+(a PortAudio device, a WAV file, or none, and why: the engine's own notice
+when it fell back to the null sink) and the MIDI input (a port, or none and
+why, in which case the on-screen knobs are the controls).
+"""
+
+from pathlib import Path
+
+from PySide6.QtCore import Signal
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFileDialog,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+
+def find_protocols(folder="protocols"):
+    """The ``.toml`` files in ``folder`` (relative to the working folder), sorted."""
+    folder = Path(folder)
+    return sorted(str(p) for p in folder.glob("*.toml")) if folder.is_dir() else []
+
+
+class SetupPanel(QWidget):
+    protocol_chosen = Signal(str)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.participant = QLineEdit()
+        self.participant.setPlaceholderText("pseudonym, e.g. P07")
+        self.protocol = QComboBox()
+        self.protocol.setEditable(False)
+        self.protocol.setMinimumContentsLength(18)
+        for path in find_protocols():
+            self.protocol.addItem(path)
+        self.protocol.activated.connect(lambda index: self.protocol_chosen.emit(self.protocol.itemText(index)))
+        browse = QPushButton("…")
+        browse.setToolTip("choose a protocol file")
+        browse.setFixedWidth(28)
+        browse.clicked.connect(self._browse_protocol)
+        self.results = QLineEdit("results")
+        results_browse = QPushButton("…")
+        results_browse.setFixedWidth(28)
+        results_browse.setToolTip("choose the results folder")
+        results_browse.clicked.connect(self._browse_results)
+        self.resume = QCheckBox("Resume the participant's unfinished session")
+        self.simulated = QCheckBox("Simulated participant plays")
+        self.error = QLabel("")
+        self.error.setWordWrap(True)
+        self.error.setStyleSheet("color: #c00;")
+
+        protocol_row = QHBoxLayout()
+        protocol_row.addWidget(self.protocol, 1)
+        protocol_row.addWidget(browse)
+        results_row = QHBoxLayout()
+        results_row.addWidget(self.results, 1)
+        results_row.addWidget(results_browse)
+        session = QGroupBox("Session set-up")
+        form = QFormLayout(session)
+        form.addRow("Participant ID", self.participant)
+        form.addRow("Protocol", protocol_row)
+        form.addRow("Results", results_row)
+        form.addRow(self.resume)
+        form.addRow(self.simulated)
+        form.addRow(self.error)
+
+        self.device = QLabel("")
+        self.audio = QLabel("")
+        self.midi = QLabel("")
+        self.engine = QLabel("")
+        for label in (self.device, self.audio, self.midi, self.engine):
+            label.setWordWrap(True)
+        apparatus = QGroupBox("Apparatus")
+        found = QFormLayout(apparatus)
+        found.addRow("Device", self.device)
+        found.addRow("Audio", self.audio)
+        found.addRow("MIDI", self.midi)
+        found.addRow("Engine", self.engine)
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(session)
+        layout.addWidget(apparatus)
+
+    # what the user set ------------------------------------------------------
+    @property
+    def participant_id(self):
+        return self.participant.text().strip()
+
+    @property
+    def protocol_path(self):
+        return self.protocol.currentText()
+
+    @property
+    def results_folder(self):
+        return self.results.text().strip() or "results"
+
+    def select_protocol(self, path):
+        """Show ``path`` as the chosen protocol (adding it to the list)."""
+        index = self.protocol.findText(str(path))
+        if index < 0:
+            self.protocol.addItem(str(path))
+            index = self.protocol.count() - 1
+        self.protocol.setCurrentIndex(index)
+
+    def _browse_protocol(self):
+        path, _ = QFileDialog.getOpenFileName(self, "Choose a study protocol", "protocols", "Protocol (*.toml)")
+        if path:
+            self.select_protocol(path)
+            self.protocol_chosen.emit(path)
+
+    def _browse_results(self):
+        folder = QFileDialog.getExistingDirectory(self, "Choose the results folder", self.results_folder)
+        if folder:
+            self.results.setText(folder)
+
+    def set_editable(self, on):
+        for widget in (self.participant, self.protocol, self.results, self.resume, self.simulated):
+            widget.setEnabled(on)
+
+    def show_error(self, text):
+        self.error.setText(text)
+
+    # what the engine found ------------------------------------------------------
+    def show_engine(self, state, info, config, notices):
+        """Fill the apparatus lines from the engine's state, ``info`` (once running) and its notices."""
+        device = config.device if config is not None else None
+        self.device.setText(f"driver {device}" if device else "simulated 1-DOF device (no device driver configured)")
+        if state == "running":
+            audio = info.get("audio", "?")
+            self.audio.setText(_with_notice(_audio_words(audio), notices.get("audio")))
+            midi = info.get("midi", "none")
+            self.midi.setText(_with_notice(f"input {midi}" if midi != "none" else "no MIDI input: on-screen knobs",
+                                           notices.get("MIDI")))
+            self.engine.setText(f"{info['rate']:g} Hz, blocks of {info['block']}, paced by the {info['paced']}")
+        elif state == "starting":
+            for label in (self.audio, self.midi):
+                label.setText("looking…")
+            self.engine.setText("starting…")
+        else:
+            self.engine.setText(state)
+
+
+def _audio_words(description):
+    if description == "null":
+        return "no sound (null sink)"
+    return description
+
+
+def _with_notice(text, notice):
+    return f"{text}<br><span style='color:#a60'>{notice}</span>" if notice else text

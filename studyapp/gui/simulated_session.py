@@ -1,0 +1,140 @@
+"""The simulated participant plays a GUI session through the console's own controls. No Qt.
+
+``SimulatedParticipant.play(runner)`` (``studyapp.experiment``) is written
+against the session runner's methods and blocks while it bows (``advance``).
+In the GUI it runs on its own thread against ``ParticipantProxy``, which acts
+out every call on the GUI thread (``act`` runs a function there and waits for
+it) through the console's widgets: ``knob`` turns the on-screen knob, ``pad``
+clicks the on-screen pad, ``set_bowing`` toggles the auto-bowing button, just
+as a mouse would. The study logic stays in the runner, reached through the
+same slots a person's clicks reach.
+
+``advance(seconds)`` waits until the controller has fed that much of the
+engine's output (from the moment of the call) to the trial, then returns
+those samples from the telemetry ring: the participant hears exactly what the
+engine played. A paused session therefore pauses the participant too; an
+aborted or closed one ends it (``Stopped``). Trials are started by the
+controller as soon as the previous one has its response; ``start_trial``
+waits for the next one.
+"""
+
+import threading
+import time
+
+import numpy as np
+
+from studyapp.experiment.simulated_participant import SimulatedParticipant
+
+WAIT_STEP = 0.004  # s between looks at the controller's progress
+ACTIVE = ("starting", "running", "paused")
+
+
+class Stopped(Exception):
+    """The session ended, was aborted, or the console closed while the participant played."""
+
+
+class ParticipantProxy:
+    """The runner's interface for ``SimulatedParticipant.play``, acted out through the console."""
+
+    def __init__(self, controller, controls, act, stop):
+        self.controller = controller
+        self.controls = controls
+        self._act = act
+        self.stop = stop
+        self._seen = controller.trial_serial
+
+    def act(self, fn):
+        # a call still queued when the session stops must do nothing once it runs
+        return self._act(lambda: None if self.stop.is_set() else fn())
+
+    def _check(self):
+        if self.stop.is_set() or self.controller.state not in ACTIVE:
+            raise Stopped()
+
+    def _wait_running(self):
+        c = self.controller
+        while c.state != "running" or c.emergency or c.clearing:
+            self._check()
+            time.sleep(WAIT_STEP)
+
+    @property
+    def task(self):
+        return self.controller.runner.task
+
+    @property
+    def loop(self):
+        return self.controller.runner.loop
+
+    def start_trial(self):
+        c = self.controller
+        while True:
+            if c.state == "finished":
+                return None
+            self._check()
+            if c.state == "running" and not c.emergency and c.trial_serial > self._seen:
+                self._seen = c.trial_serial
+                return c.runner.trial
+            time.sleep(WAIT_STEP)
+
+    def knob(self, index, value):
+        self._wait_running()
+        self.act(lambda: self.controls.turn_knob(index, value))
+
+    def pad(self, index):
+        self._wait_running()
+        self.act(lambda: self.controls.press_pad(index))
+
+    def set_bowing(self, on):
+        self._wait_running()
+        self.act(lambda: self.controls.set_auto_bowing(on))
+
+    def set_gesture(self, name):
+        self._wait_running()
+        self.act(lambda: self.controller.set_gesture(name))
+
+    def advance(self, seconds):
+        self._wait_running()
+        engine = self.controller.engine
+        n = max(1, int(round(seconds * self.loop.rate)))
+        start = engine.ring.committed
+        while self.controller.fed < start + n:
+            self._check()
+            time.sleep(WAIT_STEP)
+        block = engine.telemetry(since=start)
+        return {key: value[:n] for key, value in block.items() if isinstance(value, np.ndarray)}
+
+
+class SimulatedSession:
+    """Runs ``SimulatedParticipant(seed).play`` on a thread; ``stop()`` ends it."""
+
+    def __init__(self, controller, controls, act, seed, **participant):
+        self.stop_event = threading.Event()
+        self.proxy = ParticipantProxy(controller, controls, act, self.stop_event)
+        self.participant = SimulatedParticipant(seed, **participant)
+        self.error = None
+        self.done = False
+        self._thread = threading.Thread(target=self._play, name="studyapp-simulated-participant", daemon=True)
+
+    def start(self):
+        self._thread.start()
+        return self
+
+    def _play(self):
+        try:
+            self.participant.play(self.proxy)
+        except Stopped:
+            pass
+        except Exception as exc:  # noqa: BLE001 - shown in the console, not lost on a thread
+            self.error = f"simulated participant: {type(exc).__name__}: {exc}"
+        finally:
+            self.done = True
+
+    @property
+    def alive(self):
+        return self._thread.is_alive()
+
+    def stop(self, timeout=0.0):
+        """End the play; wait up to ``timeout`` s (never on the GUI thread: the player may be waiting for it)."""
+        self.stop_event.set()
+        if timeout and self._thread.ident is not None:
+            self._thread.join(timeout)

@@ -1,0 +1,64 @@
+"""The console's status bar: is the real-time loop keeping up, and is it safe?
+
+From the engine's shared status block (``studyapp.engine.status``): the
+achieved loop rate against the nominal one, the load (compute time over the
+block period; mean and worst over the last second), deadline misses, audio
+underruns, faults (with the latest fault's text while one is latched), plus
+telemetry samples the GUI lost (it fell more than the ring behind) and the
+scope's painted frame rate. Trouble shows in red.
+"""
+
+from PySide6.QtWidgets import QLabel, QStatusBar
+
+RED = "color: #c00; font-weight: bold;"
+
+
+class StatusBar(QStatusBar):
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.labels = {}
+        for key, tip in (
+            ("engine", "the real-time engine"),
+            ("rate", "samples per second achieved over the last second / nominal haptic rate"),
+            ("load", "compute time per block over the block period: mean (worst) over the last second"),
+            ("misses", "blocks finished after their deadline"),
+            ("underruns", "audio device periods the engine did not fill in time"),
+            ("faults", "safety faults raised (the force is held at zero while one is latched)"),
+            ("lost", "telemetry samples the GUI read too late to see"),
+            ("fps", "scope frames painted per second"),
+        ):
+            label = QLabel("")
+            label.setToolTip(tip)
+            self.addPermanentWidget(label)
+            self.labels[key] = label
+        self.show_engine("stopped")
+
+    def show_engine(self, state, info=None):
+        info = info or {}
+        text = f"Engine: {state}"
+        if state == "running" and info:
+            text += f" ({info.get('paced', '?')}-paced{', real-time priority' if info.get('realtime') else ''})"
+        self.labels["engine"].setText(text)
+        self.labels["engine"].setStyleSheet(RED if state == "failed" else "")
+        if state != "running":
+            for key in ("rate", "load", "misses", "underruns"):
+                self.labels[key].setText("")
+
+    def show_status(self, status, lost=0):
+        s = status
+        self.labels["rate"].setText(f"Loop {s['achieved_rate']:,.0f} / {s['rate']:,.0f} Hz")
+        self.labels["load"].setText(f"Load {100 * s['load_mean']:.0f}% ({100 * s['load_max']:.0f}%)")
+        self.labels["load"].setStyleSheet(RED if s["load_max"] >= 1.0 else "")
+        self.labels["misses"].setText(f"Deadline misses {s['deadline_misses']}")
+        self.labels["misses"].setStyleSheet(RED if s["deadline_misses"] else "")
+        self.labels["underruns"].setText(f"Audio underruns {s['audio_underruns']}")
+        self.labels["underruns"].setStyleSheet(RED if s["audio_underruns"] else "")
+        faults = f"Faults {s['faults']}"
+        if s["fault_latched"]:
+            faults += f" — LATCHED: {s['fault'] or 'force disabled'}"
+        self.labels["faults"].setText(faults)
+        self.labels["faults"].setStyleSheet(RED if s["fault_latched"] else "")
+        self.labels["lost"].setText(f"Lost {lost}" if lost else "")
+
+    def show_frame_rate(self, fps):
+        self.labels["fps"].setText(f"Scope {fps:.0f} fps" if fps else "")
