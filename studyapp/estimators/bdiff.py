@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from studyapp.estimators import kinds
+from studyapp.estimators.history import fill
 from studyapp.estimators.spec import EstimatorSpec, Param
 
 
@@ -22,13 +23,13 @@ def build(rate, params):
     return np.array([float(z), float(z) * (1.0 / rate)]), 2 + z
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(s, p, x, a, v):
     z = int(p[0])
     ring = s[2:2 + z]
     if s[0] == 0.0:
         s[0] = 1.0
-        ring[:] = x
+        fill(ring, x)
     head = int(s[1])
     old = ring[head]
     ring[head] = x

@@ -56,7 +56,7 @@ def build_comp2(rate, params):
     return _build(rate, params["lpf_hz"], params["hpf_hz"])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(s, p, x, a, v):
     if s[0] == 0.0:
         s[0] = 1.0

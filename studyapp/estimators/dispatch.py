@@ -14,6 +14,15 @@ hold ``[last_x, last_a, last_v, bad_count]``; the kernel's own state follows.
 The block form ``run_block`` is the streaming form ``step_guarded`` in a
 compiled loop, so its output equals per-sample stepping exactly for any split
 of the input into blocks.
+
+Speed. Every kernel is inlined into the dispatch at numba's IR level
+(``inline="always"``) and compiled loops use ``error_model="numpy"`` (no
+Python ZeroDivisionError checks; parameters are validated up front, so a
+division by zero cannot occur). Measured on this project's machine: the
+out-of-line calls halved the cost of a pass-through estimator (90 -> 45 ns
+wall-clock under load), and an out-of-line kernel in an untaken branch added
+~20 ns per sample in an isolated test. A compiled loop that calls
+``step_guarded`` (the closed loop) should use ``error_model="numpy"`` too.
 """
 
 import numpy as np
@@ -26,7 +35,7 @@ from studyapp.estimators import (
 GUARD = 4
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def step_any(kind, s, p, x, a, v):
     """One step of the kernel ``kind`` (no input guard)."""
     if kind == kinds.BDIFF:
@@ -60,7 +69,7 @@ def step_any(kind, s, p, x, a, v):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def step_guarded(kind, s, p, x, a, v):
     """One step with the bad-input policy applied (the streaming form)."""
     bad = False
@@ -84,14 +93,14 @@ def step_guarded(kind, s, p, x, a, v):
     return step_any(kind, s[GUARD:], p, x, a, v)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_block(kind, s, p, xs, acc, vel, out):
     """The block form: ``out[i] = step_guarded(...)`` for every sample."""
     for i in range(xs.shape[0]):
         out[i] = step_guarded(kind, s, p, xs[i], acc[i], vel[i])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_bank(kind_ids, states, params, xs, acc, vel, out):
     """Advance every estimator of a bank over one block; row e of ``out`` is estimator e.
 

@@ -59,13 +59,14 @@ import numpy as np
 from numba import njit
 
 from studyapp.estimators import kinds
+from studyapp.estimators.history import fill
 from studyapp.estimators.spec import EstimatorSpec, Param
 
 CHOSEN = 2  # state slot holding the window n chosen at the last step
 _RING = 3  # first slot of the ring
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def foaw_state_size(window):
     """Number of state slots ``foaw_core`` needs for a largest window ``window`` (callable compiled or not)."""
     return _RING + 4 * (int(window) + 1)
@@ -76,7 +77,7 @@ def build(rate, params):
     return np.array([float(window), params["margin"], rate]), int(foaw_state_size(window))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def foaw_core(s, window, margin, rate, x):
     """One FOAW best-fit step on the state view ``s``; returns the slope in units of x per second."""
     big = int(window)
@@ -87,7 +88,7 @@ def foaw_core(s, window, margin, rate, x):
     if s[0] == 0.0:
         s[0] = 1.0
         s[1] = 0.0
-        ring[:] = x
+        fill(ring, x)
         for j in range(1, m):
             inv[j] = 1.0 / j
             fit[j] = 6.0 / (j * (j + 1.0) * (j + 2.0))
@@ -121,7 +122,7 @@ def foaw_core(s, window, margin, rate, x):
     return best * rate
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(s, p, x, a, v):
     return foaw_core(s, p[0], p[1], p[2], x)
 

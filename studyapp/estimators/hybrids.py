@@ -146,14 +146,14 @@ def _highpass(s, p, a):
     return section_step(p, s[_AFTER:_AFTER + STATE], a)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_kallev(s, p, x, a, v):
     z = _levant_twice(s[_AFTER:], p[_P:], x)
     s[Z_A] = z
     return kalman_step(s, p, x, z)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_kallevacc(s, p, x, a, v):
     h = _highpass(s, p[_P + 3:_P + 3 + SECTION], a)
     z = _levant_twice(s[_AFTER + STATE:], p[_P:], x) + h
@@ -161,14 +161,14 @@ def step_kallevacc(s, p, x, a, v):
     return kalman_step(s, p, x, z)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_kalfoaw(s, p, x, a, v):
     z = _foaw_twice(s[_AFTER:], p[_P:], x)
     s[Z_A] = z
     return kalman_step(s, p, x, z)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_kalfoawacc(s, p, x, a, v):
     h = _highpass(s, p[_P + 4:_P + 4 + SECTION], a)
     z = _foaw_twice(s[_AFTER + STATE:], p[_P:], x) + h

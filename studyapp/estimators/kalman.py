@@ -238,12 +238,12 @@ def kalman_step(s, p, x, a):
     return y1 * p[0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_kalman(s, p, x, a, v):
     return kalman_step(s, p, x, a)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_kalpos(s, p, x, a, v):
     if s[0] == 0.0:
         s[0] = 1.0

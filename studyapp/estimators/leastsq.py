@@ -23,6 +23,7 @@ from numba import njit
 
 from studyapp.errors import ParameterError
 from studyapp.estimators import kinds
+from studyapp.estimators.history import fill
 from studyapp.estimators.spec import EstimatorSpec, Param
 
 
@@ -48,13 +49,13 @@ def build(rate, params):
     return np.concatenate(([float(m)], taps(params["order"], m, rate))), 2 + m
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(s, p, x, a, v):
     m = int(p[0])
     ring = s[2:2 + m]
     if s[0] == 0.0:
         s[0] = 1.0
-        ring[:] = x
+        fill(ring, x)
     head = int(s[1])
     ring[head] = x
     acc = 0.0

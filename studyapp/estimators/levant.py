@@ -90,12 +90,12 @@ def levant_core(s, alpha, lam, period, x):
     return u
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_levant(s, p, x, a, v):
     return levant_core(s, p[0], p[1], p[2], x)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_levantlp(s, p, x, a, v):
     u = levant_core(s[0:LEVANT_STATE], p[0], p[1], p[2], x)
     return section_step(p[3:8], s[LEVANT_STATE:LEVANT_STATE + 2], u)

@@ -22,7 +22,7 @@ def build(rate, params):
     return np.concatenate(([rate], butter_section(params["cutoff_hz"], rate))), 4
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(s, p, x, a, v):
     if s[0] == 0.0:
         s[0] = 1.0

@@ -17,7 +17,7 @@ def build(rate, params):
     return np.zeros(1), 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(s, p, x, a, v):
     return v
 
