@@ -20,6 +20,7 @@ from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QCheckBox,
+    QComboBox,
     QGroupBox,
     QHBoxLayout,
     QLabel,
@@ -40,6 +41,7 @@ from studyapp.gui.gui_thread import GuiThreadCaller
 from studyapp.gui.knobs import KnobPanel
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.scope import Scope
+from studyapp.gui.session_controller import GESTURES
 from studyapp.gui.setup_panel import SetupPanel
 from studyapp.gui.simulated_session import SimulatedSession
 from studyapp.gui.status_bar import StatusBar
@@ -124,17 +126,25 @@ class Console(QMainWindow):
         self.bowing_pad.bow_pressed.connect(controller.bow_press)
         self.bowing_pad.bow_moved.connect(controller.bow_move)
         self.bowing_pad.bow_released.connect(controller.bow_release)
-        self.auto_bow = QPushButton("Auto strokes")
-        self.auto_bow.setCheckable(True)
-        self.auto_bow.setStyleSheet("QPushButton:checked { background: #bcd7f0; font-weight: bold; }")
-        self.auto_bow.setToolTip("the virtual hand bows with the protocol's scripted strokes")
-        self.auto_bow.toggled.connect(controller.set_auto_bowing)
+        self.gesture = QComboBox()
+        self.gesture.addItems(GESTURES)
+        self.gesture.setToolTip("the virtual hand: scripted strokes, holding the handle still, or the mouse (pad)")
+        self.gesture.activated.connect(lambda index: controller.set_gesture(self.gesture.itemText(index)))
+        self.bow_button = QPushButton("Bow")
+        self.bow_button.setCheckable(True)
+        self.bow_button.setStyleSheet("QPushButton:checked { background: #bcd7f0; font-weight: bold; }")
+        self.bow_button.setToolTip("put the bow on the string (the hand moves as the gesture says)")
+        self.bow_button.toggled.connect(controller.set_bowing)
         knob_box = QGroupBox("Knobs and pads (mirror the MIDI controller)")
         QVBoxLayout(knob_box).addWidget(self.knobs)
         bow_box = QGroupBox("Bowing")
         bv = QVBoxLayout(bow_box)
         bv.addWidget(self.bowing_pad)
-        bv.addWidget(self.auto_bow)
+        row = QHBoxLayout()
+        row.addWidget(QLabel("Hand"))
+        row.addWidget(self.gesture, 1)
+        row.addWidget(self.bow_button, 1)
+        bv.addLayout(row)
         controls = QHBoxLayout()
         controls.addWidget(knob_box, 3)
         controls.addWidget(bow_box, 1)
@@ -179,6 +189,7 @@ class Console(QMainWindow):
         e.knob.connect(self._on_knob)
         e.selection.connect(self._on_selection)
         e.bowing.connect(self._on_bowing)
+        e.gesture.connect(self._on_gesture)
         e.telemetry.connect(self._on_telemetry)
         e.status.connect(self._on_status)
         e.message.connect(self._on_message)
@@ -237,11 +248,16 @@ class Console(QMainWindow):
     def press_pad(self, index):
         self.knobs.press(index)
 
-    def set_auto_bowing(self, on):
-        if self.auto_bow.isChecked() == bool(on):
-            self.controller.set_auto_bowing(on)
+    def set_bowing(self, on):
+        if self.bow_button.isChecked() == bool(on):
+            self.controller.set_bowing(on)
         else:
-            self.auto_bow.setChecked(bool(on))
+            self.bow_button.setChecked(bool(on))
+
+    def set_gesture(self, name):
+        index = self.gesture.findText(name)
+        self.gesture.setCurrentIndex(index)
+        self.gesture.activated.emit(index)
 
     # the timer --------------------------------------------------------------
     def _tick(self):
@@ -250,7 +266,7 @@ class Console(QMainWindow):
         sim = self.simulated
         if sim is not None and sim.done:
             if sim.error:
-                self._on_message(text=sim.error, level="fault")
+                self.controller.message(sim.error, level="fault")
             self.simulated = None
 
     # views of the controller's events --------------------------------------------
@@ -286,7 +302,8 @@ class Console(QMainWindow):
         accepting = self.controller.accepting and not emergency
         self.knobs.setEnabled(accepting)
         self.bowing_pad.setEnabled(accepting)
-        self.auto_bow.setEnabled(accepting)
+        self.gesture.setEnabled(accepting)
+        self.bow_button.setEnabled(accepting)
         self.participant_window.show_state(state, emergency)
         if state in ("idle", "finished", "aborted"):
             self.task_label.setText("")
@@ -329,9 +346,12 @@ class Console(QMainWindow):
                 self.knobs.set_captions(self._captions)
 
     def _on_bowing(self, on):
-        self.auto_bow.blockSignals(True)
-        self.auto_bow.setChecked(bool(on) and not self.bowing_pad.bowing)
-        self.auto_bow.blockSignals(False)
+        self.bow_button.blockSignals(True)
+        self.bow_button.setChecked(bool(on))
+        self.bow_button.blockSignals(False)
+
+    def _on_gesture(self, name):
+        self.gesture.setCurrentIndex(self.gesture.findText(name))
 
     def _on_telemetry(self, block):
         self.scope.add(block)

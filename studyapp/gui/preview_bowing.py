@@ -2,8 +2,8 @@
 
 When the engine runs and no session is in progress, ``PreviewBowing`` turns
 knob 1 (the preview's live F_max knob, ``studyapp.engine.commands``) to
-F_max = 1 N and presses "Auto strokes", as an experimenter checking the set-up
-would. Once the scope holds ``settle`` seconds of that, it calls ``ready()``
+F_max = 1 N, picks the scripted strokes and presses "Bow", as an experimenter
+checking the set-up would. Once the scope holds ``settle`` seconds of that, it calls ``ready()``
 (subclasses say what to do). If the engine fails, or nothing runs within
 ``timeout`` seconds, it prints one line on stderr and exits the application
 with code 1.
@@ -53,7 +53,8 @@ class PreviewBowing:
         if self.bowing_since is None:
             if c.state not in ("starting", "running", "paused"):
                 self.console.turn_knob(0, round(fmax_to_knob(PREVIEW_FMAX) * KNOB_MAX))
-                self.console.set_auto_bowing(True)
+                self.console.set_gesture("strokes")
+                self.console.set_bowing(True)
             self.bowing_since = self.clock()
             return
         enough = self.console.scope.samples >= self.settle * host.config.rate

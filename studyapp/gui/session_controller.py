@@ -33,6 +33,10 @@ running session pauses. ``resume`` clears the fault and, once the engine
 reports it cleared, starts the current trial again from its beginning (as a
 resumed session does: an adjustment trial from F_max = 0), never back at the
 F_max that was in force.
+
+Engine failure: if the worker dies or hangs during a session (its watchdog
+zeroes the force), the session pauses and says so; ``resume`` starts a new
+engine and, once it runs, the current trial again from its beginning.
 """
 
 import time
@@ -48,6 +52,8 @@ from studyapp.gui.engine_loop import EngineLoop
 from studyapp.gui.evented import EventGroup
 
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
+ACTIVE = ("starting", "running", "paused")
+GESTURES = ("strokes", "hold", "live")  # what the console offers: scripted strokes, a held handle, the mouse
 
 
 def scene_conditions(protocol):
@@ -65,13 +71,15 @@ def instructions_for(protocol, task):
 
 
 class SessionController:
-    def __init__(self, audio="device", midi="first", device=None, realtime=True, clock=time.monotonic):
+    def __init__(self, audio="device", midi="first", device=None, realtime=True, hang_timeout=None,
+                 clock=time.monotonic):
         self.audio = audio
         self.midi = midi
         self.device = device
         self.realtime = realtime
+        self.hang_timeout = hang_timeout
         self.clock = clock
-        self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing",
+        self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing", "gesture",
                                  "telemetry", "status", "message", "response")
         self.protocol = None
         self.host = None
@@ -79,19 +87,19 @@ class SessionController:
         self.runner = None
         self.state = "idle"
         self.emergency = False
+        self.clearing = False  # an emergency stop is being cleared
+        self.restarting = False  # a new engine is starting after the session's engine failed
+        self.engine_lost = False  # the session's engine failed; resume restarts it
         self.fed = 0  # end (sample number) of the telemetry fed to the running trial
         self.trial_serial = 0  # counts trials started (restarts too), for the simulated participant
         self._engine_state = None
-        self.clearing = False
-        self._selection = None
         self._next_status = 0.0
-        self._knob_values = {}
 
     # protocol and engines ------------------------------------------------------
     def load_protocol(self, path):
         """Load and validate ``path`` (``UserError`` if invalid) and start its preview engine."""
-        if self.state in ("starting", "running", "paused"):
-            raise RuntimeError("a session is in progress: abort it before changing the protocol")
+        if self.state in ACTIVE:
+            raise UserError("a session is in progress: abort it before changing the protocol")
         protocol = load_protocol(path)
         self.protocol = protocol
         self.events.protocol.emit(protocol=protocol)
@@ -101,21 +109,24 @@ class SessionController:
     def _engine_config(self, seed):
         p = self.protocol
         names = scene_conditions(p)
-        return EngineConfig(rate=p.rate, estimators={n: p.estimator_params(n) for n in names}, source=names[0],
-                            fmax=0.0, gesture=p.gesture, seed=int(seed) % 2**32, audio=self.audio, midi=self.midi,
-                            actions={}, realtime=self.realtime, device=self.device)
+        config = EngineConfig(rate=p.rate, estimators={n: p.estimator_params(n) for n in names}, source=names[0],
+                              fmax=0.0, gesture=p.gesture, seed=int(seed) % 2**32, audio=self.audio, midi=self.midi,
+                              actions={}, realtime=self.realtime, device=self.device)
+        if self.hang_timeout is not None:
+            config.hang_timeout = float(self.hang_timeout)
+        return config
 
     def _replace_host(self, config, describe):
         old, self.host = self.host, EngineHost(config, describe).start()
         if old is not None:
             old.stop(wait=False)
         self.emergency = False
-        self._knob_values = {}
-        self._selection = None
+        self.clearing = False
         self._announce_engine()
 
     @property
     def engine(self):
+        """The running engine, or None (starting, failed or stopped)."""
         return self.host.engine if self.host is not None and self.host.running else None
 
     def _announce_engine(self):
@@ -124,14 +135,17 @@ class SessionController:
             self._engine_state = state
             info = self.host.engine.info if state == "running" else {}
             self.events.engine.emit(state=state, info=info, config=self.host.config if self.host else None)
+            if state == "running" and self.runner is None:
+                self.events.gesture.emit(name=self.protocol.gesture)
+                self.events.bowing.emit(on=False)
 
     # session ------------------------------------------------------------------
     def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None):
         """Open the participant's session (``UserError`` when refused) and start its engine."""
         if self.protocol is None:
-            raise RuntimeError("no protocol loaded")
-        if self.state in ("starting", "running", "paused"):
-            raise RuntimeError("a session is already in progress")
+            raise UserError("no protocol loaded: choose one first")
+        if self.state in ACTIVE:
+            raise UserError("a session is already in progress")
         if self.emergency:
             raise UserError("the emergency stop is set: clear it (Resume) before starting a session")
         check_participant(participant)
@@ -142,6 +156,7 @@ class SessionController:
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described)
         self.session = session
         self.runner = None
+        self.engine_lost = False
         self._set_state("starting")
         self._replace_host(self._engine_config(session.seed), f"session {session.folder}")
         self.message(f"session {session.folder}: {len(session.finished_steps())} of "
@@ -153,22 +168,27 @@ class SessionController:
         runner = SessionRunner(self.session, make_loop=self._make_loop, progress=self.message)
         self.runner = runner
         runner.begin()
-        info = self.host.engine.info
-        runner.log({"type": "engine", "rate": info["rate"], "block": info["block"], "audio": info["audio"],
-                    "midi": info["midi"], "paced": info["paced"], "realtime": info["realtime"],
-                    "seed": self.host.config.seed,
-                    "note": "one real-time engine per session: its seed, not the trials' loop_seed, seeds the noise"})
-        self.fed = self.host.position
+        self._log_engine()
         self._set_state("running")
         self._next_trial()
         if self.emergency:
             # the stop was pressed while the engine was starting: it holds for this engine too
             self.emergency_stop()
 
+    def _log_engine(self):
+        info = self.host.engine.info
+        self.runner.log({"type": "engine", "rate": info["rate"], "block": info["block"], "audio": info["audio"],
+                         "midi": info["midi"], "paced": info["paced"], "realtime": info["realtime"],
+                         "seed": self.host.config.seed,
+                         "note": "one real-time engine per session: its seed, not the trials' loop_seed, "
+                                 "seeds the sensor noise"})
+        self.fed = self.host.position
+
     def _make_loop(self, estimators, source, seed):
         return EngineLoop(self.host.engine, estimators, source, self.protocol.gesture)
 
     def _next_trial(self):
+        """Start the first trial without a response (the same one again after an interruption)."""
         trial = self.runner.start_trial()
         if trial is None:
             self._end("finished")
@@ -180,10 +200,11 @@ class SessionController:
         else:
             values = {task.knob_index: task.value}
         for index in range(self.protocol.knobs):
-            self._show_knob(index, values.get(index, 0))
+            self.events.knob.emit(index=index, value=int(values.get(index, 0)))
         self.events.trial.emit(trial=trial, step=trial.step, total=len(self.session.schedule),
                                instructions=instructions_for(self.protocol, trial.task))
         self._announce_selection()
+        self.events.gesture.emit(name=self.runner.gesture)
         self.events.bowing.emit(on=self.runner.bowing)
 
     def _end(self, how):
@@ -197,15 +218,15 @@ class SessionController:
             self.engine.set_bowing(False)
         self.runner = None
         self._set_state(how)
+        self.events.bowing.emit(on=False)
 
     def abort(self):
         """Stop the session now; it can be resumed later (``--resume``)."""
-        if self.state == "starting" and self.runner is None:
+        if self.state == "starting":
             self.session.close()
-            self.session = None
+            self.message(f"session aborted before it began: {self.session.folder}")
             self._set_state("aborted")
-            return
-        if self.state in ("running", "paused"):
+        elif self.state in ("running", "paused"):
             self.runner.log({"type": "abort"})
             self._end("aborted")
 
@@ -216,20 +237,25 @@ class SessionController:
             self._set_state("paused")
 
     def resume(self):
-        """Resume a paused session; after an emergency stop, clear it first (see module docstring)."""
+        """Resume a pause; clear an emergency stop; or restart a failed engine (module docstring)."""
         if self.emergency:
             engine = self.engine
             if engine is not None:
                 engine.status_block.force_enable = True
                 engine.clear_fault()
             self.emergency = False
-            self.clearing = True
+            self.clearing = engine is not None
             self.message("emergency stop cleared by the experimenter")
             if self.runner is not None:
                 self.runner.log({"type": "emergency_clear"})
             self._set_state(self.state)
-            return
-        if self.state == "paused":
+        elif self.engine_lost and self.state == "paused":
+            self.engine_lost = False
+            self.restarting = True
+            self._replace_host(self.host.config, self.host.describe)
+            self.message("starting a new engine; the trial starts again once it runs")
+            self._set_state(self.state)
+        elif self.state == "paused" and not self.clearing and not self.restarting:
             self.runner.log({"type": "resume"})
             self.runner.loop.hold(False)
             self._set_state("running")
@@ -243,21 +269,18 @@ class SessionController:
             engine.set_bowing(False)
         self.emergency = True
         self.clearing = False
-        if self.state in ("running", "paused"):
+        if self.state in ("running", "paused") and self.runner.loop is not None:
             self.runner.loop.hold(True)
             self.runner.log({"type": "emergency_stop"})
             self.state = "paused"
-        self.message("EMERGENCY STOP: force zeroed; press Resume to clear it")
+        self.message("EMERGENCY STOP: force zeroed; press Resume to clear it", level="fault")
         self._set_state(self.state)
+        self.events.bowing.emit(on=False)
 
-    def _finish_clearing(self, status):
-        if status["fault_latched"] or not self.engine.status_block.force_enable:
-            return
-        self.clearing = False
-        if self.state == "paused" and self.runner is not None:
-            self.runner.log({"type": "resume"})
-            self._set_state("running")
-            self._next_trial()
+    def _restart_trial(self):
+        self.runner.log({"type": "resume"})
+        self._set_state("running")
+        self._next_trial()
 
     def _set_state(self, state):
         self.state = state
@@ -265,18 +288,24 @@ class SessionController:
 
     # the participant's controls --------------------------------------------------
     @property
+    def playing(self):
+        """True while a trial takes the participant's actions (running, no stop being cleared, engine up)."""
+        return (self.state == "running" and not self.emergency and not self.clearing and not self.restarting
+                and self.engine is not None)
+
+    @property
     def accepting(self):
-        """True when knobs and pads act (a running trial, or live use outside a session)."""
-        return self.state == "running" or (self.state in ("idle", "finished", "aborted") and self.engine is not None)
+        """True when knobs, pads and the bow act: a trial is playing, or live use outside a session."""
+        live = self.state in ("idle", "finished", "aborted") and self.engine is not None and not self.emergency
+        return self.playing or live
 
     def knob(self, index, value):
         """Knob ``index`` (from 0) moved to ``value`` (0..127), from the screen or MIDI."""
         value = int(value)
         if not self.accepting:
             return
-        self._knob_values[index] = value
-        self._show_knob(index, value)
-        if self.state == "running":
+        self.events.knob.emit(index=index, value=value)
+        if self.playing:
             self._handle(self.runner.knob(index, value))
         else:
             self._live(f"knob{index + 1}", value / 127)
@@ -285,7 +314,7 @@ class SessionController:
         """Pad ``index`` (from 0) pressed."""
         if not self.accepting:
             return
-        if self.state == "running":
+        if self.playing:
             self._handle(self.runner.pad(index))
         else:
             self._live(f"pad{index + 1}", 1.0)
@@ -301,79 +330,60 @@ class SessionController:
             self._next_trial()
 
     def _live(self, control, value):
-        names = scene_conditions(self.protocol)
-        action = default_actions(names).get(control)
+        action = default_actions(scene_conditions(self.protocol)).get(control)
         command = action_command(action, value, self.clock()) if action else None
         if command is not None:
             self.engine.send(command[0], command[1])
-            if command[0] == "source":
-                self._selection = command[1]
-                self.events.selection.emit(source=command[1], fmax=None)
-
-    def _show_knob(self, index, value):
-        self.events.knob.emit(index=index, value=int(value))
 
     def _announce_selection(self):
         task = self.runner.task if self.runner is not None else None
-        if task is None:
-            return
-        self._selection = task.source
-        self.events.selection.emit(source=task.source, fmax=task.fmax)
+        if task is not None:
+            self.events.selection.emit(source=task.source, fmax=task.fmax)
 
     # bowing ----------------------------------------------------------------------
-    def _bowing_allowed(self):
-        return self.state == "running" or (self.state in ("idle", "finished", "aborted") and self.engine is not None)
-
-    def set_auto_bowing(self, on):
-        """Bow with the protocol's scripted gesture (True), or lift the bow (False)."""
-        if not self._bowing_allowed():
+    def set_bowing(self, on):
+        """Put the bow on the string (True) or lift it (False), with the hand's current gesture."""
+        if not self.accepting:
             return
-        if self.state == "running":
-            if on:
-                self.runner.set_gesture(self.protocol.gesture)
+        if self.playing:
             self.runner.set_bowing(on)
         else:
-            if on:
-                self.engine.set_gesture(self.protocol.gesture)
-            self.engine.set_bowing(on)
+            self.engine.set_bowing(bool(on))
         self.events.bowing.emit(on=bool(on))
 
     def set_gesture(self, name):
-        if self.state == "running":
+        """How the virtual hand moves the handle: ``strokes`` (scripted), ``hold``, or ``live`` (the mouse)."""
+        if name not in GESTURES:
+            raise UserError(f"gesture {name!r}: allowed are {', '.join(GESTURES)}")
+        if not self.accepting:
+            return
+        if self.playing:
             self.runner.set_gesture(name)
-        elif self.engine is not None:
+        else:
             self.engine.set_gesture(name)
+        self.events.gesture.emit(name=name)
 
     def bow_press(self, x_m):
         """The mouse took the bow at ``x_m`` (m): the virtual hand follows it and the bow touches."""
-        if not self._bowing_allowed():
+        if not self.accepting:
             return
-        if self.state == "running":
-            self.runner.set_gesture("live")
-            self.runner.loop.set_hand_target(x_m)
-            self.runner.set_bowing(True)
-        else:
-            self.engine.set_hand_target(x_m)
-            self.engine.set_bowing(True)
-        self.events.bowing.emit(on=True)
+        self.set_gesture("live")
+        self._hand_target(x_m)
+        self.set_bowing(True)
 
     def bow_move(self, x_m):
-        if not self._bowing_allowed():
-            return
-        if self.state == "running":
+        if self.accepting:
+            self._hand_target(x_m)
+
+    def bow_release(self):
+        self.set_bowing(False)
+
+    def _hand_target(self, x_m):
+        if self.playing:
             if self.runner.gesture == "live":
                 self.runner.loop.set_hand_target(x_m)
         else:
             self.engine.set_hand_target(x_m)
-
-    def bow_release(self):
-        if not self._bowing_allowed():
-            return
-        if self.state == "running":
-            self.runner.set_bowing(False)
-        else:
-            self.engine.set_bowing(False)
-        self.events.bowing.emit(on=False)
 
     # the timer ----------------------------------------------------------------------
     def poll(self):
@@ -384,17 +394,11 @@ class SessionController:
         for kind, text in host.drain():
             self.message(text, level="fault" if kind in ("fault", "error") else "notice")
         self._announce_engine()
-        if self.state == "starting":
-            if host.state == "running":
-                self._begin()
-            elif host.state == "failed":
-                self.session.close()
-                self.message(f"the engine did not start: {host.error}", level="fault")
-                self._set_state("aborted")
+        self._follow_engine(host)
         block = host.read()
         if block is not None:
             self.events.telemetry.emit(block=block)
-            if self.state == "running" and not self.emergency:
+            if self.playing:
                 self._feed(block)
         engine = self.engine
         if engine is None:
@@ -409,8 +413,35 @@ class SessionController:
                 self.events.status.emit(status=status, lost=host.lost)
                 if self.runner is None:
                     self.events.selection.emit(source=status["source"], fmax=status["fmax"])
-            if self.clearing:
-                self._finish_clearing(status)
+            if self.clearing and not status["fault_latched"] and engine.status_block.force_enable:
+                self.clearing = False
+                if self.state == "paused" and self.runner is not None:
+                    self._restart_trial()
+
+    def _follow_engine(self, host):
+        """Session transitions that wait for the engine: its start, its restart, its failure."""
+        if self.state == "starting":
+            if host.state == "running":
+                self._begin()
+            elif host.state == "failed":
+                self.session.close()
+                self.message(f"the engine did not start: {host.error}", level="fault")
+                self._set_state("aborted")
+        elif self.restarting:
+            if host.state == "running":
+                self.restarting = False
+                self._log_engine()
+                self._restart_trial()
+            elif host.state == "failed":
+                self.restarting = False
+                self.engine_lost = True
+                self.message(f"the new engine did not start either: {host.error}", level="fault")
+        elif self.state in ("running", "paused") and host.state == "failed" and not self.engine_lost:
+            self.engine_lost = True
+            self.runner.log({"type": "engine_failed", "faults": list(host.engine.faults) if host.engine else []})
+            self.message("the engine stopped (force is zero); the session is paused: press Resume to start "
+                         "a new engine and repeat the trial", level="fault")
+            self._set_state("paused")
 
     def _feed(self, block):
         n = block["end"] - block["start"]

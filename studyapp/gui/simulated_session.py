@@ -5,8 +5,8 @@ against the session runner's methods and blocks while it bows (``advance``).
 In the GUI it runs on its own thread against ``ParticipantProxy``, which acts
 out every call on the GUI thread (``act`` runs a function there and waits for
 it) through the console's widgets: ``knob`` turns the on-screen knob, ``pad``
-clicks the on-screen pad, ``set_bowing`` toggles the auto-bowing button, just
-as a mouse would. The study logic stays in the runner, reached through the
+clicks the on-screen pad, ``set_bowing`` toggles the Bow button and
+``set_gesture`` picks the hand's gesture, just as a mouse would. The study logic stays in the runner, reached through the
 same slots a person's clicks reach.
 
 ``advance(seconds)`` waits until the controller has fed that much of the
@@ -42,6 +42,8 @@ class ParticipantProxy:
         self._act = act
         self.stop = stop
         self._seen = controller.trial_serial
+        self._trial = None
+        self._given = {}
 
     def act(self, fn):
         # a call still queued when the session stops must do nothing once it runs
@@ -52,18 +54,25 @@ class ParticipantProxy:
             raise Stopped()
 
     def _wait_running(self):
-        c = self.controller
-        while c.state != "running" or c.emergency or c.clearing:
+        while not self.controller.playing:
             self._check()
             time.sleep(WAIT_STEP)
 
+    def _current(self, name):
+        # The controller starts the next trial as soon as this one has its response, so the
+        # participant's trial is the one it was given, unless that trial was restarted (same step).
+        runner = self.controller.runner
+        if runner is not None and runner.trial is not None and runner.trial.step == self._trial.step:
+            return getattr(runner, name)
+        return self._given[name]
+
     @property
     def task(self):
-        return self.controller.runner.task
+        return self._current("task")
 
     @property
     def loop(self):
-        return self.controller.runner.loop
+        return self._current("loop")
 
     def start_trial(self):
         c = self.controller
@@ -73,7 +82,10 @@ class ParticipantProxy:
             self._check()
             if c.state == "running" and not c.emergency and c.trial_serial > self._seen:
                 self._seen = c.trial_serial
-                return c.runner.trial
+                runner = c.runner
+                self._trial = runner.trial
+                self._given = {"task": runner.task, "loop": runner.loop}
+                return self._trial
             time.sleep(WAIT_STEP)
 
     def knob(self, index, value):
@@ -86,22 +98,26 @@ class ParticipantProxy:
 
     def set_bowing(self, on):
         self._wait_running()
-        self.act(lambda: self.controls.set_auto_bowing(on))
+        self.act(lambda: self.controls.set_bowing(on))
 
     def set_gesture(self, name):
         self._wait_running()
-        self.act(lambda: self.controller.set_gesture(name))
+        self.act(lambda: self.controls.set_gesture(name))
 
     def advance(self, seconds):
-        self._wait_running()
-        engine = self.controller.engine
         n = max(1, int(round(seconds * self.loop.rate)))
-        start = engine.ring.committed
-        while self.controller.fed < start + n:
-            self._check()
-            time.sleep(WAIT_STEP)
-        block = engine.telemetry(since=start)
-        return {key: value[:n] for key, value in block.items() if isinstance(value, np.ndarray)}
+        c = self.controller
+        while True:
+            self._wait_running()
+            engine = c.engine
+            start = engine.ring.committed
+            while c.engine is engine and c.fed < start + n:
+                self._check()
+                time.sleep(WAIT_STEP)
+            if c.engine is engine:
+                # (a new engine after a failure starts its sample count again: listen again then)
+                block = engine.telemetry(since=start)
+                return {key: value[:n] for key, value in block.items() if isinstance(value, np.ndarray)}
 
 
 class SimulatedSession:

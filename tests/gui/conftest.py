@@ -1,0 +1,62 @@
+"""Fixtures for the GUI tests (pytest-qt, offscreen).
+
+Qt must find the offscreen platform before anything imports it, so the
+environment is set here, at collection time. One console (with its preview
+engine) serves every test of the session: starting an engine costs seconds.
+Its watchdog allows 0.5 s without a heartbeat instead of 80 ms: the engine
+tests check the watchdog; here a machine shared with other test runs must not
+trip it (a tripped engine pauses the session, which a test would then wait on).
+"""
+
+import os
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import pytest  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+DEMO = ROOT / "protocols" / "demo.toml"
+ENGINE_START = 180.0  # s: generous; a cold numba cache on a loaded machine is slow
+
+
+def wait_until(app, predicate, timeout, step=0.01):
+    """Run the event loop until ``predicate()`` holds; fail after ``timeout`` s."""
+    end = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > end:
+            raise AssertionError(f"timed out after {timeout:g} s waiting for {predicate}")
+        app.processEvents()
+        time.sleep(step)
+
+
+@pytest.fixture(scope="session")
+def console(qapp):
+    from studyapp.gui.console import Console
+    from studyapp.gui.session_controller import SessionController
+
+    controller = SessionController(audio="device", midi="first", hang_timeout=0.5)
+    window = Console(controller)
+    window.resize(1400, 900)
+    window.show()
+    assert window.choose_protocol(str(DEMO))
+    wait_until(qapp, lambda: controller.engine is not None or controller.host.state == "failed", ENGINE_START)
+    assert controller.host.state == "running", controller.host.error
+    yield window
+    window.close()
+
+
+@pytest.fixture
+def idle_console(console, qapp):
+    """The shared console, its preview engine running, no session, no emergency stop, bow lifted."""
+    c = console.controller
+    if c.state in ("starting", "running", "paused"):
+        console.abort_session()
+    if c.emergency:
+        c.resume()
+    wait_until(qapp, lambda: c.engine is not None and not c.clearing, ENGINE_START)
+    console.set_bowing(False)
+    console.turn_knob(0, 0)
+    return console

@@ -1,0 +1,171 @@
+"""Whole sessions through the console's own controls (pytest-qt, offscreen); responses end up on disk."""
+
+import json
+from pathlib import Path
+
+import pytest
+from PySide6.QtCore import QPoint, Qt
+
+from studyapp.experiment.export import export_responses
+from studyapp.experiment.fmax_knob import fmax_from_knob
+from tests.gui.conftest import DEMO, ENGINE_START, wait_until
+
+pytest.importorskip("pytestqt")
+
+pytestmark = pytest.mark.gui
+
+SESSION_TIME = 300.0  # s: the demo's simulated participant bows ~30 s in real time; a loaded machine is slower
+
+
+def events_of(results):
+    (path,) = Path(results).glob("*/*/*/events.jsonl")
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def participant_texts(console):
+    w = console.participant_window
+    return " ".join(label.text() for label in (w.title, w.progress, w.instructions, w.notice))
+
+
+def test_simulated_participant_plays_the_demo_through_the_console(idle_console, qapp, qtbot, tmp_path):
+    console = idle_console
+    c = console.controller
+    turned, pressed, seen = [], [], []
+    console.knobs.knob_turned.connect(lambda i, v: turned.append((i, v)))
+    console.knobs.pad_pressed.connect(pressed.append)
+    c.events.trial.connect(lambda **kw: seen.append(participant_texts(console)))
+    c.events.response.connect(lambda **kw: seen.append(participant_texts(console)))
+    console.setup.participant.setText("SIM01")
+    console.setup.results.setText(str(tmp_path))
+    console.setup.simulated.setChecked(True)
+    qtbot.mouseClick(console.start_button, Qt.MouseButton.LeftButton)
+    assert c.state == "starting", console.setup.error.text()
+    wait_until(qapp, lambda: c.state in ("finished", "aborted"), ENGINE_START + SESSION_TIME)
+    assert c.state == "finished"
+    console.setup.simulated.setChecked(False)
+
+    rows = export_responses(tmp_path)
+    rating = rows[rows.task == "rating"]
+    adjustment = rows[rows.task == "adjustment"]
+    conditions = {"LOWPASS", "LEVANT", "LVT"}
+    assert set(rating.condition) == conditions and set(adjustment.condition) == conditions
+    assert sorted(rating.rating)[0] == 0.0 and sorted(rating.rating)[-1] == 1.0
+    assert (adjustment.fmax > 0).all() and (adjustment.fmax <= 40.0).all()
+    assert set(rows.participant) == {"SIM01"}
+
+    events = events_of(tmp_path)
+    assert events[-2]["type"] == "session_end" and events[-1]["type"] == "run_stop"
+    knob_events = [e for e in events if e["type"] == "knob"]
+    pad_events = [e for e in events if e["type"] == "pad"]
+    # every logged knob turn and pad press came through the on-screen controls
+    assert knob_events and len(knob_events) == len(turned)
+    assert [(e["index"], e["value"]) for e in knob_events] == turned
+    assert len(pad_events) == len(pressed) == 4
+    assert any(e["type"] == "gesture" and e["name"] == "hold" for e in events)  # picked in the console's combo
+    # the participant's window never named a condition
+    assert seen and all(name not in text for text in seen for name in conditions)
+    assert "Thank you" in console.participant_window.notice.text()
+
+
+PROTOCOL = """
+[study]
+name = "clicks"
+title = "Scripted clicks"
+tasks = ["rating", "adjustment"]
+seed = 3
+
+[apparatus]
+rate = 5000.0
+
+[rating]
+conditions = ["LVT", "LOWPASS"]
+fmax = 1.0
+instructions = "Rate the knobs."
+
+[adjustment]
+conditions = ["LVT"]
+trials = 1
+ceiling = 40.0
+decades = 2.0
+instructions = "Turn up until it breaks, then press the pad."
+"""
+
+
+def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp_path):
+    console = idle_console
+    c = console.controller
+    protocol = tmp_path / "clicks.toml"
+    protocol.write_text(PROTOCOL)
+    results = tmp_path / "results"
+    assert console.choose_protocol(str(protocol))
+    console.setup.participant.setText("P01")
+    console.setup.results.setText(str(results))
+    qtbot.mouseClick(console.start_button, Qt.MouseButton.LeftButton)
+    wait_until(qapp, lambda: c.playing, ENGINE_START)
+    assert console.trial_label.text() == "Trial 1 of 2"
+    assert console.participant_window.progress.text() == "Trial 1 of 2"
+    pads = console.knobs.pads
+
+    # rating: the confirm is refused until both knobs are rated
+    qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
+    assert "confirm refused" in console.log.toPlainText()
+    console.knobs.dials[0].setValue(110)
+    assert "at F_max = 1 N" in console.condition_label.text()
+    console.blind.setChecked(True)
+    assert console.condition_label.text() == "hidden (blinding)"
+    assert all(label.text() == "" for label in console.knobs.captions)
+    console.blind.setChecked(False)
+    # paused: the participant's knobs do nothing
+    qtbot.mouseClick(console.pause_button, Qt.MouseButton.LeftButton)
+    assert c.state == "paused" and not console.knobs.isEnabled()
+    c.knob(1, 77)
+    qtbot.mouseClick(console.pause_button, Qt.MouseButton.LeftButton)
+    assert c.state == "running"
+    console.knobs.dials[1].setValue(15)
+    # bow with the mouse on the bowing pad
+    pad = console.bowing_pad
+    y = pad.height() // 2
+    qtbot.mousePress(pad, Qt.MouseButton.LeftButton, pos=QPoint(pad.width() // 3, y))
+    for x in range(pad.width() // 3, 2 * pad.width() // 3, 10):
+        qtbot.mouseMove(pad, QPoint(x, y))
+    qtbot.mouseRelease(pad, Qt.MouseButton.LeftButton, pos=QPoint(2 * pad.width() // 3, y))
+    qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
+    wait_until(qapp, lambda: console.trial_label.text() == "Trial 2 of 2", 10)
+
+    # adjustment: up to knob 60, emergency stop, the trial starts again from 0
+    dial = console.knobs.dials[0]
+    assert dial.value() == 0 and console.knobs.captions[0].text() == "F_max"
+    dial.setValue(60)
+    qtbot.mouseClick(console.stop_button, Qt.MouseButton.LeftButton)
+    assert c.state == "paused" and c.emergency
+    qtbot.mouseClick(console.pause_button, Qt.MouseButton.LeftButton)
+    wait_until(qapp, lambda: c.playing, 10)
+    assert dial.value() == 0
+    dial.setValue(30)
+    qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
+    wait_until(qapp, lambda: c.state == "finished", 10)
+
+    rows = export_responses(results)
+    rating = rows[rows.task == "rating"].set_index("condition")
+    session = json.loads(next(results.glob("*/*/*/session.json")).read_text())
+    first, second = session["schedule"][0]["conditions"]  # knob 1 plays the first, knob 2 the second
+    assert {first, second} == {"LVT", "LOWPASS"}
+    assert rating.loc[first, "value"] == 110 and rating.loc[second, "value"] == 15
+    assert rating.loc[first, "rating"] == 0.0 and rating.loc[second, "rating"] == 1.0
+    (fmax,) = rows[rows.task == "adjustment"].fmax
+    assert fmax == pytest.approx(fmax_from_knob(30, 40.0, 2.0))
+
+    events = events_of(results)
+    types = [e["type"] for e in events]
+    assert types.count("response") == 2
+    assert "pause" in types and "resume" in types and "emergency_stop" in types and "emergency_clear" in types
+    assert not any(e["type"] == "knob" and e["value"] == 77 for e in events)  # ignored while paused
+    assert any(e["type"] == "gesture" and e["name"] == "live" for e in events)  # the mouse took the bow
+    assert [e["on"] for e in events if e["type"] == "bowing"][:2] == [True, False]
+    restarts = [e for e in events if e["type"] == "trial_start" and e["task"] == "adjustment"]
+    assert [e["restart"] for e in restarts] == [False, True]
+    adjust_knobs = [e["value"] for e in events if e["type"] == "knob" and e["task"] == "adjustment"]
+    assert adjust_knobs[0] == 60 and adjust_knobs[-1] == 30
+
+    assert console.choose_protocol(str(DEMO))
+    wait_until(qapp, lambda: c.engine is not None, ENGINE_START)
