@@ -1,0 +1,65 @@
+"""``studyapp gui --screenshot FILE`` on a real X server (Xvfb) with Qt's xcb platform: a real picture of the console.
+
+Xvfb picks a free display itself (``-displayfd``), so parallel runs never meet.
+It comes from the Debian package ``xvfb`` (scripts/system-deps.txt), with the
+X libraries Qt's xcb plugin loads.
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tests.gui.conftest import DEMO, ROOT
+
+pytestmark = pytest.mark.gui
+
+
+@pytest.fixture(scope="module")
+def xvfb_display():
+    xvfb = shutil.which("Xvfb")
+    if xvfb is None:
+        pytest.skip("Xvfb not installed (Debian xvfb, listed in scripts/system-deps.txt)")
+    read, write = os.pipe()
+    proc = subprocess.Popen([xvfb, "-displayfd", str(write), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
+                            pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(write)
+    try:
+        with os.fdopen(read) as f:
+            number = f.readline().strip()
+        if not number.isdigit():
+            pytest.fail(f"Xvfb did not report a display (exit code {proc.poll()})")
+        yield f":{number}"
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def test_screenshot_of_the_running_console(xvfb_display, tmp_path):
+    from matplotlib.image import imread
+
+    path = tmp_path / "console.png"
+    env = {**os.environ, "QT_QPA_PLATFORM": "xcb", "DISPLAY": xvfb_display}
+    done = subprocess.run(
+        [sys.executable, "-m", "studyapp", "gui", "--protocol", str(DEMO), "--screenshot", str(path),
+         "--audio", "null", "--midi", "none", "--results", str(tmp_path / "results")],
+        cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == str(path)
+    image = imread(path)[:, :, :3]
+    height, width = image.shape[:2]
+    assert width >= 1200 and height >= 800
+    pixels = (image.reshape(-1, 3) * 255).round().astype(np.uint8)
+    assert len(np.unique(pixels, axis=0)) > 200  # text, plots and widgets, not a blank frame
+    stop_red = np.all(pixels == (204, 0, 0), axis=1)
+    assert stop_red.mean() > 0.005  # the EMERGENCY STOP button is there
+    force_orange = np.all(np.abs(pixels.astype(int) - (255, 127, 14)) <= 1, axis=1)
+    assert force_orange.sum() > 500  # the scope drew the force of the bowing
+    assert not (tmp_path / "results").exists()  # a screenshot runs no session
