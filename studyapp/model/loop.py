@@ -32,6 +32,9 @@ Built only as needed: no accelerometer (filter, noise) when no active
 estimator reads acceleration (unless ``accelerometer=True``), and no body
 filter when ``audio=False``.
 
+Compiled with numpy's error model (as the estimator dispatch is): a division
+by zero gives inf, not an exception, and inf is caught as a fault below.
+
 Safety: a non-finite value anywhere (sensor, estimate, string, device) latches
 ``fault`` (a one-line description); from that sample on the force is 0 and the
 bow is lifted.
@@ -179,7 +182,7 @@ def bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp,
     return -ctl[C_GAIN] * u * ctl[C_FORCE_SCALE]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def observe_others(src, kinds, est_s, est_p, out, est_out):
     """Advance every estimator but the source over the block, from the recorded sensor rows.
 
@@ -198,7 +201,7 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
                                          out[O_VELOCITY_LVT, k])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
               body_p, body_s, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
     """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
@@ -247,7 +250,7 @@ def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bri
     observe_others(src, kinds, est_s, est_p, out, est_out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_external_sample(ctl, state, k, dp, ds, kinds, est_s, est_p, sp, ss, bridge, nut,
                         body_p, body_s, mp, ms, x_m, a_m, v_m, out, est_out):
     """One sample for a device outside the simulation: returns the clamped force command."""
