@@ -18,7 +18,7 @@ $(STAMP): pyproject.toml scripts/system-deps.txt
 setup: $(STAMP)
 
 run: $(STAMP)
-	$(VENV)/bin/studyapp demo
+	$(VENV)/bin/studyapp gui
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -14,8 +14,6 @@ call its methods, and its events update the widgets. A ``QTimer`` calls
 thread never blocks on the engine.
 """
 
-from pathlib import Path
-
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
@@ -119,6 +117,7 @@ class Console(QMainWindow):
         left.setMaximumWidth(440)
 
         self.scope = Scope()
+        self.scope.saved.connect(lambda path: controller.message(f"scope saved to {path}"))
         self.knobs = KnobPanel()
         self.knobs.knob_turned.connect(controller.knob)
         self.knobs.pad_pressed.connect(controller.pad)
@@ -390,6 +389,3 @@ class Console(QMainWindow):
         self.controller.close()
         self.participant_window.close()
         super().closeEvent(event)
-
-    def results_path(self):
-        return Path(self.setup.results_folder)

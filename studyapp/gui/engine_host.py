@@ -80,9 +80,6 @@ class EngineHost:
         self.position = block["end"]
         return block if block["end"] > block["start"] else None
 
-    def status(self):
-        return self.engine.status() if self.running else None
-
     def drain(self):
         """Every ``(kind, text)`` message since the last call: ``notice``, ``fault`` or ``error``."""
         out = []

@@ -35,9 +35,5 @@ class EventGroup:
     """A model's events as attributes: ``group.<name>`` is an ``Event``."""
 
     def __init__(self, *names):
-        self._names = names
         for name in names:
             setattr(self, name, Event(name))
-
-    def __iter__(self):
-        return (getattr(self, name) for name in self._names)

@@ -145,10 +145,6 @@ class SimulatedSession:
         finally:
             self.done = True
 
-    @property
-    def alive(self):
-        return self._thread.is_alive()
-
     def stop(self, timeout=0.0):
         """End the play; wait up to ``timeout`` s (never on the GUI thread: the player may be waiting for it)."""
         self.stop_event.set()

@@ -21,3 +21,11 @@ def test_no_command_means_the_gui():
     assert "gui" in parser._subparsers._group_actions[0].choices
     args = parser.parse_args(["gui", "--protocol", "p.toml", "--participant", "P01", "--start"])
     assert args.func.__module__ == "studyapp.cli.gui" and args.audio == "device" and args.midi == "first"
+
+
+def test_no_display_is_one_line(monkeypatch, capsys):
+    for name in ("DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM"):
+        monkeypatch.delenv(name, raising=False)
+    assert main(["gui"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("studyapp: error: no display") and "\n" not in err

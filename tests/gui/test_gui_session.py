@@ -65,6 +65,11 @@ def test_simulated_participant_plays_the_demo_through_the_console(idle_console, 
     # the participant's window never named a condition
     assert seen and all(name not in text for text in seen for name in conditions)
     assert "Thank you" in console.participant_window.notice.text()
+    # the analysis tab shows the study just run
+    console.analyse_results()
+    assert console.tabs.currentWidget() is console.analysis
+    assert console.analysis.study is not None and list(console.analysis.study.participants) == ["SIM01"]
+    console.tabs.setCurrentIndex(0)
 
 
 PROTOCOL = """
@@ -132,6 +137,17 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
     wait_until(qapp, lambda: console.trial_label.text() == "Trial 2 of 2", 10)
 
+    # abort; starting the participant again is refused; resuming continues at trial 2
+    qtbot.mouseClick(console.abort_button, Qt.MouseButton.LeftButton)
+    assert c.state == "aborted" and console.start_button.isEnabled()
+    qtbot.mouseClick(console.start_button, Qt.MouseButton.LeftButton)
+    assert c.state == "aborted" and "already has a session" in console.setup.error.text()
+    console.setup.resume.setChecked(True)
+    qtbot.mouseClick(console.start_button, Qt.MouseButton.LeftButton)
+    wait_until(qapp, lambda: c.playing, ENGINE_START)
+    console.setup.resume.setChecked(False)
+    assert console.trial_label.text() == "Trial 2 of 2" and console.setup.error.text() == ""
+
     # adjustment: up to knob 60, emergency stop, the trial starts again from 0
     dial = console.knobs.dials[0]
     assert dial.value() == 0 and console.knobs.captions[0].text() == "F_max"
@@ -158,12 +174,13 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     events = events_of(results)
     types = [e["type"] for e in events]
     assert types.count("response") == 2
+    assert [e["resume"] for e in events if e["type"] == "run_start"] == [False, True]
     assert "pause" in types and "resume" in types and "emergency_stop" in types and "emergency_clear" in types
     assert not any(e["type"] == "knob" and e["value"] == 77 for e in events)  # ignored while paused
     assert any(e["type"] == "gesture" and e["name"] == "live" for e in events)  # the mouse took the bow
     assert [e["on"] for e in events if e["type"] == "bowing"][:2] == [True, False]
     restarts = [e for e in events if e["type"] == "trial_start" and e["task"] == "adjustment"]
-    assert [e["restart"] for e in restarts] == [False, True]
+    assert [e["restart"] for e in restarts] == [False, True, True]  # aborted, resumed; emergency stop
     adjust_knobs = [e["value"] for e in events if e["type"] == "knob" and e["task"] == "adjustment"]
     assert adjust_knobs[0] == 60 and adjust_knobs[-1] == 30
 
