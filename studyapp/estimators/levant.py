@@ -55,7 +55,7 @@ LEVANT_STATE = 3
 
 
 def c_param(default):
-    return Param("c", default, "m/s^2", 1e-3, 1e7, doc="Lipschitz constant C (max. acceleration)")
+    return Param("c", default, "m/s^2", 1e-3, 1e5, doc="Lipschitz constant C (max. acceleration)")
 
 
 def gains(c):
