@@ -2,7 +2,8 @@
 
 Qt must find the offscreen platform before anything imports it, so the
 environment is set here, at collection time. One console (with its preview
-engine) serves every test of the session: starting an engine costs seconds.
+engine) serves every test of this folder: starting an engine costs seconds,
+and it stops when the folder's tests are done (not at the end of the run).
 Its watchdog allows 0.5 s without a heartbeat instead of 80 ms: the engine
 tests check the watchdog; here a machine shared with other test runs must not
 trip it (a tripped engine pauses the session, which a test would then wait on).
@@ -32,7 +33,7 @@ def wait_until(app, predicate, timeout, step=0.01):
         time.sleep(step)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def console(qapp):
     from studyapp.gui.console import Console
     from studyapp.gui.session_controller import SessionController

@@ -152,3 +152,19 @@ def test_emergency_stop_zeroes_force(idle_console, qapp):
     bow_preview(console, qapp)
     assert np.max(np.abs(telemetry_after(console, qapp, 0.3)["force"])) > 0.3
     console.set_bowing(False)
+
+
+def test_escape_is_the_emergency_stop_in_every_window(idle_console, qapp, qtbot):
+    from PySide6.QtCore import Qt
+
+    console = idle_console
+    c = console.controller
+    for window in (console, console.participant_window):
+        window.show()
+        window.activateWindow()
+        qtbot.keyClick(window, Qt.Key.Key_Escape)
+        assert c.emergency
+        assert c.engine.status_block.force_enable is False
+        c.resume()
+        wait_until(qapp, lambda: not c.clearing, 5)
+    console.participant_window.hide()
