@@ -84,7 +84,8 @@ def test_scope_receives_data_and_draws_it(idle_console, qapp, tmp_path):
     scope = console.scope
     bow_preview(console, qapp)
     before = scope.buffer.end
-    wait_until(qapp, lambda: scope.buffer.end > before + 2500, 10)  # half a second at 5 kHz
+    # half a second of bowing, and a full window (1 s at 5 kHz) in the buffer
+    wait_until(qapp, lambda: scope.buffer.end > before + 2500 and scope.buffer.count >= 5000, 10)
     assert set(scope.traces) >= {"velocity_lvt", "source_velocity", "string_velocity", "force",
                                  "estimate:LOWPASS", "estimate:LEVANT", "estimate:LVT"}
     # the buffer holds what the engine wrote: the scope's newest samples are the ring's
