@@ -263,6 +263,7 @@ class DeviceSink(Sink):
         self.fifo = Fifo(max(4 * self.lead_frames, int(self.rate)))
         self._wanted = threading.Event()
         self._scratch = np.zeros(0, dtype=np.float32)
+        self.stuck = False
         self.period_frames = 0
         self.callbacks = 0
 
@@ -329,13 +330,29 @@ class DeviceSink(Sink):
         """Start the stream; call once the FIFO holds ``lead`` (the engine primes it)."""
         self._stream.start()
 
-    def close(self):
+    def close(self, timeout=2.0):
+        """Abort and close the stream; ``False`` if PortAudio did not let go within ``timeout``.
+
+        PortAudio's JACK back-end waits up to ten minutes for its callback to
+        acknowledge a stop; a server that has dropped the client (after a long
+        stall) never runs that callback again. So the stream is closed on a
+        helper thread, and a sink that stays stuck is left behind
+        (``self.stuck``): the worker then exits without terminating PortAudio.
+        """
         if self._stream is None:
-            return
-        with contextlib.suppress(self._sd.PortAudioError):
-            self._stream.stop()
-            self._stream.close()
-        self._stream = None
+            return not self.stuck
+        stream, self._stream = self._stream, None
+        done = threading.Event()
+
+        def shut():
+            with contextlib.suppress(self._sd.PortAudioError):
+                stream.abort()
+                stream.close()
+            done.set()
+
+        threading.Thread(target=shut, name="studyapp-audio-close", daemon=True).start()
+        self.stuck = not done.wait(timeout)
+        return not self.stuck
 
 
 def open_sink(spec, haptic_rate, say=print, lead=0.03):

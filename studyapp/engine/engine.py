@@ -7,7 +7,7 @@
         engine.controls()          # MIDI control events since the last call
 
 The parent creates the shared memory (a ring for the telemetry, the status
-block), spawns the worker (``worker.main``) and, once it reports ready, runs a
+block, a ring of events from the worker), spawns the worker (``worker.main``) and, once it reports ready, runs a
 watchdog thread that also drains the worker's events. The watchdog wakes every
 ``POLL`` seconds, or at once when the process ends (it waits on the process
 sentinel), so:
@@ -26,7 +26,6 @@ the shared memory: no orphan process, no leaked segment.
 
 import contextlib
 import multiprocessing
-import queue
 import threading
 import time
 from multiprocessing.connection import wait as wait_for
@@ -34,6 +33,7 @@ from multiprocessing.connection import wait as wait_for
 from studyapp.engine import commands as cmd
 from studyapp.engine.audio import parse as parse_audio
 from studyapp.engine.config import EngineConfig
+from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
 from studyapp.errors import ParameterError, UserError
@@ -62,6 +62,7 @@ class Engine:
         self.status_block = None
         self._controls = []
         self._lock = threading.Lock()
+        self._event_lock = threading.Lock()
         self._stop_watch = threading.Event()
         self._watchdog = None
         self._stopping = False
@@ -96,10 +97,10 @@ class Engine:
         self.status_block = StatusBlock.create()
         ctx = multiprocessing.get_context("spawn")
         self._commands = ctx.Queue()
-        self._events = ctx.Queue()
+        self._events = EventRing.create()
         self.process = ctx.Process(
             target=main, name="studyapp-engine", daemon=True,
-            args=(c, self.ring.spec, self.status_block.name, self._commands, self._events),
+            args=(c, self.ring.spec, self.status_block.name, self._commands, self._events.name),
         )
         self.process.start()
         deadline = time.monotonic() + timeout
@@ -232,10 +233,15 @@ class Engine:
 
     # watchdog --------------------------------------------------------------
     def _next_event(self, timeout):
-        try:
-            return self._events.get(timeout=timeout) if timeout > 0 else self._events.get_nowait()
-        except (queue.Empty, EOFError, OSError, ValueError):
+        if self._events is None:
             return None
+        end = time.monotonic() + timeout
+        while True:
+            with self._event_lock:  # the watchdog and stop() may both be reading
+                event = self._events.get() if self._events is not None else None
+            if event is not None or time.monotonic() >= end:
+                return event
+            time.sleep(min(POLL / 2, max(0.0, end - time.monotonic())))
 
     def _handle(self, event):
         kind = event[0]
@@ -315,10 +321,14 @@ class Engine:
         if self.process is not None and self.process.is_alive():
             self.process.kill()
             self.process.join(5.0)
-        for q in (getattr(self, "_commands", None), getattr(self, "_events", None)):
-            if q is not None:
-                q.close()
-                q.cancel_join_thread()
+        commands = getattr(self, "_commands", None)
+        if commands is not None:
+            commands.close()
+            commands.cancel_join_thread()
+        with self._event_lock:
+            if getattr(self, "_events", None) is not None:
+                self._events.close()
+                self._events = None
         if self.ring is not None:
             self.ring.close()
         if self.status_block is not None:

@@ -26,6 +26,7 @@ The worker stops on a ``stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
 """
 
+import gc
 import importlib
 import multiprocessing
 import os
@@ -39,6 +40,7 @@ import numpy as np
 
 from studyapp.engine import commands as cmd
 from studyapp.engine.audio import open_sink
+from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, open_input
 from studyapp.engine.ring import Ring
 from studyapp.engine.safety import Safety
@@ -65,14 +67,16 @@ def make_device(spec, rate):
     return getattr(importlib.import_module(module), factory)(rate)
 
 
-def main(config, ring_spec, status_name, commands, events):
+def main(config, ring_spec, status_name, commands, events_name):
     """Entry point of the worker process."""
     # Ctrl-C reaches the whole process group; the parent decides when the worker stops.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.environ.setdefault("JACK_NO_START_SERVER", "1")
     status = StatusBlock.attach(status_name)
     ring = Ring.attach(ring_spec)
+    events = EventRing.attach(events_name)
     worker = None
+    hard_exit = False
     try:
         worker = Worker(config, ring, status, commands, events)
         worker.run()
@@ -80,14 +84,16 @@ def main(config, ring_spec, status_name, commands, events):
         text = f"{type(exc).__name__}: {exc}".splitlines()[0]
         status.set(state="failed", fault=text)
         status.publish(texts=True)
-        events.put(("error", text, traceback.format_exc()))
+        events.put(("error", text, traceback.format_exc()[-3000:]))
     finally:
         if worker is not None:
-            worker.close()
+            hard_exit = worker.close()
         ring.close()
         status.close()
         events.close()
-        events.join_thread()
+    if hard_exit:
+        # PortAudio's exit handler would wait for the stuck stream: leave without it
+        os._exit(0)
 
 
 class Worker:
@@ -219,6 +225,11 @@ class Worker:
             self.step(time.monotonic())
         while self.sink.paced and self.sink.level < self.sink.lead_frames:
             self.step(time.monotonic())
+        # A full collection over the ~150 000 objects numpy, numba and scipy leave behind takes
+        # ~0.2 s, holding the GIL: long enough to trip the watchdog and starve the audio callback.
+        # Collect once now, before any clock runs, and freeze the survivors out of the collector.
+        gc.collect()
+        gc.freeze()
         self.sink.start()
 
     def step(self, started):
@@ -342,8 +353,14 @@ class Worker:
         }
 
     def close(self):
+        """Release the devices and report; ``True`` if the process must leave by ``os._exit``."""
+        stuck = False
         if self.sink is not None:
             self.sink.close()
+            stuck = getattr(self.sink, "stuck", False)
+            if stuck:
+                self.notice("audio: the device did not release its stream (JACK dropped the client?); "
+                            "leaving it open")
         if self.midi is not None:
             self.midi.close()
         if getattr(self, "loop", None) is not None:
@@ -351,9 +368,10 @@ class Worker:
             self.status.set(state="stopped", heartbeat=time.monotonic())
             self.status.publish(texts=True)
         sounddevice = sys.modules.get("sounddevice")
-        if sounddevice is not None:
+        if sounddevice is not None and not stuck:
             # PortAudio must let go of JACK now: a JACK server stopping first would abort us at exit
             sounddevice._terminate()
+        return stuck
 
 
 def _try_realtime():

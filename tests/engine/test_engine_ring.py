@@ -6,6 +6,7 @@ import time
 import numpy as np
 import pytest
 
+from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import NUMBERS, StatusBlock
 
@@ -143,3 +144,36 @@ def test_ring_rejects_bad_shapes():
         Ring.create(["a", "a"], 8)
     with pytest.raises(ValueError):
         Ring.create(["a"], 1)
+
+
+def _event_writer(name, count):
+    events = EventRing.attach(name)
+    for i in range(count):
+        events.put(("n", i, "x" * (i % 50)))
+        if i % 97 == 0:
+            time.sleep(0.001)
+    events.put(("big", "y" * 10_000))
+    events.close()
+
+
+def test_event_ring_delivers_in_order_and_counts_what_a_slow_reader_lost():
+    events = EventRing.create(slots=16, slot_size=256)
+    try:
+        proc = mp.get_context("spawn").Process(target=_event_writer, args=(events.name, 3000))
+        proc.start()
+        got = []
+        while True:
+            event = events.get()
+            if event is None:
+                if not proc.is_alive() and events.get() is None:
+                    break
+                continue
+            got.append(event)
+        proc.join(10)
+        numbers = [e[1] for e in got if e[0] == "n"]
+        assert numbers == sorted(numbers) and len(set(numbers)) == len(numbers)
+        assert all(e == ("n", e[1], "x" * (e[1] % 50)) for e in got if e[0] == "n")
+        assert len(numbers) + events.lost == 3000
+        assert got[-1][0] == "notice" and "too large" in got[-1][1]
+    finally:
+        events.close()
