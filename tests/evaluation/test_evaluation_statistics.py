@@ -72,3 +72,30 @@ def test_report_matches_the_metric_and_lowpass_is_100_percent():
     assert set(doc["estimators"]["BDIFF"]) == {"error", "delay", "error_pct_lowpass", "delay_pct_lowpass",
                                                "objective"}
     assert result.group_mask("b").tolist() == [False, True, True]
+
+
+def test_validation_comparison_by_hand():
+    from studyapp.evaluation.report import Evaluation
+    from studyapp.evaluation.validation import compare
+
+    def ev(errors, delays, fmax):
+        return Evaluation(names=["A", "B"], recordings=[f"r{f}" for f in fmax], fmax=list(fmax),
+                          rates=[5000.0] * len(fmax), params={"A": {}, "B": {}},
+                          errors={k: np.array(v, float) for k, v in errors.items()},
+                          delays={k: np.array(v, float) for k, v in delays.items()},
+                          baseline_errors=np.ones(len(fmax)), baseline_delays=np.ones(len(fmax)))
+
+    train = ev({"A": [1.0, 2.0], "B": [4.0, 5.0]}, {"A": [2, 3], "B": [5, 5]}, (0.5, 2.2))
+    # Validation in another order, with one extra gain that has no match.
+    valid = ev({"A": [2.2, 1.1, 9.0], "B": [4.0, 4.0, 9.0]}, {"A": [3, 4, 9], "B": [7, 5, 9]}, (2.2, 0.5, 9.9))
+    summary, rows = compare(train, valid)
+    assert summary["matched_recordings"] == 2
+    # Error differences: A 10 %, 10 %; B 0 %, 20 %. Delay differences: A 2, 0; B 0, 2.
+    e = np.array([10.0, 10.0, 0.0, 20.0])
+    d = np.array([2.0, 0.0, 0.0, 2.0])
+    assert summary["error_difference_pct_mean"] == pytest.approx(e.mean())
+    assert summary["error_difference_pct_std"] == pytest.approx(e.std(ddof=1))
+    assert summary["delay_difference_mean"] == pytest.approx(d.mean())
+    assert summary["delay_difference_std"] == pytest.approx(d.std(ddof=1))
+    assert summary["estimators"]["B"]["error_difference_pct_mean"] == pytest.approx(10.0)
+    assert [r["delay_difference"] for r in rows] == [2, 0, 0, 2]
