@@ -265,29 +265,30 @@ class Engine:
         if self.on_fault is not None:
             self.on_fault(text)
 
-    def _trip(self, text):
-        now = time.monotonic()
+    def _trip(self, text, when):
         self.status_block.force_enable = False
         self.tripped = True
-        self._fault(text, now)
+        self._fault(text, when)
 
     def _watch(self):
         sentinel = self.process.sentinel
         timeout = self.config.hang_timeout
         while not self._stop_watch.is_set():
             ended = wait_for([sentinel], POLL)
+            now = time.monotonic()
             while (event := self._next_event(0)) is not None:
                 self._handle(event)
-            if self._stopping:
-                continue
+            if self._stopping or self.tripped:
+                if ended:
+                    return
+                continue  # keep passing on the worker's events until stop()
             if ended:
                 self.process.join(0.1)
-                self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero")
+                self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero", now)
                 return
             snap = self.status_block.read()
-            if snap["state"] == "running" and time.monotonic() - snap["heartbeat"] > timeout:
-                self._trip(f"watchdog: no heartbeat for {1e3 * timeout:.0f} ms; force disabled")
-                return
+            if snap["state"] == "running" and now - snap["heartbeat"] > timeout:
+                self._trip(f"watchdog: no heartbeat for {1e3 * timeout:.0f} ms; force disabled", now)
 
     # shutting down ---------------------------------------------------------
     def stop(self, timeout=10.0):
