@@ -15,12 +15,13 @@ parameters (the Kalman ``q_convention``) are never tuned: they change the
 meaning of q, not its value.
 
 Search ranges are the spec's ranges except where ``SEARCH_RANGES`` narrows
-them: FOAW's cost per sample grows with the square of its window when the
-margin is wide (measured: about 200 us per sample at window 256, margin 1 mm,
-against 1 us at the paper's 17 and 0.1 mm), so the optimiser searches windows
-up to 64 and margins from 0.1 um to 1 cm, which hold the paper's optimum and
-the LVDT noise (15 um RMS) with orders of magnitude to spare. ``ranges``
-overrides any range (``--range FOAW.window=1:128``), within the spec's.
+them: FOAW's cost per sample grows with its window and margin (measured:
+about 2.5 us per sample at window 256 and a 1 mm margin, against 0.1-0.6 us at
+the paper's 17 and 0.1 mm), and long windows only add delay on stick-slip, so
+the optimiser searches windows up to 64 and margins from 0.1 um to 1 cm, which
+hold the paper's optimum and the LVDT noise (15 um RMS) with orders of
+magnitude to spare. ``ranges`` overrides any range (``--range
+FOAW.window=1:256``), within the spec's.
 """
 
 import math
