@@ -20,6 +20,12 @@ PANELS = (
 )
 
 
+def _null_formatter():
+    from matplotlib.ticker import NullFormatter
+
+    return NullFormatter()
+
+
 def _pyplot():
     import matplotlib
 
@@ -88,6 +94,7 @@ def tradeoff_plot(table, stem):
                     color="#1f77b4", lw=1.2, label="Pareto front")
             ax.legend(fontsize=8)
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(_null_formatter())
         ax.set_xlabel("cost (ns/sample, streaming form)")
         ax.set_ylabel("global objective F_g (lower is better)")
         ax.set_title(f"{rate / 1000:g} kHz", fontsize=10)
@@ -102,19 +109,25 @@ def rate_plot(table, stem):
     """What a higher rate buys: median error (m/s) and median delay (ms) of each estimator against rate."""
     plt = _pyplot()
     names = list(dict.fromkeys(row["estimator"] for row in table))
+    rates_khz = sorted({row["rate"] / 1000 for row in table})
+    colours = plt.get_cmap("tab20").colors
+    markers = "osD^v<>ph*"
     fig, axes = plt.subplots(1, 3, figsize=(13.0, 4.2))
-    for name in names:
+    for i, name in enumerate(names):
         rows = sorted((r for r in table if r["estimator"] == name), key=lambda r: r["rate"])
         rates = [r["rate"] / 1000 for r in rows]
-        axes[0].plot(rates, [r["error_median"] for r in rows], marker="o", label=name)
-        axes[1].plot(rates, [r["delay_median_ms"] for r in rows], marker="o", label=name)
-        axes[2].plot(rates, [r["cost_ns_per_sample"] * r["rate"] * 1e-9 * 100 for r in rows], marker="o", label=name)
+        style = {"marker": markers[i % len(markers)], "color": colours[i % len(colours)], "label": name}
+        axes[0].plot(rates, [r["error_median"] for r in rows], **style)
+        axes[1].plot(rates, [r["delay_median_ms"] for r in rows], **style)
+        axes[2].plot(rates, [r["cost_ns_per_sample"] * r["rate"] * 1e-9 * 100 for r in rows], **style)
     axes[0].set_ylabel("median error E (m/s)")
     axes[1].set_ylabel("median delay D (ms)")
     axes[2].set_ylabel("CPU load of one core (%)")
     for ax in axes:
         ax.set_xlabel("rate (kHz)")
         ax.set_xscale("log")
+        ax.set_xticks(rates_khz, [f"{r:g}" for r in rates_khz])
+        ax.minorticks_off()
         ax.grid(alpha=0.3)
     axes[0].set_yscale("log")
     axes[2].set_yscale("log")
