@@ -1,9 +1,10 @@
 """Numerical evaluation and tuning of the estimators (paper Sec. 6-7), and their speed/accuracy trade.
 
-    delay_and_error(reference, estimate, max_lag) -> (D samples, E)   eqs. 22-24
-    ObjectiveSum                                  the adaptive normalisation, eqs. 27-32, steps 1-8
-    AdaptiveSearch, Space                         pure adaptive search in each parameter's natural scale
-    Optimiser                                     the whole procedure: executor, checkpoints, progress
+    delay_and_error(reference, estimate, max_lag) -> (D samples, E)   eqs. 22-24 (metric.py)
+    normalisation.ObjectiveSum     the adaptive normalisation, eqs. 27-32, steps 1-8
+    search.AdaptiveSearch, space.Space   pure adaptive search in each parameter's natural scale
+    optimiser.Optimiser            the whole procedure: executor, checkpoints, progress
+    report.evaluate, tradeoff.tradeoff   Fig. 5's comparison; cost against accuracy per rate
 
 Command line: ``studyapp optimise``, ``studyapp evaluate``, ``studyapp tradeoff``.
 """

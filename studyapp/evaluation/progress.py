@@ -19,7 +19,6 @@ class Progress:
         self.started = time.monotonic()
         self.last = -float("inf")
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.drawn = False
 
     def __call__(self, iteration, evaluated, objectives, done, final=False, waiting=None):
         now = time.monotonic()
@@ -34,7 +33,6 @@ class Progress:
         line = f"iter {iteration} sets {evaluated} {now - self.started:.0f}s | " + "  ".join(parts)
         if self.tty:
             self.stream.write("\r\033[K" + line + ("\n" if final else ""))
-            self.drawn = not final
         else:
             self.stream.write(line + "\n")
         self.stream.flush()
