@@ -32,15 +32,10 @@ def register(sub):
 
 
 def run(args):
-    import os
-    import sys
-
     from studyapp.errors import UserError
+    from studyapp.gui.display import require_display
 
-    if (sys.platform.startswith("linux") and not os.environ.get("QT_QPA_PLATFORM")
-            and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")):
-        raise UserError("no display (DISPLAY is not set): allowed is a desktop session, QT_QPA_PLATFORM=offscreen "
-                        "(e.g. with --screenshot), or 'studyapp run ... --simulated-participant --headless'")
+    require_display()
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")
     if args.measure_scope is not None and not 0.5 <= args.measure_scope <= 600:

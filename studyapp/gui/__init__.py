@@ -6,6 +6,9 @@ the console with the session started at once.
 
 
 def run_session(args):
+    from studyapp.gui.display import require_display
+
+    require_display()
     from studyapp.gui.app import main
 
     args.start = True

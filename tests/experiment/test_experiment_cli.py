@@ -48,13 +48,12 @@ def test_bad_run_arguments_are_one_line(tmp_path, capsys, argv, expected):
     assert expected in err
 
 
-def test_without_headless_the_gui_is_needed(tmp_path, capsys):
-    import studyapp.gui
-
-    if hasattr(studyapp.gui, "run_session"):
-        pytest.skip("the GUI exists: its own tests cover a session run through it")
+def test_without_headless_and_without_a_display_is_one_line(tmp_path, capsys, monkeypatch):
+    for name in ("DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM"):
+        monkeypatch.delenv(name, raising=False)
     err = one_line_error(capsys, ["run", "--protocol", str(DEMO), "--participant", "P1", "--results", str(tmp_path)])
-    assert "GUI" in err
+    assert "no display" in err and "--headless" in err
+    assert not (tmp_path / "demo").exists()  # nothing started, nothing written
 
 
 def test_export_of_an_empty_folder_is_one_line(tmp_path, capsys):
