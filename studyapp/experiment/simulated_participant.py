@@ -33,8 +33,12 @@ judge "breakdown" differently, Sec. 9.1) and a per-trial jitter of
 ``hand_jitter`` positions. If the string never breaks down it confirms at the
 top of the knob.
 
-Keep the times short for demos and checks: a few tenths of a second of
-simulated bowing per judgement.
+Times. Ratings need only a few tenths of a second of bowing. In the
+adjustment task each F_max step is probed for ``probe_time`` = 1.2 s, longer
+than the stability monitor needs to call a breakdown (about 1 s after the
+oscillation starts, studyapp.model.stability): with shorter probes the
+participant kept raising F_max past breakdown before hearing it, and confirmed
+two to three times above the F_max that calibration.breakdown_fmax finds.
 """
 
 import math
@@ -46,7 +50,7 @@ from studyapp.experiment.noisiness import velocity_noise
 
 
 class SimulatedParticipant:
-    def __init__(self, seed, bow_time=0.25, probe_time=0.4, reaction_time=0.05, rest_time=1.0,
+    def __init__(self, seed, bow_time=0.25, probe_time=1.2, reaction_time=0.05, rest_time=1.0,
                  retries=12, adjust_gesture="hold", rating_jitter=0.05,
                  hand_jitter=1.5, criterion_spread=2.0):
         self.seed = int(seed)
