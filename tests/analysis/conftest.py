@@ -13,6 +13,15 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
 EXPORT_COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash"]
+# what `studyapp analyse` must write (issue 7): table -> columns, and figure stems (PNG + SVG)
+TABLES = {
+    "wilcoxon_adjustment.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
+    "wilcoxon_rating.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
+    "summary_adjustment.csv": ["condition", "n", "median", "q1", "q3"],
+    "summary_rating.csv": ["condition", "n", "median", "q1", "q3"],
+    "spearman_participants.csv": ["participant", "rho", "p_value"],
+}
+FIGURES = ["fig7_adjustment", "fig8_rating", "fig9_scatter"]
 
 # A synthetic study shaped like the paper's (Sec. 8.4, Figs. 7-8): breakdown
 # F_max per condition (N) and noisiness (0 best) per condition. Not measured data.

@@ -7,16 +7,8 @@ import pandas as pd
 import pytest
 
 from studyapp.cli import main
-from tests.analysis.conftest import SYNTHETIC_FMAX, SYNTHETIC_NOISINESS, synthetic_responses
+from tests.analysis.conftest import FIGURES, SYNTHETIC_FMAX, SYNTHETIC_NOISINESS, TABLES, synthetic_responses
 
-TABLES = {
-    "wilcoxon_adjustment.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
-    "wilcoxon_rating.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
-    "summary_adjustment.csv": ["condition", "n", "median", "q1", "q3"],
-    "summary_rating.csv": ["condition", "n", "median", "q1", "q3"],
-    "spearman_participants.csv": ["participant", "rho", "p_value"],
-}
-FIGURES = ["fig7_adjustment", "fig8_rating", "fig9_scatter"]
 
 
 @pytest.fixture(scope="module")

@@ -21,20 +21,13 @@ import pandas as pd
 import pytest
 
 from studyapp.cli import main
+from tests.analysis.conftest import FIGURES, TABLES
 
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "protocols" / "demo.toml"
 PARTICIPANTS = {"SIM1": 11, "SIM2": 22, "SIM3": 33}
-TABLES = {
-    "wilcoxon_adjustment.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
-    "wilcoxon_rating.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
-    "summary_adjustment.csv": ["condition", "n", "median", "q1", "q3"],
-    "summary_rating.csv": ["condition", "n", "median", "q1", "q3"],
-    "spearman_participants.csv": ["participant", "rho", "p_value"],
-}
-FIGURES = ["fig7_adjustment", "fig8_rating", "fig9_scatter"]
 
 
 def analyse(*args):
