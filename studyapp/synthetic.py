@@ -10,16 +10,21 @@ so the ripple has zero mean and a sawtooth-like shape with sharp transients.
 Position is the exact integral of that piecewise-linear ripple plus the stroke.
 
 Sensors (paper Sec. 4.2): LVDT position with 15 um RMS Gaussian noise and
-16-bit quantisation over 2.2 cm; LVT velocity with 0.115 mm/s RMS noise;
-accelerometer with 0.22 m/s^2 RMS noise. The exact velocity is returned too.
+16-bit quantisation over 2.2 cm; LVT velocity through the tachometer's band
+(a 2nd-order Butterworth at 500 Hz, started at rest on the first sample) with
+0.115 mm/s RMS noise, so the LVT reference lags the true velocity as the
+paper's did; accelerometer with 0.22 m/s^2 RMS noise on the stroke's
+acceleration. The exact velocity is returned too.
 """
 
 import numpy as np
+from scipy import signal
 
 LVDT_NOISE_M = 15e-6
 LVDT_RANGE_M = 0.022
 LVDT_BITS = 16
 LVT_NOISE_MPS = 0.115e-3
+LVT_BAND_HZ = 500.0
 ACC_NOISE_MPS2 = 0.22
 
 
@@ -44,12 +49,14 @@ def stick_slip(rate, duration, f0=110.0, ripple=0.02, v0=0.05, f_stroke=0.5, sli
     position = v0 / w * (1.0 - np.cos(w * t)) - v0 / w + x_ripple
     acceleration = v0 * w * np.cos(w * t)
     q = LVDT_RANGE_M / 2**LVDT_BITS
+    band = signal.butter(2, LVT_BAND_HZ, fs=rate, output="sos")
+    lvt = signal.sosfilt(band, velocity, zi=signal.sosfilt_zi(band) * velocity[0])[0]
     measured = np.round((position + rng.normal(0.0, LVDT_NOISE_M, n)) / q) * q
     return {
         "t": t,
         "position": measured,
         "velocity_true": velocity,
         "acceleration_true": acceleration,
-        "velocity_lvt": velocity + rng.normal(0.0, LVT_NOISE_MPS, n),
+        "velocity_lvt": lvt + rng.normal(0.0, LVT_NOISE_MPS, n),
         "acceleration": acceleration + rng.normal(0.0, ACC_NOISE_MPS2, n),
     }
