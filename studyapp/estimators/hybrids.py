@@ -131,11 +131,11 @@ def _levant_twice(s, p, x):
 
 
 @njit(cache=True, inline="always")
-def _foaw_twice(s, p, x):
-    """F(F(x)) on two FOAW states starting at ``s[0]``; parameters ``p[0:4]``."""
+def _foaw_twice(s, at, p, x):
+    """F(F(x)) on two FOAW states starting at ``s[at]``; parameters ``p[0:4]``."""
     size = foaw_state_size(p[0])
-    v1 = foaw_core(s[0:size], p[0], p[1], p[3], x)
-    return foaw_core(s[size:2 * size], p[0], p[2], p[3], v1)
+    v1 = foaw_core(s, at, p[0], p[1], p[3], x)
+    return foaw_core(s, at + size, p[0], p[2], p[3], v1)
 
 
 @njit(cache=True, inline="always")
@@ -163,7 +163,7 @@ def step_kallevacc(s, p, x, a, v):
 
 @njit(cache=True, inline="always")
 def step_kalfoaw(s, p, x, a, v):
-    z = _foaw_twice(s[_AFTER:], p[_P:], x)
+    z = _foaw_twice(s, _AFTER, p[_P:], x)
     s[Z_A] = z
     return kalman_step(s, p, x, z)
 
@@ -171,7 +171,7 @@ def step_kalfoaw(s, p, x, a, v):
 @njit(cache=True, inline="always")
 def step_kalfoawacc(s, p, x, a, v):
     h = _highpass(s, p[_P + 4:_P + 4 + SECTION], a)
-    z = _foaw_twice(s[_AFTER + STATE:], p[_P:], x) + h
+    z = _foaw_twice(s, _AFTER + STATE, p[_P:], x) + h
     s[Z_A] = z
     return kalman_step(s, p, x, z)
 

@@ -47,6 +47,7 @@ from numba import njit
 
 from studyapp.errors import ParameterError
 from studyapp.estimators import Bank
+from studyapp.estimators.dispatch import run_block as run_estimator_block
 from studyapp.estimators.dispatch import step_guarded
 from studyapp.estimators.registry import SPECS
 from studyapp.estimators.spec import validate_rate
@@ -189,16 +190,10 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
     They only observe the stream, so stepping each over the whole block in turn
     gives exactly the per-sample result (DESIGN.md, "Data flow").
     """
-    n = out.shape[1]
     for e in range(kinds.shape[0]):
-        if e == src:
-            continue
-        kind = kinds[e]
-        s = est_s[e]
-        p = est_p[e]
-        for k in range(n):
-            est_out[e, k] = step_guarded(kind, s, p, out[O_POSITION, k], out[O_ACCELERATION, k],
-                                         out[O_VELOCITY_LVT, k])
+        if e != src:
+            run_estimator_block(kinds[e], est_s[e], est_p[e], out[O_POSITION], out[O_ACCELERATION],
+                                out[O_VELOCITY_LVT], est_out[e])
 
 
 @njit(cache=True, error_model="numpy")

@@ -13,23 +13,31 @@ N = 600
 SIGNAL = stick_slip(RATE, N / RATE, seed=5)
 X, A, V = SIGNAL["position"], SIGNAL["acceleration"], SIGNAL["velocity_lvt"]
 # a few bad samples too: the policy must not depend on where blocks are cut
-X = X.copy()
+X, A, V = X.copy(), A.copy(), V.copy()
 X[[50, 51, 300]] = [np.nan, np.inf, np.nan]
+A[[51, 120]] = [np.nan, -np.inf]
+V[[120, 400, 401]] = [np.inf, np.nan, np.nan]
 
 
 def streamed(name):
     est = estimators.create(name, RATE)
-    return np.array([est.step(x, a, v) for x, a, v in zip(X, A, V)])
+    return np.array([est.step(x, a, v) for x, a, v in zip(X, A, V)]), est.state.copy()
 
 
-STREAMED = {name: streamed(name) for name in estimators.names()}
+STREAMED, STATES = {}, {}
+for _name in estimators.names():
+    STREAMED[_name], STATES[_name] = streamed(_name)
 
 
 @pytest.mark.parametrize("name", estimators.names())
 def test_whole_block_equals_per_sample_steps(name):
-    out = estimators.create(name, RATE).process(X, A, V)
+    est = estimators.create(name, RATE)
+    out = est.process(X, A, V)
     np.testing.assert_array_equal(out, STREAMED[name])
     assert np.all(np.isfinite(out))
+    # the whole state too: the guard's last finite samples and its count of the 6 samples with a bad input
+    np.testing.assert_array_equal(est.state, STATES[name])
+    assert est.state[3] == 6
 
 
 @settings(max_examples=25, deadline=None)

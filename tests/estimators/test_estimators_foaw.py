@@ -102,8 +102,8 @@ def _double_foaw(xs, window, margin, margin_vel, rate):
     s = np.zeros(2 * n)
     out = np.empty_like(xs)
     for i in range(xs.shape[0]):
-        v = foaw_core(s[0:n], window, margin, rate, xs[i])
-        out[i] = foaw_core(s[n:], window, margin_vel, rate, v)
+        v = foaw_core(s, 0, window, margin, rate, xs[i])
+        out[i] = foaw_core(s, n, window, margin_vel, rate, v)
     return out
 
 
