@@ -3,7 +3,8 @@
 Each sub-command lives in its own module of this package with two functions:
 ``register(subparsers)`` adds its parser (argparse only, so start-up stays fast)
 and sets ``func``; the function imports what it needs and returns an exit code.
-A ``UserError`` becomes one line on stderr and exit code 2.
+A ``UserError`` becomes one line on stderr and exit code 2; so does a
+malformed command line (argparse's own usage dump is several lines).
 """
 
 import argparse
@@ -33,8 +34,19 @@ COMMANDS = [
 ]
 
 
+class UsageError(UserError):
+    """The command line itself is malformed (unknown option, a value of the wrong type)."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with errors raised, not printed with the usage: ``main`` prints them as one line."""
+
+    def error(self, message):
+        raise UsageError(f"{message} (see '{self.prog} --help')")
+
+
 def build_parser():
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="studyapp",
         description="Velocity estimation studies for audio-haptic stick-slip simulation.",
     )
@@ -53,14 +65,14 @@ def build_parser():
 
 def main(argv=None):
     parser = build_parser()
-    args = parser.parse_args(argv)
-    if args.command is None:
-        if "gui" in parser._subparsers._group_actions[0].choices:
-            args = parser.parse_args(["gui"])
-        else:
-            parser.print_help()
-            return 0
     try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            if "gui" in parser._subparsers._group_actions[0].choices:
+                args = parser.parse_args(["gui"])
+            else:
+                parser.print_help()
+                return 0
         return args.func(args) or 0
     except UserError as exc:
         print(f"studyapp: error: {exc}", file=sys.stderr)

@@ -17,6 +17,8 @@ def register(sub):
 
     p = kinds.add_parser("live", help="highest rate the live engine holds in real time")
     p.add_argument("--seconds", type=float, default=30.0, help="confirmation run length (default 30)")
+    p.add_argument("--block-ms", type=float, default=2.0,
+                   help="block period in ms, the deadline of each block (default 2, the engine's)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.benchmark"))
 

@@ -33,7 +33,10 @@ estimator reads acceleration (unless ``accelerometer=True``), and no body
 filter when ``audio=False``.
 
 Compiled with numpy's error model (as the estimator dispatch is): a division
-by zero gives inf, not an exception, and inf is caught as a fault below.
+by zero gives inf, not an exception, and inf is caught as a fault below. The
+block releases the GIL (``nogil``): in the live engine the audio device's
+callback thread needs it, and a block that held it while the OS descheduled
+the worker starved the callback (a JACK "client not finished" xrun).
 
 Safety: a non-finite value anywhere (sensor, estimate, string, device) latches
 ``fault`` (a one-line description); from that sample on the force is 0 and the
@@ -196,7 +199,7 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
                                 out[O_VELOCITY_LVT], est_out[e])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
               body_p, body_s, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
     """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
