@@ -20,10 +20,10 @@ is the end of its own period, so the OS's wake-up jitter counts in full: on a
 machine that wakes a real-time thread late by more than a block period, no
 rate holds however light the load (then the load figures are the measure).
 
-A run whose misses were all late starts (no block overran its period: the
-OS, not the engine, was late) is run once more at the same rate before it
-counts as failed; every run is listed in the result with its overruns and the
-worst wake-up delay, so a busy machine shows as such. Speed depends on the
+A run whose misses were all the machine's (late starts and stalls, no block
+overran its period on the CPU: the OS, not the engine, was late) is run once
+more at the same rate before it counts as failed; every run is listed in the result with its overruns, stalls and
+the worst wake-up delay, so a busy machine shows as such. Speed depends on the
 machine and on what else runs on it; the result is a measurement, never a
 test.
 """
@@ -68,7 +68,8 @@ def probe(rate, seconds, progress=print, block_period=BLOCK_PERIOD):
         "deadline_misses": summary.get("deadline_misses", -1),
         "load_mean": summary.get("load_mean", 0.0), "load_p99": summary.get("load_p99", 0.0),
         "load_max": summary.get("load_max", 0.0), "faults": list(engine.faults),
-        "overruns": summary.get("overruns", 0), "wake_late_max": summary.get("wake_late_max", 0.0),
+        "overruns": summary.get("overruns", 0), "stalls": summary.get("stalls", 0),
+        "wake_late_max": summary.get("wake_late_max", 0.0),
         "realtime_priority": summary.get("realtime", False),
     }
     result["passed"] = (
@@ -78,7 +79,7 @@ def probe(rate, seconds, progress=print, block_period=BLOCK_PERIOD):
     progress(f"bench live: {rate:8.0f} Hz for {seconds:g} s: "
              f"{'holds' if result['passed'] else 'FAILS'} (misses {result['deadline_misses']}, "
              f"load mean {100 * result['load_mean']:.0f}% p99 {100 * result['load_p99']:.0f}% "
-             f"max {100 * result['load_max']:.0f}%, overruns {result['overruns']}, "
+             f"max {100 * result['load_max']:.0f}%, overruns {result['overruns']}, stalls {result['stalls']}, "
              f"worst wake-up {1e3 * result['wake_late_max']:.1f} ms late)")
     return result
 
@@ -131,6 +132,7 @@ def search(confirm_seconds=30.0, probe_seconds=PROBE_SECONDS, progress=print, bl
         "confirm_seconds": confirm_seconds,
         "block_period": block_period,
         "confirm_overruns": sum(p["overruns"] for p in confirms),
+        "confirm_stalls": sum(p["stalls"] for p in confirms),
         "confirm_wake_late_max": max((p["wake_late_max"] for p in confirms), default=0.0),
         "estimators": list(all_fourteen()),
         "load_at_48k": None if check is None else {
@@ -161,7 +163,8 @@ def run_cli(args):
     if rate is None:
         print(f"no rate held {seconds:g} s without a deadline miss in {block_ms:g} ms blocks "
               f"(best {PROBE_SECONDS:g} s probe: {result['best_probe_rate']} Hz; in the confirmation runs "
-              f"{result['confirm_overruns']} blocks overran their period and the OS woke the worker up to "
+              f"{result['confirm_overruns']} blocks overran their period on the CPU, {result['confirm_stalls']} "
+              f"were stalled off it, and the OS woke the worker up to "
               f"{1e3 * result['confirm_wake_late_max']:.1f} ms late)")
     else:
         print(f"highest real-time rate with all fourteen estimators: {rate:g} Hz "

@@ -17,10 +17,14 @@ rate R (period T = B / R):
 
 A block is a *deadline miss* when it finishes after its deadline: t0 + (k+1) T
 on the timer; on the audio clock, when the device had to play silence while
-the block was being made. The load of a block is its compute time over T. A
-miss is an *overrun* when the block's own compute took longer than T; the
+the block was being made. The load of a block is its compute time (wall
+clock) over T. A miss is an *overrun* when the block's own compute took longer
+than T on the CPU (the thread's CPU time), a *stall* when it took longer than
+T by the wall clock only (the worker was taken off the CPU mid-block); the
 other misses come from starting late (the OS woke the worker late, or an
 earlier block overran): the summary's ``wake_late_max`` says how late.
+Stalls and late starts are the machine's share of the misses, overruns the
+engine's.
 
 The worker stops on a ``stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
@@ -134,7 +138,8 @@ class Worker:
         self.k = 0
         self.loads = []  # every timed block's load, for the summary's percentiles
         self.wake_late_max = 0.0  # the timer's worst wake-up delay: the OS's share of a miss
-        self.overruns = 0  # misses whose block alone took longer than its period
+        self.overruns = 0  # misses whose block alone took longer than its period on the CPU
+        self.stalls = 0  # misses whose block took longer than its period by the wall clock only
         self._rows = np.empty((len(self.channels), self.block))
         self._faults_seen = 0
         status.set(
@@ -233,6 +238,8 @@ class Worker:
         self.sink.start()
 
     def step(self, started):
+        """One block; returns (finished, wall-clock compute, CPU time of this thread)."""
+        cpu_started = time.thread_time()
         out = self.loop.run(self.block)
         self.safety.check(out, force_enable=self.status.force_enable)
         if self.sink.render:
@@ -248,10 +255,11 @@ class Worker:
         rows[len(CHANNELS):] = out["estimates"]
         self.ring.write(rows)
         finished = time.monotonic()
+        cpu = time.thread_time() - cpu_started
         self.k += 1
         if self.midi is not None:
             self.midi.block = self.k
-        return finished, finished - started
+        return finished, finished - started, cpu
 
     def run(self):
         status = self.status
@@ -293,7 +301,7 @@ class Worker:
             if self.stopping:
                 break
             deadline = t0 + (self.k - k0 + 1) * self.period
-            finished, compute = self.step(started)
+            finished, compute, cpu = self.step(started)
             load = compute / self.period
             loads.append(load)
             self.loads.append(load)
@@ -301,8 +309,10 @@ class Worker:
             shortfalls = self.sink.shortfalls
             if late:
                 status.set(deadline_misses=status.get("deadline_misses") + 1)
-                if compute > self.period:
+                if cpu > self.period:
                     self.overruns += 1
+                elif compute > self.period:
+                    self.stalls += 1
             new_faults = self.safety.faults[self._faults_seen:]
             for text in new_faults:
                 self.fault(text)
@@ -349,7 +359,7 @@ class Worker:
             "load_p99": float(np.percentile(self.loads, 99)) if self.loads else 0.0,
             "load_max": float(np.max(self.loads)) if self.loads else 0.0, "realtime": self.realtime,
             "block": self.block, "paced": "audio" if self.sink.paced else "timer",
-            "wake_late_max": self.wake_late_max, "overruns": self.overruns,
+            "wake_late_max": self.wake_late_max, "overruns": self.overruns, "stalls": self.stalls,
         }
 
     def close(self):

@@ -12,7 +12,10 @@ from studyapp.engine import benchmark
 
 
 def _fake(holds, calls, transient=()):
-    """A probe that holds real time when ``holds(rate, seconds)``; the first run at a rate in ``transient`` fails late."""
+    """A probe that holds real time when ``holds(rate, seconds)``.
+
+    The first run at a rate in ``transient`` fails by the machine's fault (a late start and a stall, no overrun).
+    """
     def probe(rate, seconds, progress=print, block_period=benchmark.BLOCK_PERIOD):
         first = not any(c == (rate, seconds) for c in calls)
         calls.append((rate, seconds))
@@ -22,7 +25,8 @@ def _fake(holds, calls, transient=()):
             "rate": rate, "seconds": seconds, "block": benchmark.block_samples(rate, block_period),
             "achieved_rate": rate, "deadline_misses": 0 if passed else 3, "load_mean": rate / 1e5,
             "load_p99": rate / 8e4, "load_max": rate / 6e4, "faults": [],
-            "overruns": 0 if passed or late_start else 2, "wake_late_max": 0.006 if late_start else 0.0,
+            "overruns": 0 if passed or late_start else 2, "stalls": 1 if late_start else 0,
+            "wake_late_max": 0.006 if late_start else 0.0,
             "realtime_priority": True, "passed": passed,
         }
     return probe
@@ -43,7 +47,7 @@ def test_the_search_climbs_the_ladder_bisects_and_confirms(monkeypatch):
     assert len(result["probes"]) == len(calls)
 
 
-def test_a_late_start_is_run_again_but_an_overrun_is_not(monkeypatch):
+def test_a_miss_of_the_machines_is_run_again_but_an_overrun_is_not(monkeypatch):
     calls = []
     monkeypatch.setattr(benchmark, "probe", _fake(lambda rate, s: rate <= 96_000, calls, transient=(20000.0,)))
     result = benchmark.search(confirm_seconds=5.0, progress=lambda text: None)
@@ -74,7 +78,7 @@ def test_one_real_probe_reports_what_it_ran():
     result = benchmark.probe(5000.0, 1.0, progress=lines.append, block_period=0.01)
     assert result["rate"] == 5000.0 and result["block"] == 50
     assert result["seconds"] == pytest.approx(1.0, abs=0.5)
-    assert result["faults"] == []
+    assert result["faults"] == [] and result["overruns"] >= 0 and result["stalls"] >= 0
     assert 0.0 < result["load_mean"] <= result["load_p99"] <= result["load_max"]
     assert result["passed"] == (result["deadline_misses"] == 0
                                 and abs(result["achieved_rate"] - 5000.0) <= 50.0)
