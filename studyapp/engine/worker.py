@@ -11,7 +11,7 @@ rate R (period T = B / R):
    t0 + k T;
 2. apply every queued command and MIDI control (block boundary), measuring
    the command-to-effect latency: from the command's ``sent`` time (or the
-   MIDI message's arrival) to the start of this block;
+   MIDI message's arrival) to its application, just before this block runs;
 3. run the loop for B samples; let the safety layer inspect them;
 4. push the audio to the sink, the telemetry to the ring, the status record.
 
@@ -157,7 +157,7 @@ class Worker:
         self.events.put(("fault", text, time.monotonic()))
 
     # commands -------------------------------------------------------------
-    def apply(self, command, started):
+    def apply(self, command):
         kind, value, sent = command
         try:
             if kind == "source":
@@ -192,12 +192,14 @@ class Worker:
         except (ValueError, TypeError) as exc:
             self.notice(f"command {kind}={value!r} ignored: {exc}")
             return None
-        latency = started - sent
+        # measured when applied, just before the block it affects: a message that arrived after
+        # the block's start time was taken but before the drain would otherwise read negative
+        latency = time.monotonic() - sent
         self.status.set(command_latency=latency,
                         command_latency_max=max(self.status.get("command_latency_max"), latency))
         return latency
 
-    def drain(self, started):
+    def drain(self):
         while True:
             try:
                 command = self.commands.get_nowait()
@@ -206,7 +208,7 @@ class Worker:
             except (EOFError, OSError):
                 self.stopping = True
                 break
-            self.apply(command, started)
+            self.apply(command)
         if self.midi is None:
             return
         for msg, arrived, block in self.midi.poll():
@@ -220,7 +222,7 @@ class Worker:
                 self.events.put(("learned", control, self.cmap.to_dict()[control]))
             action = self.actions.get(control)
             command = cmd.action_command(action, value, arrived) if action else None
-            latency = self.apply(command, started) if command else None
+            latency = self.apply(command) if command else None
             self.events.put(("control", control, value, arrived, latency, self.k - block, self.k))
 
     # the loop -------------------------------------------------------------
@@ -297,7 +299,7 @@ class Worker:
                 elif now - start_at > RESYNC:
                     t0, k0 = now, self.k
             started = time.monotonic()
-            self.drain(started)
+            self.drain()
             if self.stopping:
                 break
             deadline = t0 + (self.k - k0 + 1) * self.period
