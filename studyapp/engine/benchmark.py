@@ -32,16 +32,12 @@ import json
 import sys
 
 from studyapp import estimators
-from studyapp.engine.config import BLOCK_PERIOD
+from studyapp.engine.config import BLOCK_PERIOD, block_samples
 
 LADDER = (5000.0, 10000.0, 20000.0, 40000.0, 48000.0, 96000.0)
 PROBE_SECONDS = 3.0
 RESOLUTION = 0.05
 CHECK_RATE = 48000.0
-
-
-def block_samples(rate, block_period):
-    return max(1, int(round(rate * block_period)))
 
 
 def all_fourteen():

@@ -13,6 +13,11 @@ from studyapp.errors import ParameterError
 BLOCK_PERIOD = 0.002  # s: default block length; commands and MIDI act at block boundaries
 
 
+def block_samples(rate, period=BLOCK_PERIOD):
+    """Samples in a block of ``period`` seconds at ``rate`` (at least one)."""
+    return max(1, int(round(rate * period)))
+
+
 @dataclass
 class EngineConfig:
     rate: float = 5000.0  # haptic rate, Hz
@@ -39,7 +44,7 @@ class EngineConfig:
             if int(self.block) < 1:
                 raise ParameterError(f"block = {self.block}: allowed is a number of samples >= 1")
             return int(self.block)
-        return max(1, int(round(self.rate * BLOCK_PERIOD)))
+        return block_samples(self.rate)
 
     def sources(self):
         """The velocity sources a pad can select, in the scene's order."""
