@@ -55,7 +55,7 @@ from studyapp.estimators.dispatch import run_block as run_estimator_block
 from studyapp.estimators.dispatch import step_guarded
 from studyapp.estimators.registry import SPECS
 from studyapp.estimators.spec import validate_rate
-from studyapp.model import body, bow_table, bowed_string, calibration, hand, sensors, stability
+from studyapp.model import body, bow_table, bowed_string, calibration, contact_mic, hand, sensors, stability
 from studyapp.model import device as mechanics
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
 from studyapp.model.stability import StabilityMonitor
@@ -69,7 +69,7 @@ F0_RANGE = (20.0, 2000.0)
 C_GAIN, C_SCALE, C_FORCE_SCALE, C_BOWING, C_SOURCE, C_USE_ACC, C_USE_AUDIO, C_PEAK, C_BREAKAWAY = range(9)
 N_CONTROL = 9
 # loop state
-L_FAULT, L_FAULT_SAMPLE, L_PUSH = range(3)
+L_FAULT, L_FAULT_SAMPLE = range(2)
 FAULT_SENSOR, FAULT_ESTIMATE, FAULT_STRING, FAULT_DEVICE = 1, 2, 3, 4
 # output rows
 (O_POSITION, O_VELOCITY_LVT, O_ACCELERATION, O_VELOCITY_TRUE, O_ACCELERATION_TRUE,
@@ -151,7 +151,7 @@ def _fault(state, code, k):
 
 
 @njit(cache=True, inline="always")
-def bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp, ms, out):
+def bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out):
     """The string and the force for one sample of the source velocity; returns the unclamped force (N)."""
     if _bad(v_src):
         _fault(state, FAULT_ESTIMATE, k)
@@ -177,7 +177,6 @@ def bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp,
         for j in range(body_s.shape[0] // 2):
             audio = sensors.section_at(body_p, 5 * j, body_s, 2 * j, audio)
     friction = u / ctl[C_PEAK]
-    stability.observe(mp, ms, friction)
     out[O_SOURCE_VELOCITY, k] = v_src
     out[O_STRING_VELOCITY, k] = v_string / ctl[C_SCALE]
     out[O_AUDIO, k] = audio
@@ -201,8 +200,8 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
-              body_p, body_s, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
+def run_block(ctl, state, dp, ds, hp, hs, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
+              body_p, body_s, cp, cs, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
     """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
     n = target.shape[0]
     use_acc = ctl[C_USE_ACC] != 0.0
@@ -223,20 +222,24 @@ def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bri
             v_src = v
         else:
             v_src = v_m
-        f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp, ms, out)
+        f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out)
+        stability.observe(mp, ms, v)
+        if ctl[C_USE_AUDIO] != 0.0:
+            out[O_AUDIO, k] += contact_mic.step(cp, cs, a)
         f = mechanics.clamp_force(dp, ds, f)
-        f_hand = hand.force(hp, target[k], target_v[k], target_a[k], x, v, state[L_PUSH])
+        f_hand = hand.grip_force(hp, hs, x, v)
         if _bad(f) or _bad(f_hand):
             _fault(state, FAULT_DEVICE, k)
         if state[L_FAULT] != 0.0:
             f = 0.0
-            if _bad(f_hand) or _bad(state[L_PUSH]):
+            if _bad(f_hand) or _bad(hs[hand.HS_PUSH]):
                 f_hand = 0.0
-                state[L_PUSH] = 0.0
+                hs[:] = 0.0
                 ds[mechanics.DS_X] = 0.0
                 ds[mechanics.DS_V] = 0.0
                 ds[mechanics.DS_A] = 0.0
-        state[L_PUSH] = hand.learn_push(hp, state[L_PUSH], f)
+        hand.learn_push(hp, hs, f)
+        hand.advance(hp, hs, target[k], target_v[k], target_a[k], f_hand)
         out[O_POSITION, k] = x_m
         out[O_VELOCITY_LVT, k] = v_m
         out[O_ACCELERATION, k] = a_m
@@ -251,7 +254,7 @@ def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bri
 
 @njit(cache=True, error_model="numpy")
 def run_external_sample(ctl, state, k, dp, ds, kinds, est_s, est_p, sp, ss, bridge, nut,
-                        body_p, body_s, mp, ms, x_m, a_m, v_m, out, est_out):
+                        body_p, body_s, cp, cs, mp, ms, x_m, a_m, v_m, out, est_out):
     """One sample for a device outside the simulation: returns the clamped force command."""
     if _bad(x_m) or _bad(v_m) or _bad(a_m):
         _fault(state, FAULT_SENSOR, k)
@@ -259,7 +262,10 @@ def run_external_sample(ctl, state, k, dp, ds, kinds, est_s, est_p, sp, ss, brid
         est_out[e, k] = step_guarded(kinds[e], est_s[e], est_p[e], x_m, a_m, v_m)
     src = int(ctl[C_SOURCE])
     v_src = est_out[src, k] if src >= 0 else v_m
-    f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, mp, ms, out)
+    f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out)
+    stability.observe(mp, ms, v_m)
+    if ctl[C_USE_AUDIO] != 0.0:
+        out[O_AUDIO, k] += contact_mic.step(cp, cs, a_m)
     f = mechanics.clamp_force(dp, ds, f)
     if state[L_FAULT] != 0.0 or _bad(f):
         f = 0.0
@@ -300,10 +306,10 @@ class ClosedLoop:
         self.simulated = isinstance(dev, mechanics.SimulatedDevice)
         if getattr(dev, "rate", self.rate) != self.rate:
             raise ParameterError(f"device rate {dev.rate:g} Hz differs from the loop rate {self.rate:g} Hz")
-        self.string = bowed_string.StringDesign(self.rate, f0)
+        self.string = bowed_string.StringDesign(self.rate, f0, nut_reflection=calibration.NUT_REFLECTION)
         self.sensor_spec = sensors.SensorSpec()
         self.hand = hand.HandImpedance(calibration.HAND_MASS, calibration.HAND_STIFFNESS, calibration.HAND_DAMPING,
-                                       calibration.HAND_REACTION)
+                                       calibration.GRIP_STIFFNESS, calibration.GRIP_DAMPING, calibration.HAND_REACTION)
         self.velocity_scale = calibration.VELOCITY_SCALE
         use_acc = ("acceleration" in self.reads) if config.accelerometer is None else bool(config.accelerometer)
         self._ctl = np.zeros(N_CONTROL)
@@ -314,17 +320,19 @@ class ClosedLoop:
         self._ctl[C_BOWING] = 1.0
         self._ctl[C_USE_ACC] = 1.0 if use_acc else 0.0
         self._ctl[C_USE_AUDIO] = 1.0 if config.audio else 0.0
-        self._state = np.zeros(3)
-        # the hand's mass moves with the handle (hand.py)
-        self._dp = dev.params(extra_mass=self.hand.mass) if self.simulated else _limits_params(self.rate, dev.limits)
+        self._state = np.zeros(2)
+        self._dp = dev.params() if self.simulated else _limits_params(self.rate, dev.limits)
         self._ds = np.zeros(mechanics.N_STATE)
-        self._hp = self.hand.params(self._dp[mechanics.DP_MASS], self.rate) if self.simulated else np.zeros(4)
+        self._hp = self.hand.params(self._dp[mechanics.DP_MASS], self.rate)
+        self._hs = np.zeros(hand.N_STATE)
         self._snp = self.sensor_spec.params(self.rate)
         self._sns = np.zeros(sensors.N_STATE)
         self._sp = self.string.params()
         self._ss, self._bridge, self._nut = self.string.new_state()
         self._body = body.sections(self.rate).ravel() if config.audio else np.zeros(0)
         self._body_s = np.zeros(2 * (self._body.shape[0] // 5))
+        self._mic = contact_mic.params(self.rate)
+        self._mic_s = contact_mic.new_state()
         seeds = np.random.SeedSequence(int(config.seed)).spawn(3)
         self._rng_x, self._rng_v, self._rng_a = (np.random.default_rng(s) for s in seeds)
         self._sample = 0
@@ -391,6 +399,7 @@ class ClosedLoop:
         self._bridge[:] = 0.0
         self._nut[:] = 0.0
         self._body_s[:] = 0.0
+        self._mic_s[:] = 0.0
         self.monitor.reset()
 
     @property
@@ -430,9 +439,9 @@ class ClosedLoop:
         nx = self._rng_x.standard_normal(n)
         nv = self._rng_v.standard_normal(n)
         na = self._rng_a.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
-        run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._snp, self._sns,
+        run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._hs, self._snp, self._sns,
                   self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss,
-                  self._bridge, self._nut, self._body, self._body_s, self.monitor.params, self.monitor.state,
+                  self._bridge, self._nut, self._body, self._body_s, self._mic, self._mic_s, self.monitor.params, self.monitor.state,
                   np.ascontiguousarray(target), np.ascontiguousarray(target_v), np.ascontiguousarray(target_a),
                   nx, nv, na, out, est)
 
@@ -442,7 +451,8 @@ class ClosedLoop:
             x_m, a_m, v_m = dev.read_sensors()
             f = run_external_sample(self._ctl, self._state, k, self._dp, self._ds, self.bank.kinds,
                                     self.bank.states, self.bank.params, self._sp, self._ss, self._bridge,
-                                    self._nut, self._body, self._body_s, self.monitor.params, self.monitor.state,
+                                    self._nut, self._body, self._body_s, self._mic, self._mic_s, self.monitor.params,
+                                    self.monitor.state,
                                     float(x_m), float(a_m), float(v_m),
                                     out, est)
             dev.write_force(f)

@@ -8,39 +8,43 @@ What breakdown is in this model. While the bow sticks, the string pushes on
 the handle through the junction (F = -G rho(v_delta) v_delta, with rho at its
 0.98 clip), and the string beyond the bow is a resonator: with the sticking
 bow as its fixed end, the nut-side segment rings at about f0 / (1 - beta)
-(168 Hz for the default 147 Hz string). A velocity source that lags the
+(112 Hz for the default 98 Hz string). A velocity source that lags the
 handle's true velocity turns this coupling from a brake into a drive, and past
 a gain the loop oscillates by itself: the force swings between +F_max and
--F_max at that frequency (the handle buzzes) and the string near the bow rings
-with it (the sound distorts). A healthy loop never does this: the friction of
-a bowed string keeps one sign, opposing the stroke, with a ripple at the
-string's period; a held handle feels almost nothing.
+-F_max at that frequency, the handle buzzes (tens of mm/s) and the string
+near the bow rings with it (the sound distorts; the handle's buzz is heard
+too, loop.py).
 
-Criterion (pinned by tests/model/test_model_stability.py). With
-r = F / F_max = -rho(v_delta) v_delta / max|rho v| (the loop's "friction"
-output, in [-1, 1], defined even when F_max = 0), high-passed at 40 Hz:
+Criterion, on absolute quantities (pinned by tests/model/test_model_stability.py).
+The monitor watches the handle's velocity v (m/s: the simulation's true
+velocity, or a real device's tachometer), high-passed at 40 Hz so that strokes
+and tremor do not count:
 
-    level = RMS of r over the last WINDOW = 0.25 s          (``score``)
-    e(t)  = RMS of r over the last ENVELOPE = 12 ms (about two oscillation periods)
+    level = RMS of v over the last WINDOW = 0.25 s                 (``score``, m/s)
+    e(t)  = RMS of v over the last ENVELOPE = 12 ms (about one oscillation period)
     cv    = standard deviation / mean of e over the last 0.25 s
-    broken  = level > LEVEL_MIN = 0.3  and  cv < CV_MAX = 0.15
+    broken  = level > VIBRATION_MIN = 5 mm/s  and  cv < CV_MAX = 0.15
 
-A self-sustained oscillation is large and steady: it saturates between about
--F_max and +F_max (level 0.4-0.9) with an envelope that hardly moves
-(cv 0.01-0.1). The two things it must not be confused with are healthy
-bowing, whose friction keeps one sign (level 0.1-0.2), and estimator noise,
-which the string's resonance filters into a narrow-band random force: its
-envelope fluctuates like a Rayleigh variable (cv 0.2-0.35 measured) even when
-its level is high. An oscillation that starts is itself an envelope change:
-cv falls below CV_MAX about a second after the onset, so the verdict lags
-the onset by about that long (a participant also needs a moment). Noise so large that it saturates the bow table at any gain
-(BDIFF at 5 kHz) is steady too, and is judged broken: that string never
-sounds like a bowed string.
+A self-sustained oscillation is large and steady: the force saturates at
++-F_max, so the handle's buzz is about F_max / (m w) (tens of mm/s at a few
+newtons on the 50 g handle) with an envelope that hardly moves (cv 0.01-0.1).
+What it must not be confused with: estimator noise, whose force is random and
+whose envelope fluctuates like a Rayleigh variable (cv 0.2-0.35) even when
+large; bowing, whose stick-slip ripple changes with every stroke; and, above
+all, anything at a low gain. An earlier criterion on F / F_max read estimator
+noise the same at every gain and flagged LEVANT and KALMAN "broken" at
+0.001 N on some seeds; in metres per second, a handle pushed by millinewtons
+cannot reach VIBRATION_MIN. VIBRATION_MIN sits a decade above the held
+handle's band-passed velocity below breakdown and below the buzz of the
+earliest breakdowns (docs/breakdown.md). An oscillation that starts is itself
+an envelope change: cv falls below CV_MAX some tenths of a second after the
+onset, so the verdict lags the onset by about that long (a participant also
+needs a moment).
 
-Caveat (what the model shows): regular bowing at the strokes' speed masks the
-oscillation, because every slip restarts the sticking phase in which it
-grows; it appears when the bow rests or moves slowly. Breakdown searches
-(``calibration.breakdown_fmax``) therefore hold the handle, with tremor.
+Caveat (what the model shows): regular bowing masks the oscillation, because
+every slip restarts the sticking phase in which it grows; it appears when the
+bow rests or moves slowly. Breakdown searches (``studyapp.model.breakdown``)
+therefore hold the handle, with tremor.
 """
 
 import math
@@ -54,7 +58,7 @@ from studyapp.model.sensors import section_at
 WINDOW = 0.25  # s
 ENVELOPE = 0.012  # s
 HIGHPASS_HZ = 40.0
-LEVEL_MIN = 0.3
+VIBRATION_MIN = 5e-3  # m/s
 CV_MAX = 0.15
 
 # parameter vector: high-pass section (5), long and short smoothing factors
@@ -66,11 +70,11 @@ N_STATE = 6
 
 
 @njit(cache=True, inline="always")
-def observe(mp, ms, r):
-    """Advance the monitor by one sample of the friction ratio ``r`` (non-finite counts as 0)."""
-    if not np.isfinite(r):
-        r = 0.0
-    y = section_at(mp, MP_HP, ms, MS_HP, r)
+def observe(mp, ms, v):
+    """Advance the monitor by one sample of the handle's velocity ``v`` (m/s; non-finite counts as 0)."""
+    if not np.isfinite(v):
+        v = 0.0
+    y = section_at(mp, MP_HP, ms, MS_HP, v)
     sq = y * y
     a = mp[MP_LONG]
     ms[MS_MS] += a * (sq - ms[MS_MS])
@@ -81,10 +85,10 @@ def observe(mp, ms, r):
 
 
 @njit(cache=True)
-def observe_block(mp, ms, friction, level, cv):
+def observe_block(mp, ms, velocity, level, cv):
     """``observe`` over a block, writing the running level and cv per sample."""
-    for k in range(friction.shape[0]):
-        observe(mp, ms, friction[k])
+    for k in range(velocity.shape[0]):
+        observe(mp, ms, velocity[k])
         level[k], cv[k] = verdict(ms)
 
 
@@ -99,7 +103,7 @@ def verdict(ms):
 
 
 class StabilityMonitor:
-    """``.broken``, ``.score`` (= ``.level``), ``.cv``; the loop advances ``.state`` sample by sample."""
+    """``.broken``, ``.score`` (= ``.level``, m/s), ``.cv``; the loop advances ``.state`` sample by sample."""
 
     def __init__(self, rate):
         self.rate = float(rate)
@@ -124,12 +128,12 @@ class StabilityMonitor:
     def judge(self):
         """Update ``level``, ``cv`` and ``broken`` from the state (the loop calls this after each block)."""
         self.level, self.cv = verdict(self.state)
-        self.broken = bool(self.level > LEVEL_MIN and self.cv < CV_MAX)
+        self.broken = bool(self.level > VIBRATION_MIN and self.cv < CV_MAX)
         return self.broken
 
-    def measure(self, friction):
-        """Feed a block of friction ratios (e.g. from a recording); returns per-sample (level, cv)."""
-        r = np.ascontiguousarray(friction, dtype=np.float64)
+    def measure(self, velocity):
+        """Feed a block of handle velocities (m/s, e.g. from a recording); returns per-sample (level, cv)."""
+        r = np.ascontiguousarray(velocity, dtype=np.float64)
         level = np.empty_like(r)
         cv = np.empty_like(r)
         observe_block(self.params, self.state, r, level, cv)
