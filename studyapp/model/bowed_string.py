@@ -43,8 +43,8 @@ from numba import njit
 from studyapp.model import bow_table
 
 # parameter vector layout
-P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET, P_NUT = range(7)
-N_PARAMS = 7
+P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET = range(6)
+N_PARAMS = 6
 # state vector layout
 S_WRITE, S_LOSS_Y = range(2)
 N_STATE = 2
@@ -63,7 +63,6 @@ class StringDesign:
     offset: float = 0.0
     loss: float = 0.95  # STK stringFilter_ gain: the round trip's DC gain
     f_loss: float = 2100.0  # Hz, STK's loss corner at its design rate 22.05 kHz
-    nut_reflection: float = 1.0  # |reflection| at the nut (frequency-independent), besides the bridge's loss
 
     def __post_init__(self):
         if not (0.0 < self.beta < 1.0):
@@ -98,7 +97,6 @@ class StringDesign:
         out[P_LOSS_B0] = self.loss * (1.0 - p)
         out[P_LOSS_A1] = p
         out[P_SLOPE], out[P_OFFSET] = self.slope, self.offset
-        out[P_NUT] = self.nut_reflection
         return out
 
     def peak_friction(self):
@@ -140,7 +138,7 @@ def step(p, s, bridge, nut, v_bow, bowing):
     y = p[P_LOSS_B0] * v_bridge + p[P_LOSS_A1] * s[S_LOSS_Y]
     s[S_LOSS_Y] = y
     bridge_refl = -y
-    nut_refl = -p[P_NUT] * read_line(nut, write, p[P_DN])
+    nut_refl = -read_line(nut, write, p[P_DN])
     v_h = bridge_refl + nut_refl
     v_delta = v_bow - v_h
     u = 0.0

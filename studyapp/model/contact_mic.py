@@ -27,7 +27,7 @@ from studyapp.estimators.spec import NYQUIST_FRACTION
 from studyapp.model.sensors import section_at
 
 HIGHPASS_HZ = 60.0
-GAIN = 2e-4  # audio units per m/s^2
+GAIN = 2e-3  # audio units per m/s^2
 
 
 def params(rate, gain=GAIN):

@@ -67,11 +67,11 @@ class SimulatedDevice:
     mass: float
     limits: DeviceLimits = DeviceLimits()
 
-    def params(self):
-        """Packed for the compiled loop."""
+    def params(self, extra_mass=0.0):
+        """Packed for the compiled loop; ``extra_mass`` (the hand's) moves with the handle."""
         p = np.zeros(N_PARAMS)
         p[DP_T] = 1.0 / self.rate
-        p[DP_MASS] = self.mass
+        p[DP_MASS] = self.mass + extra_mass
         p[DP_TRAVEL] = self.limits.travel
         p[DP_IMPULSIVE] = self.limits.impulsive
         p[DP_SUSTAINED] = self.limits.sustained

@@ -69,7 +69,7 @@ F0_RANGE = (20.0, 2000.0)
 C_GAIN, C_SCALE, C_FORCE_SCALE, C_BOWING, C_SOURCE, C_USE_ACC, C_USE_AUDIO, C_PEAK, C_BREAKAWAY = range(9)
 N_CONTROL = 9
 # loop state
-L_FAULT, L_FAULT_SAMPLE = range(2)
+L_FAULT, L_FAULT_SAMPLE, L_PUSH = range(3)
 FAULT_SENSOR, FAULT_ESTIMATE, FAULT_STRING, FAULT_DEVICE = 1, 2, 3, 4
 # output rows
 (O_POSITION, O_VELOCITY_LVT, O_ACCELERATION, O_VELOCITY_TRUE, O_ACCELERATION_TRUE,
@@ -200,7 +200,7 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_block(ctl, state, dp, ds, hp, hs, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
+def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
               body_p, body_s, cp, cs, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
     """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
     n = target.shape[0]
@@ -227,19 +227,18 @@ def run_block(ctl, state, dp, ds, hp, hs, snp, sns, kinds, est_s, est_p, sp, ss,
         if ctl[C_USE_AUDIO] != 0.0:
             out[O_AUDIO, k] += contact_mic.step(cp, cs, a)
         f = mechanics.clamp_force(dp, ds, f)
-        f_hand = hand.grip_force(hp, hs, x, v)
+        f_hand = hand.force(hp, target[k], target_v[k], target_a[k], x, v, state[L_PUSH])
         if _bad(f) or _bad(f_hand):
             _fault(state, FAULT_DEVICE, k)
         if state[L_FAULT] != 0.0:
             f = 0.0
-            if _bad(f_hand) or _bad(hs[hand.HS_PUSH]):
+            if _bad(f_hand) or _bad(state[L_PUSH]):
                 f_hand = 0.0
-                hs[:] = 0.0
+                state[L_PUSH] = 0.0
                 ds[mechanics.DS_X] = 0.0
                 ds[mechanics.DS_V] = 0.0
                 ds[mechanics.DS_A] = 0.0
-        hand.learn_push(hp, hs, f)
-        hand.advance(hp, hs, target[k], target_v[k], target_a[k], f_hand)
+        state[L_PUSH] = hand.learn_push(hp, state[L_PUSH], f)
         out[O_POSITION, k] = x_m
         out[O_VELOCITY_LVT, k] = v_m
         out[O_ACCELERATION, k] = a_m
@@ -306,10 +305,10 @@ class ClosedLoop:
         self.simulated = isinstance(dev, mechanics.SimulatedDevice)
         if getattr(dev, "rate", self.rate) != self.rate:
             raise ParameterError(f"device rate {dev.rate:g} Hz differs from the loop rate {self.rate:g} Hz")
-        self.string = bowed_string.StringDesign(self.rate, f0, nut_reflection=calibration.NUT_REFLECTION)
+        self.string = bowed_string.StringDesign(self.rate, f0)
         self.sensor_spec = sensors.SensorSpec()
         self.hand = hand.HandImpedance(calibration.HAND_MASS, calibration.HAND_STIFFNESS, calibration.HAND_DAMPING,
-                                       calibration.GRIP_STIFFNESS, calibration.GRIP_DAMPING, calibration.HAND_REACTION)
+                                       calibration.HAND_REACTION)
         self.velocity_scale = calibration.VELOCITY_SCALE
         use_acc = ("acceleration" in self.reads) if config.accelerometer is None else bool(config.accelerometer)
         self._ctl = np.zeros(N_CONTROL)
@@ -320,11 +319,11 @@ class ClosedLoop:
         self._ctl[C_BOWING] = 1.0
         self._ctl[C_USE_ACC] = 1.0 if use_acc else 0.0
         self._ctl[C_USE_AUDIO] = 1.0 if config.audio else 0.0
-        self._state = np.zeros(2)
-        self._dp = dev.params() if self.simulated else _limits_params(self.rate, dev.limits)
+        self._state = np.zeros(3)
+        # the hand's mass moves with the handle (hand.py)
+        self._dp = dev.params(extra_mass=self.hand.mass) if self.simulated else _limits_params(self.rate, dev.limits)
         self._ds = np.zeros(mechanics.N_STATE)
-        self._hp = self.hand.params(self._dp[mechanics.DP_MASS], self.rate)
-        self._hs = np.zeros(hand.N_STATE)
+        self._hp = self.hand.params(self._dp[mechanics.DP_MASS], self.rate) if self.simulated else np.zeros(4)
         self._snp = self.sensor_spec.params(self.rate)
         self._sns = np.zeros(sensors.N_STATE)
         self._sp = self.string.params()
@@ -439,7 +438,7 @@ class ClosedLoop:
         nx = self._rng_x.standard_normal(n)
         nv = self._rng_v.standard_normal(n)
         na = self._rng_a.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
-        run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._hs, self._snp, self._sns,
+        run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._snp, self._sns,
                   self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss,
                   self._bridge, self._nut, self._body, self._body_s, self._mic, self._mic_s, self.monitor.params, self.monitor.state,
                   np.ascontiguousarray(target), np.ascontiguousarray(target_v), np.ascontiguousarray(target_a),

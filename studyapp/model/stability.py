@@ -8,10 +8,10 @@ What breakdown is in this model. While the bow sticks, the string pushes on
 the handle through the junction (F = -G rho(v_delta) v_delta, with rho at its
 0.98 clip), and the string beyond the bow is a resonator: with the sticking
 bow as its fixed end, the nut-side segment rings at about f0 / (1 - beta)
-(112 Hz for the default 98 Hz string). A velocity source that lags the
+(168 Hz for the default 147 Hz string). A velocity source that lags the
 handle's true velocity turns this coupling from a brake into a drive, and past
 a gain the loop oscillates by itself: the force swings between +F_max and
--F_max at that frequency, the handle buzzes (tens of mm/s) and the string
+-F_max at that frequency, the handle buzzes (mm/s) and the string
 near the bow rings with it (the sound distorts; the handle's buzz is heard
 too, loop.py).
 
@@ -23,20 +23,21 @@ and tremor do not count:
     level = RMS of v over the last WINDOW = 0.25 s                 (``score``, m/s)
     e(t)  = RMS of v over the last ENVELOPE = 12 ms (about one oscillation period)
     cv    = standard deviation / mean of e over the last 0.25 s
-    broken  = level > VIBRATION_MIN = 5 mm/s  and  cv < CV_MAX = 0.15
+    broken  = level > VIBRATION_MIN = 1 mm/s  and  cv < CV_MAX = 0.15
 
 A self-sustained oscillation is large and steady: the force saturates at
-+-F_max, so the handle's buzz is about F_max / (m w) (tens of mm/s at a few
-newtons on the 50 g handle) with an envelope that hardly moves (cv 0.01-0.1).
++-F_max, so the handle's buzz is about F_max / (m w) (3 mm/s at 5 N on the
+1 kg of handle and hand) with an envelope that hardly moves (cv 0.01-0.1).
 What it must not be confused with: estimator noise, whose force is random and
 whose envelope fluctuates like a Rayleigh variable (cv 0.2-0.35) even when
 large; bowing, whose stick-slip ripple changes with every stroke; and, above
 all, anything at a low gain. An earlier criterion on F / F_max read estimator
 noise the same at every gain and flagged LEVANT and KALMAN "broken" at
 0.001 N on some seeds; in metres per second, a handle pushed by millinewtons
-cannot reach VIBRATION_MIN. VIBRATION_MIN sits a decade above the held
-handle's band-passed velocity below breakdown and below the buzz of the
-earliest breakdowns (docs/breakdown.md). An oscillation that starts is itself
+cannot reach VIBRATION_MIN. VIBRATION_MIN sits 25 times above the held
+handle's band-passed velocity at low gain (0.04 mm/s: the tremor's leak
+through the high-pass) and below the buzz of the breakdowns (LOWPASS: 3 mm/s
+at 5 N; docs/breakdown.md). An oscillation that starts is itself
 an envelope change: cv falls below CV_MAX some tenths of a second after the
 onset, so the verdict lags the onset by about that long (a participant also
 needs a moment).
@@ -58,7 +59,7 @@ from studyapp.model.sensors import section_at
 WINDOW = 0.25  # s
 ENVELOPE = 0.012  # s
 HIGHPASS_HZ = 40.0
-VIBRATION_MIN = 5e-3  # m/s
+VIBRATION_MIN = 1e-3  # m/s
 CV_MAX = 0.15
 
 # parameter vector: high-pass section (5), long and short smoothing factors
