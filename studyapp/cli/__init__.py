@@ -23,6 +23,7 @@ COMMANDS = [
     "estimate",
     "simulate",
     "simulate_set",
+    "breakdown",
     "optimise",
     "evaluate",
     "tradeoff",

@@ -38,7 +38,7 @@ adjustment task each F_max step is probed for ``probe_time`` = 1.2 s, longer
 than the stability monitor needs to call a breakdown (about 1 s after the
 oscillation starts, studyapp.model.stability): with shorter probes the
 participant kept raising F_max past breakdown before hearing it, and confirmed
-two to three times above the F_max that calibration.breakdown_fmax finds.
+two to three times above the F_max that model.breakdown.breakdown_fmax finds.
 """
 
 import math

@@ -79,56 +79,8 @@ STROKE_RAMP = 0.03
 STROKE_DWELL = 0.1
 VALIDATION_STROKES = dict(amplitude=0.007, speed=0.045, ramp=0.04, dwell=0.15)
 
-BREAKDOWN_SETTLE = 0.25  # s before the monitor's verdict counts (its window)
-BREAKDOWN_BLOCK = 0.05  # s
-
 
 def describe():
     """The constants as a dict (stored in recordings' metadata)."""
     return {k.lower(): v for k, v in globals().items() if k.isupper() and not k.startswith("BREAKDOWN")}
 
-
-def is_broken(source, fmax, rate=5000.0, gesture="hold", duration=4.0, seed=0, estimators=None, f0=None):
-    """Whether the stability monitor flags breakdown within ``duration`` s at ``fmax`` N."""
-    from studyapp.model.loop import ClosedLoop, LoopConfig
-
-    estimators = dict(estimators or {})
-    if source not in ("LVT", "TRUE") and source not in estimators:
-        estimators[source] = {}
-    loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
-                                 f0=F0 if f0 is None else f0, seed=seed, audio=False))
-    block = max(1, int(round(BREAKDOWN_BLOCK * loop.rate)))
-    settle = int(round(BREAKDOWN_SETTLE * loop.rate))
-    done = 0
-    total = int(round(duration * loop.rate))
-    while done < total:
-        loop.run(block)
-        done += block
-        if loop.fault is not None or (done >= settle and loop.monitor.broken):
-            return True
-    return False
-
-
-def breakdown_fmax(source, rate=5000.0, gesture="hold", duration=4.0, low=0.05, high=200.0, tolerance=0.02,
-                   seed=0, estimators=None, f0=None):
-    """The largest F_max (N) at which ``source`` stays stable, by bisection on a log scale.
-
-    Stable means: the stability monitor (stability.py) does not flag breakdown
-    within ``duration`` s with the hand holding the handle (``gesture="hold"``,
-    with tremor). Returns ``low`` if even ``low`` breaks down and ``inf`` if
-    ``high`` does not; otherwise the geometric midpoint of the final bracket,
-    whose width is at most ``tolerance`` (relative).
-    """
-    kwargs = dict(rate=rate, gesture=gesture, duration=duration, seed=seed, estimators=estimators, f0=f0)
-    if is_broken(source, low, **kwargs):
-        return low
-    if not is_broken(source, high, **kwargs):
-        return float("inf")
-    lo, hi = low, high
-    while hi / lo > 1.0 + tolerance:
-        mid = float(np.sqrt(lo * hi))
-        if is_broken(source, mid, **kwargs):
-            hi = mid
-        else:
-            lo = mid
-    return float(np.sqrt(lo * hi))

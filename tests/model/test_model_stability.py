@@ -5,7 +5,7 @@ import pytest
 from scipy import signal
 
 from studyapp.model import stability
-from studyapp.model.calibration import breakdown_fmax, is_broken
+from studyapp.model.breakdown import breakdown_fmax, is_broken
 from studyapp.model.loop import ClosedLoop, LoopConfig
 
 RATE = 5000.0

@@ -1,0 +1,185 @@
+"""``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--gesture hold|strokes] [--json] [-o FILE]``.
+
+Breakdown F_max (studyapp.model.breakdown) for one source or every source,
+over seeds 0..N-1. Prints a table (or with ``--json`` one JSON object for
+``--source``, a list of them for ``--all``); ``-o`` also writes it, by suffix:
+``.csv`` (one row per source, the seeds' values ';'-joined in
+``fmax_per_seed``), ``.md`` (the same table, headed by the date and the
+command that regenerates it) or ``.json``. Stable up to the search's 200 N is
+``inf`` in CSV, ``null`` in JSON and "> 200" in Markdown; broken already at
+0.05 N is 0.05, "<= 0.05" in Markdown. Progress goes to stderr.
+"""
+
+SUFFIXES = (".csv", ".md", ".json")
+COLUMNS = ("source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed")
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "breakdown",
+        help="breakdown F_max of velocity sources over seeds (the adjustment task's measure, Fig. 7)",
+        description="Find the largest F_max at which each velocity source keeps the simulated loop stable, "
+                    "for seeds 0..N-1.",
+    )
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument("--source", metavar="NAME", help="an estimator name, LVT (the tachometer) or TRUE")
+    which.add_argument("--all", action="store_true", help="every estimator, LVT and TRUE")
+    p.add_argument("--rate", type=float, default=5000.0, metavar="HZ", help="sample rate in Hz, 1000..96000 (default 5000)")
+    p.add_argument("--seeds", type=int, default=5, metavar="N", help="seeds 0..N-1, N at most 100 (default 5)")
+    p.add_argument("--gesture", default="hold", metavar="hold|strokes",
+                   help="hold (the hand at rest, with tremor) or strokes (default hold)")
+    p.add_argument("--duration", type=float, default=4.0, metavar="SECONDS",
+                   help="length of each trial, 0.5..60 s (default 4; shorter misses late onsets)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of the table")
+    p.add_argument("-o", "--output", metavar="FILE", help="also write the result: .csv, .md or .json")
+    p.set_defaults(func=run)
+
+
+def check_output(path):
+    """Raise ``UserError`` unless ``path`` can be written (call before the search)."""
+    import os
+    from pathlib import Path
+
+    from studyapp.errors import UserError
+
+    path = Path(path)
+    if path.suffix.lower() not in SUFFIXES:
+        raise UserError(f"-o {path}: allowed suffixes are {', '.join(SUFFIXES)}")
+    if path.is_dir():
+        raise UserError(f"-o {path}: is a directory; give a file name")
+    parent = path.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
+        raise UserError(f"-o {path}: cannot create a file in {parent}")
+
+
+def command_line(args):
+    """The canonical command that reproduces ``args``, every setting spelled out."""
+    import shlex
+
+    which = "--all" if args.all else f"--source {shlex.quote(args.source)}"
+    words = f"studyapp breakdown {which} --rate {args.rate:g} --seeds {args.seeds} --gesture {args.gesture}"
+    words += f" --duration {args.duration:g}"
+    if args.output:
+        words += f" -o {shlex.quote(str(args.output))}"
+    return words
+
+
+def run(args):
+    import json
+    import sys
+
+    from studyapp.estimators.spec import validate_rate
+    from studyapp.model import breakdown
+
+    names = breakdown.sources() if args.all else [breakdown.check_source(args.source, "--source")]
+    validate_rate(args.rate)
+    breakdown.check_seeds(args.seeds, "--seeds")
+    breakdown.check_gesture(args.gesture, "--gesture")
+    breakdown.check_duration(args.duration, "--duration")
+    if args.output:
+        check_output(args.output)
+
+    results = []
+    for i, name in enumerate(names):
+        prefix = f"breakdown [{i + 1}/{len(names)}] {name}" if args.all else f"breakdown {name}"
+
+        def progress(seed, trial, fmax, verdict, prefix=prefix):
+            # one line per seed; the trials overwrite each other on it
+            if verdict == "result":
+                line = f"{prefix}: seed {seed + 1}/{args.seeds}: F_max {_number(fmax)} N ({trial} trials)"
+                print("\r" + line.ljust(72), file=sys.stderr, flush=True)
+            else:
+                line = f"{prefix}: seed {seed + 1}/{args.seeds}, trial {trial}: {fmax:.3g} N {verdict}"
+                print("\r" + line.ljust(72), end="", file=sys.stderr, flush=True)
+
+        results.append(breakdown.breakdown_over_seeds(name, rate=args.rate, seeds=args.seeds, gesture=args.gesture,
+                                                      duration=args.duration, progress=progress))
+
+    if args.json:
+        json.dump(_json(results if args.all else results[0]), sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        sys.stdout.write(text_table(results))
+    if args.output:
+        write(args.output, results, args)
+        print(f"wrote {args.output} ({len(results)} source{'s' if len(results) > 1 else ''})", file=sys.stderr)
+    return 0
+
+
+def write(path, results, args):
+    import csv
+    import json
+    from pathlib import Path
+
+    from studyapp.atomic import atomic_open
+
+    suffix = Path(path).suffix.lower()
+    with atomic_open(path, "w", newline="", encoding="utf-8") as f:
+        if suffix == ".csv":
+            writer = csv.writer(f, lineterminator="\n")
+            writer.writerow(COLUMNS)
+            writer.writerows([_cells(r, repr) for r in results])
+        elif suffix == ".md":
+            f.write(markdown(results, command_line(args)))
+        else:
+            json.dump(_json(results if args.all else results[0]), f, indent=1, allow_nan=False)
+            f.write("\n")
+
+
+def _json(value):
+    """``value`` with inf (stable to the search's top) as null, since JSON has no infinity."""
+    import math
+
+    if isinstance(value, float) and math.isinf(value):
+        return None
+    if isinstance(value, list):
+        return [_json(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _json(v) for k, v in value.items()}
+    return value
+
+
+def _number(value):
+    """F_max for people: 3 significant figures (the search's tolerance is 2 %), the search's bounds as bounds."""
+    from studyapp.model.breakdown import HIGH, LOW
+
+    if value == float("inf"):
+        return f"> {HIGH:g}"
+    if value <= LOW:
+        return f"<= {LOW:g}"
+    return f"{value:.3g}"
+
+
+def _cells(result, fmt):
+    """A result as the row of ``COLUMNS``, F_max values written with ``fmt``."""
+    return [result["source"], f"{result['rate']:g}", result["gesture"], str(result["seeds"]),
+            fmt(result["fmax_median"]), fmt(result["fmax_min"]), fmt(result["fmax_max"]),
+            ";".join(fmt(v) for v in result["fmax"])]
+
+
+def text_table(results):
+    rows = [COLUMNS] + [_cells(r, _number) for r in results]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(COLUMNS) - 1)]
+    return "".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[-1] + "\n" for row in rows)
+
+
+def markdown(results, command):
+    import datetime
+
+    lines = [
+        "# Breakdown F_max",
+        "",
+        f"Generated on {datetime.date.today().isoformat()} by `{command}`.",
+        "",
+        "The largest F_max (N) at which each velocity source keeps the simulated loop stable, judged by the "
+        "stability monitor (`studyapp.model.breakdown`; see [model.md](model.md)). One search per seed (the sensors' "
+        "noise and the hand's tremor); median, min and max over the seeds, then each seed's value. "
+        f"\"{_number(float('inf'))}\": stable up to the search's top; \"{_number(0.0)}\": broken at its bottom.",
+        "",
+        "| " + " | ".join(COLUMNS) + " |",
+        "|" + " --- |" * len(COLUMNS),
+    ]
+    lines += ["| " + " | ".join(_cells(r, _number)).replace(";", "; ") + " |" for r in results]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,169 @@
+"""Breakdown F_max: the largest friction gain at which a velocity source keeps the loop stable.
+
+The paper's adjustment task (Sec. 8.2-8.3, Fig. 7) asks for "the maximum
+displayable friction gain F_max such that the display remains stable". This
+is the simulated world's answer, judged by the stability monitor
+(stability.py) instead of a participant.
+
+One trial, ``is_broken(source, f)``: the closed loop (loop.py) runs for
+``duration`` s at F_max = f with ``source`` as the velocity in the loop; it is
+broken if the loop faults, or if the monitor flags breakdown once its
+SETTLE = 0.25 s window has filled (checked every BLOCK = 0.05 s).
+
+The search, ``breakdown_fmax``, assumes broken(f) is monotonic in f and
+bisects log f. It starts from the bracket [LOW, HIGH] = [0.05, 200] N (200 N:
+the loop's F_max limit, the motors' impulsive limit): with lo stable and hi
+broken it tries the geometric midpoint sqrt(lo hi) and keeps the half that
+still brackets the edge, until hi / lo <= 1 + tolerance, and returns
+sqrt(lo hi), within a factor sqrt(1 + tolerance) of the edge. That takes
+2 + ceil(log2(ln(HIGH / LOW) / ln(1 + tolerance))) trials (11 at tolerance
+0.02). It returns LOW when LOW already breaks and inf when HIGH does not.
+
+Over seeds, ``breakdown_over_seeds``: seed k (k = 0..N-1) draws the sensors'
+noise and the hand's tremor, so each seed is one run of the same world, like
+one trial of the paper's six per participant. The result gives every seed's
+F_max and their median (for even N the mean of the middle two, numpy.median),
+minimum and maximum; inf (stable to 200 N) counts as the largest value.
+"""
+
+import math
+
+import numpy as np
+
+from studyapp.errors import ParameterError
+from studyapp.model.calibration import F0
+
+SETTLE = 0.25  # s before the monitor's verdict counts (its window)
+BLOCK = 0.05  # s
+LOW = 0.05  # N, the search's lowest F_max
+HIGH = 200.0  # N, the search's highest F_max (loop.FMAX_LIMIT)
+GESTURES = ("hold", "strokes")
+MAX_SEEDS = 100  # a source's search takes about 0.3 s per seed at 5 kHz; --all with 100 seeds about 10 min
+DURATION_RANGE = (0.5, 60.0)  # s per trial; below about 2 s a late onset is missed (the verdict lags ~1 s)
+KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max")
+
+
+def sources():
+    """Every velocity source the loop can run: each estimator name (LVT, the tachometer, among them) and TRUE."""
+    from studyapp.estimators import names
+
+    return names() + ["TRUE"]
+
+
+def check_source(name, label="source"):
+    allowed = sources()
+    if name not in allowed:
+        raise ParameterError(f"{label} {name!r}: allowed are {', '.join(allowed)}")
+    return name
+
+
+def check_seeds(n, label="seeds"):
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= MAX_SEEDS:
+        raise ParameterError(f"{label} {n!r}: allowed is a whole number from 1 to {MAX_SEEDS}")
+    return int(n)
+
+
+def check_gesture(name, label="gesture"):
+    if name not in GESTURES:
+        raise ParameterError(f"{label} {name!r}: allowed are {', '.join(GESTURES)}")
+    return name
+
+
+def check_duration(seconds, label="duration"):
+    lo, hi = DURATION_RANGE
+    try:
+        value = float(seconds)
+    except (TypeError, ValueError):
+        value = float("nan")
+    if not lo <= value <= hi:
+        raise ParameterError(f"{label} {seconds!r}: allowed is a number of seconds from {lo:g} to {hi:g}")
+    return value
+
+
+def is_broken(source, fmax, rate=5000.0, gesture="hold", duration=4.0, seed=0, estimators=None, f0=None):
+    """Whether the stability monitor flags breakdown within ``duration`` s at ``fmax`` N."""
+    from studyapp.model.loop import ClosedLoop, LoopConfig
+
+    estimators = dict(estimators or {})
+    if source not in ("LVT", "TRUE") and source not in estimators:
+        estimators[source] = {}
+    loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
+                                 f0=F0 if f0 is None else f0, seed=seed, audio=False))
+    block = max(1, int(round(BLOCK * loop.rate)))
+    settle = int(round(SETTLE * loop.rate))
+    done = 0
+    total = int(round(duration * loop.rate))
+    while done < total:
+        loop.run(block)
+        done += block
+        if loop.fault is not None or (done >= settle and loop.monitor.broken):
+            return True
+    return False
+
+
+def breakdown_fmax(source, rate=5000.0, gesture="hold", duration=4.0, low=LOW, high=HIGH, tolerance=0.02,
+                   seed=0, estimators=None, f0=None, progress=None):
+    """The largest F_max (N) at which ``source`` stays stable, by bisection on a log scale.
+
+    Stable means: the stability monitor does not flag breakdown within
+    ``duration`` s (``gesture="hold"``: the hand holding the handle, with
+    tremor). Returns ``low`` if even ``low`` breaks down and ``inf`` if
+    ``high`` does not; otherwise the geometric midpoint of the final bracket,
+    whose width is at most ``tolerance`` (relative). ``progress(fmax, broken)``
+    is called after each trial.
+    """
+    kwargs = dict(rate=rate, gesture=gesture, duration=duration, seed=seed, estimators=estimators, f0=f0)
+
+    def trial(fmax):
+        broken = is_broken(source, fmax, **kwargs)
+        if progress is not None:
+            progress(fmax, broken)
+        return broken
+
+    if trial(low):
+        return low
+    if not trial(high):
+        return math.inf
+    lo, hi = low, high
+    while hi / lo > 1.0 + tolerance:
+        mid = math.sqrt(lo * hi)
+        if trial(mid):
+            hi = mid
+        else:
+            lo = mid
+    return math.sqrt(lo * hi)
+
+
+def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="hold", duration=4.0, tolerance=0.02, progress=None):
+    """Breakdown F_max for seeds 0..``seeds``-1: a dict with exactly the keys ``KEYS``.
+
+    ``fmax`` lists the seeds' values (N; inf when stable up to 200 N);
+    ``fmax_median``, ``fmax_min`` and ``fmax_max`` summarise them.
+    ``progress(seed, trial, fmax, verdict)`` is called after each trial with
+    verdict "stable" or "broken" (trial counts from 1 within the seed), and
+    once per seed with verdict "result", ``fmax`` the seed's breakdown F_max
+    and ``trial`` the number of trials it took.
+    """
+    from studyapp.estimators.spec import validate_rate
+
+    check_source(source)
+    rate = validate_rate(rate)
+    seeds = check_seeds(seeds)
+    check_gesture(gesture)
+    duration = check_duration(duration)
+    values = []
+    for seed in range(seeds):
+        trials = []
+
+        def on_trial(fmax, broken, seed=seed, trials=trials):
+            trials.append(fmax)
+            if progress is not None:
+                progress(seed, len(trials), fmax, "broken" if broken else "stable")
+
+        value = breakdown_fmax(source, rate=rate, gesture=gesture, duration=duration, tolerance=tolerance,
+                               seed=seed, progress=on_trial)
+        values.append(float(value))
+        if progress is not None:
+            progress(seed, len(trials), value, "result")
+    return {"source": source, "rate": rate, "gesture": gesture, "seeds": seeds, "fmax": values,
+            "fmax_median": float(np.median(values)), "fmax_min": min(values), "fmax_max": max(values)}
