@@ -23,8 +23,9 @@ the source switches at a block boundary.
 
 The stability monitor (stability.py) is advanced per sample inside the block.
 Python runs only at block boundaries: it draws the block's sensor noise from
-seeded generators (one per sensor, so the stream does not depend on how the
-run is cut into blocks), computes the gesture's target, applies setting
+seeded generators (one per sensor, two for the accelerometer's white and
+low-frequency noise, so the stream does not depend on how the run is cut into
+blocks), computes the gesture's target, applies setting
 changes (source, F_max, force scale, bowing, gesture) and reads the
 monitor's verdict. Everything inside a block is one ``@njit`` function.
 
@@ -201,7 +202,8 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
-              body_p, body_s, cp, cs, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, out, est_out):
+              body_p, body_s, cp, cs, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, noise_lf,
+              out, est_out):
     """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
     n = target.shape[0]
     use_acc = ctl[C_USE_ACC] != 0.0
@@ -212,7 +214,7 @@ def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bri
         a = ds[mechanics.DS_A]
         x_m = sensors.lvdt(snp, x, noise_x[k])
         v_m = sensors.lvt(snp, sns, v, noise_v[k])
-        a_m = sensors.accelerometer(snp, sns, a, noise_a[k]) if use_acc else 0.0
+        a_m = sensors.accelerometer(snp, sns, a, noise_a[k], noise_lf[k]) if use_acc else 0.0
         if _bad(x_m) or _bad(v_m) or _bad(a_m):
             _fault(state, FAULT_SENSOR, k)
         if src >= 0:
@@ -332,8 +334,9 @@ class ClosedLoop:
         self._body_s = np.zeros(2 * (self._body.shape[0] // 5))
         self._mic = contact_mic.params(self.rate)
         self._mic_s = contact_mic.new_state()
-        seeds = np.random.SeedSequence(int(config.seed)).spawn(3)
-        self._rng_x, self._rng_v, self._rng_a = (np.random.default_rng(s) for s in seeds)
+        # the accelerometer's low-frequency noise is the 4th child, so the first three streams stay as they were
+        seeds = np.random.SeedSequence(int(config.seed)).spawn(4)
+        self._rng_x, self._rng_v, self._rng_a, self._rng_lf = (np.random.default_rng(s) for s in seeds)
         self._sample = 0
         self._fault_text = None
         self.source = None
@@ -438,11 +441,12 @@ class ClosedLoop:
         nx = self._rng_x.standard_normal(n)
         nv = self._rng_v.standard_normal(n)
         na = self._rng_a.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
+        nl = self._rng_lf.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
         run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._snp, self._sns,
                   self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss,
                   self._bridge, self._nut, self._body, self._body_s, self._mic, self._mic_s, self.monitor.params, self.monitor.state,
                   np.ascontiguousarray(target), np.ascontiguousarray(target_v), np.ascontiguousarray(target_a),
-                  nx, nv, na, out, est)
+                  nx, nv, na, nl, out, est)
 
     def _run_external(self, n, out, est):
         dev = self.device
