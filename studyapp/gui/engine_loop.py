@@ -10,13 +10,10 @@ the telemetry ring (``feed``), so ``runner.advance(n / rate)`` ticks the task by
 exactly the time the engine ran. Nothing here waits.
 
 Stability. The loop's monitor (``studyapp.model.stability``) watches the
-friction ratio r = u / max|rho v|, which the engine does not publish; but the
-force is F = -G u g with G = F_max / max|rho v| and g the safety force scale,
-so r = -F / (F_max g) wherever F_max g > 0 and the motor clamp is not reached
-(always below the 60 N ceiling of the protocols' F_max). The same
-``StabilityMonitor`` is fed with that r, so the verdict follows the same
-criterion as headless sessions. With F_max g = 0 there is no force and r is
-taken as 0 (nothing can break down).
+handle's velocity in m/s, which the engine publishes: the simulation's true
+velocity, or, for a real device (whose true velocity is NaN), its tachometer.
+The same ``StabilityMonitor`` is fed with it, so the verdict follows the same
+criterion as headless sessions.
 
 Holding. ``hold(True)`` (pause, emergency stop) sends F_max = 0 and lifts the
 bow without changing what the runner asked for; ``hold(False)`` sends the
@@ -97,10 +94,10 @@ class EngineLoop:
         if block is None or len(block["force"]) != n:
             have = 0 if block is None else len(block["force"])
             raise RuntimeError(f"EngineLoop.run({n}): the controller fed {have} samples")
-        scale = block["fmax"] * block["force_scale"]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            friction = np.where(scale > 0.0, -block["force"] / scale, 0.0)
-        self.monitor.measure(friction)
+        velocity = block["velocity_true"]
+        if not np.all(np.isfinite(velocity)):
+            velocity = block["velocity_lvt"]
+        self.monitor.measure(velocity)
         status = self.engine.status()
         self._fault = status["fault"] or "safety fault" if status["fault_latched"] else None
         return block

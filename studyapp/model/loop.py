@@ -346,7 +346,7 @@ class ClosedLoop:
         self.gesture_name = None
         self._trajectory = config.trajectory
         self.set_gesture(config.gesture)
-        self.monitor = StabilityMonitor(self.rate)
+        self.monitor = StabilityMonitor(self.rate, f0)
 
     # settings -------------------------------------------------------------
     def set_source(self, name):
@@ -444,7 +444,8 @@ class ClosedLoop:
         nl = self._rng_lf.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
         run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._snp, self._sns,
                   self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss,
-                  self._bridge, self._nut, self._body, self._body_s, self._mic, self._mic_s, self.monitor.params, self.monitor.state,
+                  self._bridge, self._nut, self._body, self._body_s, self._mic, self._mic_s,
+                  self.monitor.params, self.monitor.state,
                   np.ascontiguousarray(target), np.ascontiguousarray(target_v), np.ascontiguousarray(target_a),
                   nx, nv, na, nl, out, est)
 

@@ -17,8 +17,9 @@ too, loop.py).
 
 Criterion, on absolute quantities (pinned by tests/model/test_model_stability.py).
 The monitor watches the handle's velocity v (m/s: the simulation's true
-velocity, or a real device's tachometer), high-passed at 40 Hz so that strokes
-and tremor do not count:
+velocity, or a real device's tachometer), high-passed at f0 / 2 (73 Hz for the
+default string) so that strokes, their reversals and tremor do not count,
+while the loop mode, above f0, does:
 
     level = RMS of v over the last WINDOW = 0.25 s                 (``score``, m/s)
     e(t)  = RMS of v over the last ENVELOPE = 12 ms (about one oscillation period)
@@ -54,11 +55,12 @@ import numpy as np
 from numba import njit
 from scipy import signal
 
+from studyapp.model import calibration
 from studyapp.model.sensors import section_at
 
 WINDOW = 0.25  # s
 ENVELOPE = 0.012  # s
-HIGHPASS_HZ = 40.0
+HIGHPASS_FRACTION = 0.5  # of f0
 VIBRATION_MIN = 1e-3  # m/s
 CV_MAX = 0.15
 
@@ -106,9 +108,9 @@ def verdict(ms):
 class StabilityMonitor:
     """``.broken``, ``.score`` (= ``.level``, m/s), ``.cv``; the loop advances ``.state`` sample by sample."""
 
-    def __init__(self, rate):
+    def __init__(self, rate, f0=calibration.F0):
         self.rate = float(rate)
-        hp = signal.butter(2, min(HIGHPASS_HZ, 0.45 * rate), "high", fs=rate, output="sos")[0]
+        hp = signal.butter(2, min(HIGHPASS_FRACTION * f0, 0.45 * rate), "high", fs=rate, output="sos")[0]
         self.params = np.zeros(N_PARAMS)
         self.params[MP_HP:MP_HP + 5] = np.array([hp[0], hp[1], hp[2], hp[4], hp[5]]) / hp[3]
         self.params[MP_LONG] = 1.0 - np.exp(-1.0 / (WINDOW * rate))

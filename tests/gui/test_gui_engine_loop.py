@@ -33,7 +33,8 @@ class RecordingEngine:
 def telemetry_like(out, fmax, scale=1.0):
     n = len(out["force"])
     return {"force": out["force"], "fmax": np.full(n, fmax), "force_scale": np.full(n, scale),
-            "source_velocity": out["source_velocity"], "velocity_true": out["velocity_true"]}
+            "source_velocity": out["source_velocity"], "velocity_true": out["velocity_true"],
+            "velocity_lvt": out["velocity_lvt"]}
 
 
 @pytest.fixture(scope="module")
@@ -59,22 +60,24 @@ def test_monitor_verdict_matches_the_loops_monitor(bowed):
         block = telemetry_like({k: v[part] for k, v in out.items() if k != "estimates"}, fmax)
         loop.feed(block)
         assert loop.run(len(block["force"])) is block
-        reference.measure(out["friction"][part])
+        reference.measure(out["velocity_true"][part])
     assert loop.monitor.level == pytest.approx(reference.level, rel=1e-9)
     assert loop.monitor.cv == pytest.approx(reference.cv, rel=1e-9)
     assert loop.monitor.broken == reference.broken
     assert loop.fault is None
 
 
-def test_no_force_means_no_friction_and_no_division_by_zero(bowed):
+def test_a_real_device_is_judged_on_its_tachometer(bowed):
     _, out = bowed
     engine = RecordingEngine(["LOWPASS"])
     loop = EngineLoop(engine, {"LOWPASS": {}}, "LOWPASS", "strokes")
-    block = telemetry_like({k: v for k, v in out.items() if k != "estimates"}, fmax=0.0)
-    block["force"] = np.zeros_like(block["force"])
+    block = telemetry_like({k: v for k, v in out.items() if k != "estimates"}, fmax=3.0)
+    block["velocity_true"] = np.full_like(block["force"], np.nan)  # a real device has no true velocity
     loop.feed(block)
     loop.run(len(block["force"]))
-    assert loop.monitor.level == 0.0 and not loop.monitor.broken
+    reference = StabilityMonitor(RATE)
+    reference.measure(out["velocity_lvt"])
+    assert loop.monitor.level == pytest.approx(reference.level, rel=1e-9) and loop.monitor.level > 0.0
 
 
 def test_a_new_trial_starts_silent_and_hold_gives_settings_back():
