@@ -1,4 +1,4 @@
-"""Calibration: the simulated world's constants, each with its source or reason, and the breakdown search.
+"""Calibration: the simulated world's constants, each with its source or reason (searches: breakdown.py).
 
 The issue asks for, at 5 kHz: Helmholtz motion with TRUE or LVT over most of
 the paper's F_max range and strokes inside +-11 mm; a stick-slip ripple that
@@ -20,7 +20,9 @@ about 0.5 F / (M w0^2), is then small: about 1 um RMS (4-7 um peak to peak)
 at the paper's gains, below the LVDT noise (15 um RMS), not the "tens of
 micrometres" hoped for. A 10 times lighter handle gives 10 times the ripple
 but moves every breakdown 10 times lower (LVT near 1 N); the paper's two
-figures cannot both be had with strokes that fit the device.
+figures cannot both be had with strokes that fit the device (measured with a
+compliant grip, lighter handles, a lower string and a lossy nut:
+docs/model.md, "What the recalibration tried").
 
 Constants (SI):
 
@@ -62,8 +64,6 @@ VALIDATION_STROKES: the second data set's slightly different strokes (7 mm,
     0.045 m/s, 0.04 s ramps, 0.15 s dwell), paper Sec. 7.3.
 """
 
-import numpy as np
-
 F0 = 147.0
 DEVICE_MASS = 0.2
 HAND_MASS = 0.8
@@ -82,5 +82,5 @@ VALIDATION_STROKES = dict(amplitude=0.007, speed=0.045, ramp=0.04, dwell=0.15)
 
 def describe():
     """The constants as a dict (stored in recordings' metadata)."""
-    return {k.lower(): v for k, v in globals().items() if k.isupper() and not k.startswith("BREAKDOWN")}
+    return {k.lower(): v for k, v in globals().items() if k.isupper()}
 
