@@ -15,8 +15,9 @@ Sensors (paper Sec. 4.2): LVDT position with 15 um RMS Gaussian noise and
 0.115 mm/s RMS noise, so the LVT reference lags the true velocity as the
 paper's did. A digital filter's cut-off must lie below Nyquist, so below
 about 1.02 kHz the band is the highest the rate allows, ``NYQUIST_FRACTION *
-rate`` (the rule of the model's sensors and every estimator cut-off); accelerometer with 0.22 m/s^2 RMS noise on the stroke's
-acceleration. The exact velocity is returned too.
+rate`` (the rule of the model's sensors and every estimator cut-off).
+Accelerometer with 0.22 m/s^2 RMS noise on the stroke's acceleration. The
+exact velocity is returned too.
 """
 
 import numpy as np
