@@ -7,6 +7,8 @@ def register(sub):
 
     p = kinds.add_parser("estimators", help="ns per sample of every estimator and of the bank")
     p.add_argument("--rate", type=float, default=48_000.0, help="sample rate in Hz (default 48000)")
+    p.add_argument("--samples", type=int, default=100_000, metavar="N",
+                   help="samples per timed run (default 100000)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.estimators.benchmark"))
 

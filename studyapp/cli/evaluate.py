@@ -6,6 +6,8 @@ Fig. 5-style box plots (a: F_max 0-7.7 N, b: 2.2-12.1 N); and with
 ``--validation DIR`` the Sec. 7.3 comparison on an independent set.
 """
 
+from studyapp.cli import delay_option
+
 
 def register(sub):
     p = sub.add_parser("evaluate", help="error, delay, objective and ranking of estimators on recordings (Fig. 5)")
@@ -18,6 +20,7 @@ def register(sub):
                    help="reference velocity: the LVT tachometer (paper) or the true velocity (default lvt)")
     p.add_argument("--max-lag", type=float, default=0.02, metavar="SECONDS",
                    help="longest delay searched by the cross-correlation (default 0.02 s)")
+    delay_option.add(p)
     p.add_argument("--json", action="store_true", help="print the results as one JSON object")
     p.add_argument("-o", "--output", metavar="DIR",
                    help="write evaluation.json, evaluation.csv, wilcoxon.csv and the Fig. 5 plots here")
@@ -34,6 +37,7 @@ def run(args):
     from studyapp.errors import UserError
     from studyapp.evaluation.dataset import Dataset, expand_paths, load_takes
     from studyapp.evaluation.parameter_sets import parameter_sets
+    from studyapp.evaluation.provenance import provenance
     from studyapp.evaluation.report import evaluate
 
     if args.max_lag <= 0:
@@ -42,15 +46,25 @@ def run(args):
     if output is not None and output.exists() and not output.is_dir():
         raise UserError(f"-o {output}: exists and is not a directory")
     takes = load_takes(expand_paths(args.recordings), args.reference)
-    params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes))
-    result = evaluate(Dataset(takes, args.max_lag), params)
+    unavailable = {}
+    params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes), unavailable)
+    for name, reason in unavailable.items():
+        print(f"studyapp evaluate: {name} skipped, {reason}", file=sys.stderr)
+    result = evaluate(Dataset(takes, args.max_lag, delay_method=args.delay), params)
     document = result.to_json()
+    document["provenance"] = provenance(
+        command="studyapp evaluate", reference=args.reference, max_lag_s=args.max_lag, delay=args.delay,
+        params=args.params, recordings=[t.name for t in takes], recording_sha256=[t.sha256 for t in takes])
+    if unavailable:
+        document["unavailable"] = unavailable
     validation = None
     if args.validation:
         from studyapp.evaluation.validation import compare
 
         other = load_takes(expand_paths([args.validation]), args.reference)
-        summary, rows = compare(result, evaluate(Dataset(other, args.max_lag), params))
+        summary, rows = compare(result, evaluate(Dataset(other, args.max_lag, delay_method=args.delay), params))
+        summary["provenance"] = {**document["provenance"], "validation_recordings": [t.name for t in other],
+                                 "validation_recording_sha256": [t.sha256 for t in other]}
         validation = (summary, rows)
         document["validation"] = summary
     if output is not None:
@@ -99,13 +113,15 @@ def _write_outputs(output, result, document, validation):
 def _print_table(result, validation):
     import numpy as np
 
+    from studyapp.evaluation.report import finite_median
+
     print(f"{'rank':>4}  {'estimator':<11} {'objective':>10} {'E median':>11} {'E %LP':>7} "
           f"{'D median':>8} {'D %LP':>7}")
     for rank, name in enumerate(result.ranking, 1):
         e, d = result.errors[name], result.delays[name]
         print(f"{rank:>4}  {name:<11} {result.objective[name]:>10.4g} {np.median(e):>11.4g} "
-              f"{np.nanmedian(result.error_pct(name)):>7.1f} {np.median(d):>8.1f} "
-              f"{np.nanmedian(result.delay_pct(name)):>7.1f}")
+              f"{finite_median(result.error_pct(name)):>7.1f} {np.median(d):>8.1f} "
+              f"{finite_median(result.delay_pct(name)):>7.1f}")
     if validation is not None:
         s = validation[0]
         print(f"validation ({s['matched_recordings']} matched recordings): error difference "

@@ -6,6 +6,8 @@ recordings and writes the tuned parameters with their provenance. Progress
 lets ``--resume`` continue an interrupted run to the same result.
 """
 
+from studyapp.cli import delay_option
+
 
 def register(sub):
     p = sub.add_parser("optimise", help="tune estimators on recordings (objective sum, pure adaptive search)")
@@ -23,6 +25,7 @@ def register(sub):
                    help="parameters to tune: the paper's Table 2 list, or every numeric one (default paper)")
     p.add_argument("--max-lag", type=float, default=0.02, metavar="SECONDS",
                    help="longest delay searched by the cross-correlation (default 0.02 s)")
+    delay_option.add(p)
     p.add_argument("--range", action="append", default=[], metavar="NAME.PARAM=LOW:HIGH",
                    help="search range of one parameter, within its allowed range (e.g. FOAW.window=1:128)")
     p.add_argument("--max-sets", type=int, metavar="N", help="also stop an estimator after N new sets")
@@ -68,14 +71,14 @@ def run(args):
     rate = min(t.rate for t in takes)
     ranges = parse_ranges(args.range)
     spaces = {name: Space(name, rate, args.tune, ranges=ranges.get(name)) for name in names}
-    source = RecordingFiles(tuple(paths), args.reference, args.max_lag, tuple(names))
+    source = RecordingFiles(tuple(paths), args.reference, args.max_lag, tuple(names), delay_method=args.delay)
     checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
     if args.resume and not checkpoint.is_file():
         raise UserError(f"--resume: no checkpoint at {checkpoint}")
 
     fingerprint = {
         "recordings": [t.sha256 for t in takes], "reference": args.reference,
-        "max_lag_s": args.max_lag, "tune": args.tune,
+        "max_lag_s": args.max_lag, "delay": args.delay, "tune": args.tune,
     }
     optimiser = Optimiser(
         spaces, partial(raw_objectives_task, source), None, patience=args.patience, seed=args.seed,
@@ -95,7 +98,7 @@ def run(args):
         optimiser.executor.shutdown(wait=True, cancel_futures=True)
     info = provenance(
         command="studyapp optimise", seed=args.seed, patience=args.patience, tune=args.tune,
-        reference=args.reference, max_lag_s=args.max_lag, rate=rate, recordings=paths,
+        reference=args.reference, max_lag_s=args.max_lag, delay=args.delay, rate=rate, recordings=paths,
         recording_sha256=[t.sha256 for t in takes], iterations=result.iterations,
         parameter_sets_evaluated=result.evaluated, seconds=round(result.seconds, 3), resumed=result.resumed,
     )

@@ -124,6 +124,21 @@ class EstimatorSpec:
             self.check(rate, values)
         return rate, values
 
+    def not_available(self, rate, given=None):
+        """Why this estimator, with ``given`` (else Table 1's defaults), cannot exist at ``rate``; None if it can.
+
+        Only the rate counts: values allowed at ``RATE_MAX`` but not at ``rate``
+        (a cut-off above ``NYQUIST_FRACTION * rate``, e.g. COMP2's 2,254 Hz
+        high-pass below 4.6 kHz). Values bad at every rate raise ``ParameterError``.
+        """
+        given = given or {}
+        try:
+            self.validate(rate, given)
+        except ParameterError as exc:
+            self.validate(RATE_MAX, given)
+            return f"not available at {float(rate):g} Hz: {exc}"
+        return None
+
     def describe(self):
         return {
             "name": self.name,

@@ -1,6 +1,7 @@
 """Numerical evaluation and tuning of the estimators (paper Sec. 6-7), and their speed/accuracy trade.
 
-    delay_and_error(reference, estimate, max_lag) -> (D samples, E)   eqs. 22-24 (metric.py)
+    delay_and_error(reference, estimate, max_lag, method="normalised") -> (D samples, E)
+                                   eqs. 22-24; normalised or the paper's eq. 22 (metric.py)
     normalisation.ObjectiveSum     the adaptive normalisation, eqs. 27-32, steps 1-8
     search.AdaptiveSearch, space.Space   pure adaptive search in each parameter's natural scale
     optimiser.Optimiser            the whole procedure: executor, checkpoints, progress

@@ -4,9 +4,11 @@ A ``Take`` is one recording made ready for evaluation: the measured position,
 acceleration and tachometer velocity the estimators read, and the reference
 velocity they are judged against, the LVT (``reference="lvt"``, the paper's
 choice, eq. 25) or the simulated true velocity (``"true"``). A ``Dataset`` is
-a list of takes and the delay bound; ``raw_objectives(name, params)`` runs the
-estimator on every take, from rest, and returns eq. 28's vector
-``[E_0, D_0, ..., E_{n-1}, D_{n-1}]`` (E in m/s, D in samples).
+a list of takes, the delay bound and the delay method (``metric.py``:
+``"normalised"`` or eq. 22's ``"paper"``); ``raw_objectives(name, params)``
+runs the estimator on every take, from rest, and returns eq. 28's vector
+``[E_0, |D_0|, ..., E_{n-1}, |D_{n-1}|]`` (E in m/s, D in samples; why |D|:
+``normalisation.py``).
 
 ``RecordingFiles`` is a small picklable pointer to recording files: a worker
 process (or a dask worker on a shared file system) loads the files once,
@@ -21,7 +23,8 @@ import numpy as np
 
 from studyapp.errors import InputDataError, UserError
 from studyapp.evaluation import kernels
-from studyapp.evaluation.metric import Reference
+from studyapp.evaluation.metric import DEFAULT_METHOD, Reference, check_method
+from studyapp.evaluation.normalisation import raw_objectives
 
 REFERENCE_COLUMNS = {"lvt": "velocity_lvt", "true": "velocity_true"}
 DEFAULT_MAX_LAG_S = 0.02  # 100 samples at 5 kHz: far beyond any useful estimator's delay
@@ -92,14 +95,15 @@ def load_takes(paths, reference="lvt"):
 
 
 class Dataset:
-    """Takes plus the delay bound; measures raw objectives (eq. 28) of a parameter set.
+    """Takes plus the delay bound and method; measures raw objectives (eq. 28) of a parameter set.
 
     ``fast=True`` runs the estimators through ``kernels.run`` (same output,
     compiled once per process: for long runs such as the optimiser's).
     """
 
-    def __init__(self, takes, max_lag_s=DEFAULT_MAX_LAG_S, fast=False):
+    def __init__(self, takes, max_lag_s=DEFAULT_MAX_LAG_S, fast=False, delay_method=DEFAULT_METHOD):
         self.fast = bool(fast)
+        self.delay_method = check_method(delay_method)
         if not takes:
             raise UserError("no recordings given")
         self.takes = list(takes)
@@ -111,7 +115,7 @@ class Dataset:
                 raise InputDataError(
                     f"{take.name}: {take.reference.shape[0]} samples is too short for a delay bound of "
                     f"{self.max_lag_s:g} s ({max_lag} samples)")
-            self.references.append(Reference(take.reference, max_lag))
+            self.references.append(Reference(take.reference, max_lag, self.delay_method))
 
     def load(self):
         return self
@@ -138,21 +142,27 @@ class Dataset:
         return errors, delays
 
     def raw_objectives(self, name, params):
-        """Eq. 28: [E_0, D_0, E_1, D_1, ...]."""
-        errors, delays = self.delays_and_errors(name, params)
-        raw = np.empty(2 * len(self.takes))
-        raw[0::2] = errors
-        raw[1::2] = delays
-        return raw
+        """Eq. 28: [E_0, |D_0|, E_1, |D_1|, ...]."""
+        return raw_objectives(*self.delays_and_errors(name, params))
 
 
 def warm_up(names, rate=5000.0, fast=False):
-    """Run each estimator once on a few samples, so its compiled code is loaded (or compiled) in this process."""
+    """Run each estimator once on a few samples, so its compiled code is loaded (or compiled) in this process.
+
+    The compiled code is the same at every rate; an estimator whose Table 1
+    defaults cannot exist at ``rate`` (COMP2's high-pass below 4.6 kHz) is
+    run at the highest rate instead.
+    """
+    from studyapp.errors import ParameterError
     from studyapp.estimators import create
+    from studyapp.estimators.spec import RATE_MAX
 
     x = np.zeros(16)
     for name in names:
-        estimator = create(name, rate)
+        try:
+            estimator = create(name, rate)
+        except ParameterError:
+            estimator = create(name, RATE_MAX)
         if fast:
             kernels.run(estimator, x, x, x, True)
         else:
@@ -171,12 +181,13 @@ class RecordingFiles:
     max_lag_s: float = DEFAULT_MAX_LAG_S
     warm: tuple = ()
     fast: bool = True
+    delay_method: str = DEFAULT_METHOD
 
     def load(self):
         dataset = _LOADED.get(self)
         if dataset is None:
             warm_up(self.warm, fast=self.fast)
-            dataset = Dataset(load_takes(self.paths, self.reference), self.max_lag_s, self.fast)
+            dataset = Dataset(load_takes(self.paths, self.reference), self.max_lag_s, self.fast, self.delay_method)
             _LOADED.clear()
             _LOADED[self] = dataset
         return dataset

@@ -2,7 +2,14 @@
 
 Each estimator e has 2n raw objectives over n recordings, in the order of eq. 28:
 
-    F_raw^e = [E_0, D_0, E_1, D_1, ..., E_{n-1}, D_{n-1}]
+    F_raw^e = [E_0, |D_0|, E_1, |D_1|, ..., E_{n-1}, |D_{n-1}|]
+
+A delay counts by its magnitude. The normalised delay (``metric.py``, the
+default) reads an estimate that leads the reference as D < 0, which happens
+against the band-limited LVT; a lead is as much a mismatch with the reference
+as a lag, and D itself would reward leading it without bound. With eq. 22's
+delay (``--delay paper``) D >= 0, so |D| = D and the paper's objective is
+unchanged.
 
 Normalisation (eqs. 29-32). At a remembered iteration K, offsets and scales are
 taken from the best and worst estimator on each objective i:
@@ -36,6 +43,15 @@ scale, while the scale follows the estimators as they improve.
 from dataclasses import dataclass
 
 import numpy as np
+
+
+def raw_objectives(errors, delays):
+    """Eq. 28's vector [E_0, |D_0|, E_1, |D_1|, ...] from per-recording errors and delays."""
+    errors = np.asarray(errors, dtype=np.float64)
+    raw = np.empty(2 * errors.shape[0])
+    raw[0::2] = errors
+    raw[1::2] = np.abs(np.asarray(delays, dtype=np.float64))
+    return raw
 
 
 def bounds(raw):

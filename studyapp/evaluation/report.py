@@ -1,10 +1,12 @@
 """The numerical comparison of tuned estimators (paper Sec. 7.2, Fig. 5).
 
 For every estimator and recording r: the delay-corrected error E_r (m/s) and
-the delay D_r (samples) of eqs. 22-24; both as a percentage of LOWPASS's on
-the same recording (Fig. 5's normalisation, since results vary between
-recordings but are consistent across estimators within one); and the
-normalised objectives of eqs. 29-32 with the bounds taken over the evaluated
+the delay D_r (samples) of eqs. 22-24, by the dataset's delay method (negative
+for an estimate that leads the reference, with the normalised method); both as
+a percentage of LOWPASS's on the same recording (Fig. 5's normalisation, since
+results vary between recordings but are consistent across estimators within
+one; a lead gives a negative percentage); and the normalised objectives of
+eqs. 29-32, which count |D_r|, with the bounds taken over the evaluated
 estimators themselves. A recording's objective is F_2r + F_2r+1; the global
 objective F_g is their sum over all recordings (eq. 27), and the ranking is by
 F_g, best (lowest) first.
@@ -18,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from studyapp.evaluation.normalisation import bounds, per_objective
+from studyapp.evaluation.normalisation import bounds, per_objective, raw_objectives
 
 BASELINE = "LOWPASS"
 GROUPS = {"a": (0.0, 7.7), "b": (2.2, 12.1)}
@@ -30,6 +32,13 @@ def in_group(fmax, group):
     if fmax is None:
         return group == "a"
     return low - 1e-9 <= fmax <= high + 1e-9
+
+
+def finite_median(values):
+    """Median of the finite values; NaN when there are none (a percentage of a LOWPASS delay of 0)."""
+    values = np.asarray(values, dtype=np.float64)
+    finite = values[np.isfinite(values)]
+    return float(np.median(finite)) if finite.size else float("nan")
 
 
 def _percent(values, baseline):
@@ -51,6 +60,7 @@ class Evaluation:
     delays: dict  # name -> array (samples)
     baseline_errors: np.ndarray
     baseline_delays: np.ndarray
+    delay_method: str = "normalised"
 
     def __post_init__(self):
         raw = np.array([self._raw(name) for name in self.names])
@@ -64,10 +74,7 @@ class Evaluation:
             self.objective[name] = float(np.sum(per_recording)) if np.all(np.isfinite(f)) else float("inf")
 
     def _raw(self, name):
-        raw = np.empty(2 * len(self.recordings))
-        raw[0::2] = self.errors[name]
-        raw[1::2] = self.delays[name]
-        return raw
+        return raw_objectives(self.errors[name], self.delays[name])
 
     @property
     def ranking(self):
@@ -105,6 +112,7 @@ class Evaluation:
                 for name in self.names
             },
             "ranking": self.ranking,
+            "delay_method": self.delay_method,
             "recordings": [
                 {"file": r, "fmax": f, "rate": rate}
                 for r, f, rate in zip(self.recordings, self.fmax, self.rates)
@@ -152,5 +160,5 @@ def evaluate(dataset, params):
     return Evaluation(
         names=names, recordings=dataset.names, fmax=[t.fmax for t in dataset.takes],
         rates=[t.rate for t in dataset.takes], params=params, errors=errors, delays=delays,
-        baseline_errors=base_e, baseline_delays=base_d,
+        baseline_errors=base_e, baseline_delays=base_d, delay_method=dataset.delay_method,
     )

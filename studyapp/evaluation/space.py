@@ -21,7 +21,8 @@ the paper's 17 and 0.1 mm), and long windows only add delay on stick-slip, so
 the optimiser searches windows up to 64 and margins from 0.1 um to 1 cm, which
 hold the paper's optimum and the LVDT noise (15 um RMS) with orders of
 magnitude to spare. ``ranges`` overrides any range (``--range
-FOAW.window=1:256``), within the spec's.
+FOAW.window=1:256``), within the spec's. A search starts from Table 1's
+values, each moved to the nearest end of its range where it lies outside.
 """
 
 import math
@@ -127,11 +128,15 @@ class Space:
             log = p.scale == "log" and low > 0
             self.dims.append(Dimension(p.name, low, high, log, p.kind == "int"))
         tuned_names = {d.name for d in self.dims}
-        # Fixed parameters keep their given value, else the spec's default (Table 1).
-        _, self.start = self.spec.validate(self.rate, given)
-        for d in self.dims:  # a start outside a narrowed range moves to its nearest end
-            if not d.low <= self.start[d.name] <= d.high:
-                self.start[d.name] = d.value(d.unit(self.start[d.name]))
+        # Fixed parameters keep their given value, else the spec's default (Table 1). A tuned
+        # default outside its range (narrowed, or capped by the rate: COMP2's 2,254 Hz high-pass
+        # below 4.6 kHz) starts from the range's nearest end.
+        start = dict(given)
+        for d in self.dims:
+            default = self.spec.param(d.name).default
+            if not d.low <= default <= d.high:
+                start[d.name] = d.value(d.unit(default))
+        _, self.start = self.spec.validate(self.rate, start)
         self.fixed = {k: v for k, v in self.start.items() if k not in tuned_names}
 
     @property

@@ -9,10 +9,10 @@ from studyapp.atomic import atomic_open
 def _cell(v):
     if v is None:
         return ""
+    if hasattr(v, "item"):  # numpy scalars first: np.float64 is a float whose repr is "np.float64(...)"
+        return _cell(v.item())
     if isinstance(v, float):
         return "" if math.isnan(v) else repr(v)
-    if hasattr(v, "item"):
-        return _cell(v.item())
     return v
 
 

@@ -1,10 +1,13 @@
-"""Delay D and delay-corrected error E (eqs. 22-24), against known delays, filters and noise."""
+"""Delay D and delay-corrected error E (eqs. 22-24), against known delays, filters and noise.
+
+Both methods: ``normalised`` (the default) and ``paper`` (eq. 22 as printed).
+"""
 
 import numpy as np
 import pytest
 from scipy import signal
 
-from studyapp.errors import InputDataError
+from studyapp.errors import InputDataError, UserError
 from studyapp.evaluation import delay_and_error
 from studyapp.evaluation.metric import Reference
 from tests.evaluation.conftest import stick_slip
@@ -68,22 +71,39 @@ def test_delay_of_a_butterworth_low_pass_is_near_its_low_frequency_group_delay()
     assert abs(d - expected) <= 2
 
 
-def test_reference_class_equals_brute_force_correlation():
+def _brute_force(v, w, max_lag, method):
+    """(D, E) straight from the module docstring's sums, one lag at a time."""
+    n = v.shape[0]
+    ks = range(-max_lag, max_lag + 1) if method == "normalised" else range(max_lag + 1)
+    best = None
+    for k in sorted(ks, key=lambda k: (abs(k), -k)):
+        a, b = v[max(0, -k): n - max(0, k)], w[max(0, k): n + min(0, k)]
+        r = np.dot(a, b)
+        if method == "normalised":
+            r /= np.sqrt(np.dot(a, a) * np.dot(b, b))
+        if best is None or r > best[0]:
+            best = (r, k, np.sqrt(np.mean((a - b) ** 2)))
+    return best[1], best[2]
+
+
+@pytest.mark.parametrize("method", ["normalised", "paper"])
+@pytest.mark.parametrize("shift", [-6, 6])
+def test_reference_class_equals_brute_force_correlation(method, shift):
     rng = np.random.default_rng(2)
     sig = stick_slip(5000.0, 0.5)
-    v, w = sig["velocity_lvt"], _delayed(sig["velocity_true"], 6) + rng.normal(0, 1e-3, 2500)
+    v = sig["velocity_lvt"]
+    w = np.roll(sig["velocity_true"], shift) + rng.normal(0, 1e-3, 2500)
     max_lag = 30
-    c = np.array([np.dot(v[: v.shape[0] - k], w[k:]) for k in range(max_lag + 1)])
-    d = int(np.argmax(c))
-    e = np.sqrt(np.mean((v[: v.shape[0] - d] - w[d:]) ** 2))
-    assert delay_and_error(v, w, max_lag) == (d, pytest.approx(e, rel=1e-12))
-    assert Reference(v, max_lag).measure(w) == (d, pytest.approx(e, rel=1e-12))
+    d, e = _brute_force(v, w, max_lag, method)
+    assert delay_and_error(v, w, max_lag, method) == (d, pytest.approx(e, rel=1e-12))
+    assert Reference(v, max_lag, method).measure(w) == (d, pytest.approx(e, rel=1e-12))
 
 
-def test_delay_is_bounded_by_max_lag():
+@pytest.mark.parametrize("method", ["normalised", "paper"])
+def test_delay_is_bounded_by_max_lag(method):
     v = stick_slip(5000.0, 1.0)["velocity_true"]
-    d, e = delay_and_error(v, _delayed(v, 40), 10)
-    assert 0 <= d <= 10
+    d, e = delay_and_error(v, _delayed(v, 40), 10, method)
+    assert (-10 if method == "normalised" else 0) <= d <= 10
     assert e > 0
 
 
@@ -95,6 +115,18 @@ def test_bad_inputs():
         delay_and_error(v, v, 100)
     with pytest.raises(InputDataError, match="1-D"):
         delay_and_error(np.zeros((2, 50)), np.zeros((2, 50)), 5)
+    with pytest.raises(UserError, match="normalised or paper"):
+        delay_and_error(v, v, 5, method="overlap")
     w = np.ones(100)
     w[5] = np.nan
     assert delay_and_error(np.ones(100), w, 5) == (0, float("inf"))
+    assert Reference(np.ones(100), 5).measure(w) == (0, float("inf"))
+
+
+@pytest.mark.parametrize("method", ["normalised", "paper"])
+def test_a_silent_estimate_reads_zero_delay_and_the_reference_rms(method):
+    # Every lag correlates as 0 (an overlap of zero energy counts as 0): the tie goes to lag 0.
+    v = stick_slip(5000.0, 0.5)["velocity_true"]
+    expected = (0, pytest.approx(np.sqrt(np.mean(v ** 2)), rel=1e-12))
+    assert delay_and_error(v, np.zeros_like(v), 20, method) == expected
+    assert Reference(v, 20, method).measure(np.zeros_like(v)) == expected
