@@ -12,9 +12,9 @@ import math
 import numpy as np
 
 from studyapp import __version__
+from studyapp.analysis.missing_trials import describe_missing
 from studyapp.analysis.rank_sum import POOLED
 from studyapp.analysis.signed_rank import EXACT_LIMIT
-from studyapp.analysis.missing_trials import describe_missing
 
 _STYLE = """
 body { font-family: sans-serif; max-width: 60em; margin: 1em auto; color: #222; }

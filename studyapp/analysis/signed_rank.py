@@ -20,8 +20,8 @@ observed one.
 
 - Without ties among the |d_i| that is ``scipy.stats.wilcoxon(method="exact")``.
 - With ties, scipy's "exact" assumes distinct ranks 1..n' and is off, and its
-  enumeration (``method=PermutationMethod(n_resamples=2**n')``) takes seconds
-  per pair from about twelve participants on. The same conditional
+  enumeration (``method=PermutationMethod(n_resamples=2**n')``) recomputes the
+  statistic for each of the 2^n' assignments. The same conditional
   distribution is counted here directly: with every rank doubled to an
   integer q_i, the number of sign assignments giving each doubled T+ is the
   coefficient of the generating function prod_i (1 + x^q_i), built one rank at

@@ -24,11 +24,11 @@ from itertools import combinations
 
 import pandas as pd
 
-from studyapp.analysis import friedman as friedman_module
-from studyapp.analysis import signed_rank as signed_rank_module
-from studyapp.analysis.friedman import Friedman, friedman_test
+from studyapp.analysis.friedman import MIN_CONDITIONS, RELIABLE_PARTICIPANTS, Friedman, friedman_test
+from studyapp.analysis.friedman import minimum_p as friedman_minimum_p
 from studyapp.analysis.holm import holm_adjust
-from studyapp.analysis.signed_rank import signed_rank_test
+from studyapp.analysis.signed_rank import minimum_p as signed_rank_minimum_p
+from studyapp.analysis.signed_rank import participants_needed, signed_rank_test
 
 SIGNED_RANK_COLUMNS = ["condition_a", "condition_b", "statistic", "p_value", "p_holm", "effect_size", "significant"]
 FRIEDMAN_COLUMNS = ["task", "statistic", "p_value", "n_participants"]
@@ -58,19 +58,19 @@ class WithinSubject:
             return lines
         if n == 0:
             return lines + ["no participant has every condition: no within-subject tests"]
-        if k < friedman_module.MIN_CONDITIONS:
-            lines.append(f"Friedman's test needs {friedman_module.MIN_CONDITIONS} or more conditions (here {k})")
-        elif n < friedman_module.RELIABLE_PARTICIPANTS:
+        if k < MIN_CONDITIONS:
+            lines.append(f"Friedman's test needs {MIN_CONDITIONS} or more conditions (here {k})")
+        elif n < RELIABLE_PARTICIPANTS:
             line = (f"Friedman's test with {n} participants: its chi-square p is unreliable below "
-                    f"{friedman_module.RELIABLE_PARTICIPANTS} participants, read it as a guide")
-            smallest = friedman_module.minimum_p(n, k)
+                    f"{RELIABLE_PARTICIPANTS} participants, read it as a guide")
+            smallest = friedman_minimum_p(n, k)
             if smallest >= alpha:
                 line += f"; an exact test could not reach p < {alpha:g} either (smallest p (k!)^(1-n) = {smallest:.3g})"
             lines.append(line)
         pairs = k * (k - 1) // 2
-        smallest = signed_rank_module.minimum_p(n)
-        needed = signed_rank_module.participants_needed(alpha)
-        needed_holm = signed_rank_module.participants_needed(alpha, pairs)
+        smallest = signed_rank_minimum_p(n)
+        needed = participants_needed(alpha)
+        needed_holm = participants_needed(alpha, pairs)
         if n < needed:
             lines.append(
                 f"a signed-rank test on {n} participants cannot reach p < {alpha:g} two-sided: the smallest "
