@@ -3,22 +3,45 @@
 Measured with matplotlib's own renderer: every visible ``Text`` artist of a
 figure (titles, labels, tick labels, annotations, legend entries) is drawn,
 its window extent taken, and each pair tested for intersection. Empty strings
-and invisible artists are skipped.
+and invisible artists are skipped, and so are texts the draw leaves out: an
+axis keeps tick labels for ticks outside its view limits (visible, but never
+drawn), so only the texts actually drawn count. A figure made without pyplot
+(``matplotlib.figure.Figure()``) gets an Agg canvas to be drawn on.
 """
 
 import matplotlib
 
 matplotlib.use("Agg")
 
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.text import Text  # noqa: E402
 
 
+def _drawn_texts(fig):
+    """Every ``Text`` drawn when ``fig`` is drawn, in drawing order."""
+    drawn = []
+    draw = Text.draw
+
+    def recording_draw(self, renderer):
+        drawn.append(self)
+        return draw(self, renderer)
+
+    Text.draw = recording_draw
+    try:
+        fig.canvas.draw()
+    finally:
+        Text.draw = draw
+    return drawn
+
+
 def text_boxes(fig):
-    """[(text, Bbox)] of every visible, non-empty text artist in ``fig`` (display units)."""
-    fig.canvas.draw()
+    """[(text, Bbox)] of every visible, non-empty text artist drawn in ``fig`` (display units)."""
+    if not hasattr(fig.canvas, "get_renderer"):
+        FigureCanvasAgg(fig)
+    drawn = _drawn_texts(fig)
     renderer = fig.canvas.get_renderer()
     boxes = []
-    for artist in fig.findobj(Text):
+    for artist in dict.fromkeys(drawn):
         if not artist.get_visible() or not artist.get_text().strip():
             continue
         box = artist.get_window_extent(renderer)

@@ -6,14 +6,18 @@ canvas. Boxes follow matplotlib's defaults (median line, quartile box,
 whiskers to the furthest sample within 1.5 IQR of the box); every sample is
 drawn over its box, outliers included, so no separate outlier marks. Conditions run best first, left to right, as in
 the paper. The letters above the boxes are the compact letter display of the
-pairwise rank-sum tests (compact_letters.py): two conditions sharing a letter
-are not significantly different.
+pairwise rank-sum tests (compact_letters.py), on trials pooled across
+participants as in the paper: two conditions sharing a letter are not
+significantly different. The footnote saying so is the figure's
+``supxlabel``, so the constrained layout keeps room for it below the tick
+labels and the x label instead of drawing it over them.
 """
 
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.transforms import blended_transform_factory
 
+from studyapp.analysis.rank_sum import POOLED
 from studyapp.atomic import atomic_path
 
 FORMATS = ("png", "svg")
@@ -62,11 +66,13 @@ def draw_scatter(figure, study):
     yerr = np.vstack([y - adjustment.loc[common, "q1"].to_numpy(), adjustment.loc[common, "q3"].to_numpy() - y])
     ax.errorbar(x, y, xerr=xerr, yerr=yerr, fmt="none", ecolor="0.75", elinewidth=1, zorder=1)
     ax.scatter(x, y, s=36, color="C0", zorder=2)
-    for name, xi, yi, dy in zip(common, x, y, _label_offsets(x, y)):
-        ax.annotate(name, (xi, yi), xytext=(5, dy), textcoords="offset points", fontsize=9,
-                    va="bottom" if dy > 0 else "top")
     ax.grid(True, alpha=0.3)
-    figure.text(0.01, 0.01, "points: medians; bars: quartiles; top left is better", fontsize=8, color="0.35")
+    _footnote(figure, "points: medians; bars: quartiles; top left is better")
+    labels = [
+        ax.annotate(name, (xi, yi), xytext=(5, 4), textcoords="offset points", fontsize=9, va="bottom")
+        for name, xi, yi in zip(common, x, y)
+    ]
+    _place_labels(figure, ax, labels)
 
 
 FIGURES = {
@@ -117,22 +123,60 @@ def _draw_box_plot(figure, task, study, ylabel, title):
     ax.tick_params(axis="x", labelrotation=30)
     ax.grid(True, axis="y", alpha=0.3)
     correction = ", Holm-corrected" if study.holm else ""
-    figure.text(
-        0.01, 0.01,
-        f"letters: conditions sharing a letter do not differ (Wilcoxon rank-sum, p < {study.alpha:g}{correction})",
-        fontsize=8, color="0.35",
+    _footnote(
+        figure,
+        f"letters: conditions sharing a letter do not differ (Wilcoxon rank-sum, p < {study.alpha:g}{correction}),\n"
+        f"{POOLED}",
     )
 
 
-def _label_offsets(x, y):
-    """Vertical label offsets (points): below the point when an earlier label sits close by."""
-    span_x = max(np.ptp(x), 1e-12)
-    span_y = max(np.ptp(y), 1e-12)
-    offsets = []
-    for k in range(len(x)):
-        near = [j for j in range(k) if abs(x[j] - x[k]) < 0.12 * span_x and abs(y[j] - y[k]) < 0.06 * span_y]
-        offsets.append(-4 if any(offsets[j] > 0 for j in near) else 4)
-    return offsets
+def _footnote(figure, text):
+    figure.supxlabel(text, x=0.01, ha="left", fontsize=8, color="0.35")
+
+
+# Label positions tried around a point, nearest first: (dx, dy) in points, alignment.
+_LABEL_SPOTS = [
+    (dx * sx, dy * sy, "left" if sx > 0 else "right", "bottom" if sy > 0 else "top")
+    for dx, dy in ((5, 4), (5, 14), (12, 24))
+    for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1))
+]
+
+
+def _place_labels(figure, ax, labels):
+    """Move each point label to the first spot where it meets no earlier label and stays in the axes.
+
+    Measured with the renderer after the layout is done (labels are kept out of
+    the layout, so moving them cannot move the axes). When no spot is free, the
+    one overlapping least is kept.
+    """
+    for label in labels:
+        label.set_in_layout(False)
+    figure.draw_without_rendering()
+    frame = ax.get_window_extent()
+    placed = []
+    for label in labels:
+        best = None
+        for dx, dy, ha, va in _LABEL_SPOTS:
+            label.set_position((dx, dy))
+            label.set_horizontalalignment(ha)
+            label.set_verticalalignment(va)
+            box = label.get_window_extent()
+            inside = frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+            clash = sum(_overlap(box, other) for other in placed) + (0.0 if inside else box.width * box.height)
+            if best is None or clash < best[0]:
+                best = (clash, dx, dy, ha, va, box)
+            if clash == 0.0:
+                break
+        _, dx, dy, ha, va, box = best
+        label.set_position((dx, dy))
+        label.set_horizontalalignment(ha)
+        label.set_verticalalignment(va)
+        placed.append(box)
+
+
+def _overlap(a, b):
+    """Area shared by boxes ``a`` and ``b`` (display units squared)."""
+    return max(0.0, min(a.x1, b.x1) - max(a.x0, b.x0)) * max(0.0, min(a.y1, b.y1) - max(a.y0, b.y0))
 
 
 def _say(ax, message):

@@ -7,7 +7,9 @@ ranking by numerical delay: Spearman's rho = 0.61 and 0.43.
 The numerical side is an ``evaluation.json`` written by ``studyapp evaluate -o
 DIR``: ``{"estimators": {NAME: {"error": [...], "delay": [...],
 "error_pct_lowpass": [...], "delay_pct_lowpass": [...], "objective": x}},
-"ranking": [...]}``, one list entry per recording. Each estimator's numerical
+"ranking": [...]}``, one list entry per recording; with ``--perceptual`` each
+estimator also has ``audio_distance`` (a number, or one per recording; read
+in perceptual.py). Each estimator's numerical
 score is the median over recordings of its error (or delay) as percent of
 LOWPASS, Fig. 5's normalisation; when those lists are absent or empty, the
 median of the raw ``error`` (``delay``) list. Which one was used is reported.
@@ -53,6 +55,8 @@ def load_evaluation(source):
         for field in ("error", "delay", "error_pct_lowpass", "delay_pct_lowpass"):
             if field in result:
                 _numbers(result[field], f"{path}: field 'estimators.{name}.{field}'")
+        if "audio_distance" in result:
+            number_or_numbers(result["audio_distance"], f"{path}: field 'estimators.{name}.audio_distance'")
     return data
 
 
@@ -92,6 +96,14 @@ def compare_with_numerical(evaluation, noisiness_medians, fmax_medians):
     for column in ["comparison", "subjective", "numerical", "metric", "conditions"]:
         table[column] = table[column].astype(object)
     return table
+
+
+def number_or_numbers(value, where):
+    """``value`` (a number, null, or a list of them) as a float array; NaN for null."""
+    values = value if isinstance(value, list) else [value]
+    if not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in values):
+        raise InputDataError(f"{where} must be a number or a list of numbers")
+    return _numbers(values, where)
 
 
 def _numbers(values, where):

@@ -20,6 +20,13 @@ matters here. The statistic reported is z: positive when a tends to be larger.
 
 When every pooled value is equal the variance is zero: there is no evidence of
 a difference, so z = 0 and p = 1.
+
+The analysis applies it as the paper did, to every trial of every participant
+pooled per condition. The test assumes independent samples, which the trials
+of one participant are not (they share that participant's criterion), so its
+p-values come out too small: two participants with six trials each give
+p ~ 3e-5. Tables and figures label it ``POOLED``; the within-subject tests
+(within_subject.py) treat participants as the units.
 """
 
 from dataclasses import dataclass
@@ -33,6 +40,7 @@ from studyapp.analysis.holm import holm_adjust
 from studyapp.analysis.ranks import average_ranks, tie_sizes
 from studyapp.errors import InputDataError
 
+POOLED = "pooled across participants, as the paper did; trials are not independent"
 WILCOXON_COLUMNS = ["condition_a", "condition_b", "statistic", "p_value", "significant"]
 
 

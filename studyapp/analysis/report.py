@@ -13,6 +13,8 @@ import numpy as np
 
 from studyapp import __version__
 from studyapp.analysis.missing_trials import describe_missing
+from studyapp.analysis.rank_sum import POOLED
+from studyapp.analysis.signed_rank import EXACT_LIMIT
 
 _STYLE = """
 body { font-family: sans-serif; max-width: 60em; margin: 1em auto; color: #222; }
@@ -83,8 +85,12 @@ def _inputs(study):
         f"{len(study.participants)} participants: {html.escape(', '.join(study.participants))}",
         f"{len(responses)} responses ({(responses['task'] == 'adjustment').sum()} adjustment, "
         f"{(responses['task'] == 'rating').sum()} rating)",
-        f"Pairwise Wilcoxon rank-sum tests (normal approximation with tie correction), "
-        f"significance at p &lt; {study.alpha:g}, {correction}",
+        f"The paper's pairwise Wilcoxon rank-sum tests (normal approximation with tie correction), "
+        f"{POOLED}, {correction}",
+        "Within-subject tests on each participant's median per condition: Friedman's test across conditions "
+        "and pairwise Wilcoxon signed-rank tests, Holm-corrected, with the matched-pairs rank-biserial "
+        "correlation as effect size",
+        f"Significance at p &lt; {study.alpha:g}",
     ]
     hashes = study.protocol_hashes()
     if len(hashes) > 1:
@@ -117,9 +123,44 @@ def _task_tables(study, task, unit):
     )
     return (
         f"<h3>Summary (best first)</h3>{summary}"
-        f"<h3>Pairwise Wilcoxon rank-sum p-values</h3>"
-        f"<p>Shaded red: p &lt; {study.alpha:g}, the distributions differ; green: no significant difference.</p>"
+        f"<h3>Pairwise Wilcoxon rank-sum p-values, {POOLED}</h3>"
+        "<p>The paper's test (Figs. 7-8): every response counts as an independent sample, but the responses "
+        "of one participant are not independent of each other, so these p-values are too small; the "
+        "within-subject tests below treat participants as the units. "
+        f"Shaded red: p &lt; {study.alpha:g}, the distributions differ; green: no significant difference.</p>"
         f"{_significance_matrix(task)}"
+        f"{_within_subject(study, task, unit_text)}"
+    )
+
+
+def _within_subject(study, task, unit_text):
+    within = task.within
+    warnings = "".join(f'<p class="warn">{html.escape(line)}</p>' for line in within.warnings(study.alpha))
+    medians = _table(
+        ["participant"] + [str(c) for c in within.medians.columns],
+        [[participant, *row] for participant, row in zip(within.medians.index, within.medians.to_numpy())],
+    )
+    f = within.friedman
+    friedman = _table(["participants", "conditions", "chi-square", "p"],
+                      [[f.n_participants, f.n_conditions, f.statistic, f.p_value]])
+    pairs = _table(
+        ["condition a", "condition b", "T = min(T+, T-)", "p", "p (Holm)", "effect size r", "significant"],
+        [list(row) for row in within.signed_rank.itertuples(index=False)],
+    )
+    return (
+        f"<h3>Within-subject tests: each participant's median per condition{unit_text}</h3>"
+        f"{warnings}{medians}"
+        "<h4>Friedman test across conditions</h4>"
+        "<p>Each participant is one block; chi-square approximation with tie correction "
+        "(<code>scipy.stats.friedmanchisquare</code>). A small p: the conditions are not all alike.</p>"
+        f"{friedman}"
+        "<h4>Pairwise Wilcoxon signed-rank tests, Holm-corrected</h4>"
+        "<p>Paired by participant; zero differences dropped (<code>zero_method=\"wilcox\"</code>); exact "
+        "p-values over every sign assignment to the ranks (ties included), the normal approximation beyond "
+        f"{EXACT_LIMIT} participants. Effect size: matched-pairs "
+        "rank-biserial correlation r = (T+ &minus; T&minus;) / (T+ + T&minus;) (Kerby 2014), positive when "
+        f"condition a is larger. Significant: p (Holm) &lt; {study.alpha:g}.</p>"
+        f"{pairs}"
     )
 
 
@@ -156,22 +197,28 @@ def _consistency(study):
         table,
     ]
     if not study.variance.empty:
-        lower = study.intra_lower_pct()
-        headline = (
-            f"Intra-subject variance is on average <b>{lower:.0f}%</b> lower than the total variance of Fig. 7"
-            if math.isfinite(lower)
-            else "Intra-subject variance cannot be computed here"
-        )
+        headline = intra_variance_headline(study.intra_lower_pct())
         parts += [
             "<h3>Intra- against inter-subject variance of max F<sub>max</sub> (N<sup>2</sup>)</h3>",
             f"<p>{headline} (the paper: 61% lower). Intra-subject variance needs two or more trials "
             "per participant and condition.</p>",
             _table(
-                ["condition", "participants", "intra", "inter", "total", "intra lower (%)"],
+                ["condition", "participants", "intra", "inter", "total", "intra lower by (%; < 0: higher)"],
                 [list(r[1:]) for r in study.variance.itertuples()],
             ),
         ]
     return "\n".join(parts)
+
+
+def intra_variance_headline(lower_pct):
+    """The consistency headline for intra-subject variance ``lower_pct`` percent below the total."""
+    if not math.isfinite(lower_pct):
+        return "Intra-subject variance cannot be computed here"
+    shown = f"{abs(lower_pct):.0f}"
+    if shown == "0":
+        return "Intra-subject variance is on average <b>about equal to</b> the total variance of Fig. 7"
+    word = "lower" if lower_pct > 0 else "higher"
+    return f"Intra-subject variance is on average <b>{shown}%</b> {word} than the total variance of Fig. 7"
 
 
 def _numerical(study):
@@ -185,6 +232,26 @@ def _numerical(study):
         "<p>Spearman rho between subjective and numerical rankings, oriented so that rho &gt; 0 means they "
         "agree (the paper: 0.61 for noisiness against error, 0.43 for F<sub>max</sub> against delay).</p>"
         + _table(["comparison", "numerical metric", "n", "rho", "p", "conditions"], rows)
+        + _perceptual(study)
+    )
+
+
+def _perceptual(study):
+    if study.perceptual is None:
+        return ""
+    note = f'<p class="warn">{html.escape(study.perceptual_note)}</p>' if study.perceptual_note else ""
+    rows = [
+        [r.comparison, r.metric, r.n, r.rho, r.p_value, r.paper_rho, r.conditions]
+        for r in study.perceptual.itertuples()
+    ]
+    return (
+        "<h3>Noisiness against the perceptual audio distance</h3>"
+        "<p>Spearman rho between the median normalised noisiness per condition and each estimator's "
+        "<code>audio_distance</code> (its audio against the audio with the true velocity, "
+        "<code>studyapp evaluate --perceptual</code>), beside noisiness against numerical error and the "
+        "paper's 0.61. Both are better when lower, so rho &gt; 0 means the rankings agree.</p>"
+        f"{note}"
+        + _table(["comparison", "numerical metric", "n", "rho", "p", "paper rho", "conditions"], rows)
     )
 
 

@@ -3,13 +3,20 @@
 Names are fixed, so scripts and the GUI find them:
 
     wilcoxon_adjustment.csv, wilcoxon_rating.csv   condition_a, condition_b, statistic, p_value, significant
+                                                   (rank-sum, trials pooled across participants, as the paper)
+    friedman.csv                                   task, statistic, p_value, n_participants
+    signed_rank_adjustment.csv, signed_rank_rating.csv
+                                                   condition_a, condition_b, statistic, p_value, p_holm,
+                                                   effect_size, significant (within-subject)
     summary_adjustment.csv, summary_rating.csv     condition, n, median, q1, q3 (best first)
     spearman_participants.csv                      participant, rho, p_value
     variance_adjustment.csv                        intra- and inter-subject variance per condition
     missing_trials.csv                             participant, task, condition, expected, present, missing_trials
     spearman_numerical.csv                         only with an evaluation
+    perceptual_correlation.csv                     only with an evaluation: noisiness against audio_distance
     responses_analysed.csv                         the checked responses the numbers come from
-    analysis_settings.json                         source, Holm, alpha, expected trials, evaluation
+    analysis_settings.json                         source, Holm, alpha, expected trials, evaluation, and
+                                                   under "tests" the test behind each table
     fig7_adjustment, fig8_rating, fig9_scatter     .png and .svg
     report.html                                    everything above in one file
 
@@ -25,17 +32,26 @@ from pathlib import Path
 from studyapp.analysis.consistency import SPEARMAN_COLUMNS
 from studyapp.analysis.figures import FIGURES, render, save_figure
 from studyapp.analysis.numerical import load_evaluation
-from studyapp.analysis.rank_sum import WILCOXON_COLUMNS
+from studyapp.analysis.perceptual import PERCEPTUAL_COLUMNS
+from studyapp.analysis.rank_sum import POOLED, WILCOXON_COLUMNS
 from studyapp.analysis.report import report_html
 from studyapp.analysis.responses import load_responses
 from studyapp.analysis.study import analyse
 from studyapp.analysis.summary import SUMMARY_COLUMNS
+from studyapp.analysis.within_subject import FRIEDMAN_COLUMNS, SIGNED_RANK_COLUMNS
 from studyapp.atomic import atomic_open
 from studyapp.errors import InputDataError
 
 RESPONSES_FILE = "responses_analysed.csv"
 SETTINGS_FILE = "analysis_settings.json"
 REPORT_FILE = "report.html"
+TESTS = {
+    "wilcoxon_{task}.csv": f"Wilcoxon rank-sum test of every pair of conditions, {POOLED}",
+    "friedman.csv": "Friedman test across conditions on per-participant medians (within-subject)",
+    "signed_rank_{task}.csv": "Wilcoxon signed-rank test of every pair of conditions on per-participant "
+    "medians (within-subject, zero differences dropped), Holm-corrected; effect size: matched-pairs "
+    "rank-biserial correlation (Kerby 2014)",
+}
 
 
 def open_study(path):
@@ -78,12 +94,15 @@ def write_report_folder(study, directory, progress=None, evaluation_path=None, e
     say("writing tables")
     for task in (study.adjustment, study.rating):
         table(f"wilcoxon_{task.task}.csv", task.wilcoxon, WILCOXON_COLUMNS)
+        table(f"signed_rank_{task.task}.csv", task.within.signed_rank, SIGNED_RANK_COLUMNS)
         table(f"summary_{task.task}.csv", task.summary, SUMMARY_COLUMNS)
+    table("friedman.csv", study.friedman(), FRIEDMAN_COLUMNS)
     table("spearman_participants.csv", study.participant_spearman, SPEARMAN_COLUMNS)
     table("variance_adjustment.csv", study.variance)
     table("missing_trials.csv", study.missing)
     if study.numerical is not None:
         table("spearman_numerical.csv", study.numerical)
+        table("perceptual_correlation.csv", study.perceptual, PERCEPTUAL_COLUMNS)
     table(RESPONSES_FILE, study.responses)
     settings = {
         "source": study.source,
@@ -91,6 +110,11 @@ def write_report_folder(study, directory, progress=None, evaluation_path=None, e
         "alpha": study.alpha,
         "expected": expected,
         "evaluation": None if evaluation_path is None else str(Path(evaluation_path).resolve()),
+        "tests": {
+            name.format(task=task): text
+            for name, text in TESTS.items()
+            for task in ("adjustment", "rating")
+        },
     }
     path = directory / SETTINGS_FILE
     with atomic_open(path, "w", encoding="utf-8") as f:

@@ -3,11 +3,15 @@
 Adjustment task (Fig. 7): every confirmed breakdown F_max is one sample of its
 condition; conditions are ordered best first (highest median). Rating task
 (Fig. 8): every participant's normalised noisiness is one sample; ordered best
-first (lowest median). For each task: median and quartiles, pairwise Wilcoxon
-rank-sum tests of every pair (optionally Holm-corrected), and the compact
-letters marking which conditions differ. Fig. 9 pairs the two medians per
-condition. Consistency and, given an evaluation, the numerical comparison
-follow (see consistency.py and numerical.py).
+first (lowest median). For each task: median and quartiles, the paper's
+pairwise Wilcoxon rank-sum tests of every pair on the samples pooled across
+participants (optionally Holm-corrected; trials of one participant are not
+independent, so these p-values are too small), the compact letters marking
+which conditions differ, and the within-subject analysis on per-participant
+medians: Friedman's test and Holm-corrected pairwise signed-rank tests with
+effect sizes (within_subject.py). Fig. 9 pairs the two medians per condition.
+Consistency and, given an evaluation, the numerical and perceptual
+comparisons follow (consistency.py, numerical.py, perceptual.py).
 """
 
 from dataclasses import dataclass
@@ -19,9 +23,11 @@ from studyapp.analysis.compact_letters import compact_letters
 from studyapp.analysis.consistency import participant_spearman, variance_decomposition
 from studyapp.analysis.missing_trials import describe_missing, find_missing_trials
 from studyapp.analysis.numerical import compare_with_numerical
+from studyapp.analysis.perceptual import perceptual_correlation
 from studyapp.analysis.rank_sum import pairwise_rank_sum
 from studyapp.analysis.responses import response_values
 from studyapp.analysis.summary import summarise
+from studyapp.analysis.within_subject import WithinSubject, friedman_table, within_subject
 
 ALPHA = 0.05
 
@@ -35,6 +41,7 @@ class TaskAnalysis:
     summary: pd.DataFrame  # condition, n, median, q1, q3
     wilcoxon: pd.DataFrame  # condition_a, condition_b, statistic, p_value, significant, p_raw
     letters: dict  # condition -> compact letters
+    within: WithinSubject  # per-participant medians, Friedman, pairwise signed-rank tests
 
     @property
     def conditions(self):
@@ -57,6 +64,8 @@ class StudyAnalysis:
     spearman_task: str  # the task the per-participant rho is computed on
     variance: pd.DataFrame
     numerical: pd.DataFrame | None = None
+    perceptual: pd.DataFrame | None = None  # noisiness against audio_distance and error (perceptual.py)
+    perceptual_note: str | None = None  # why the perceptual row is empty, when it is
     holm: bool = False
     alpha: float = ALPHA
 
@@ -78,6 +87,18 @@ class StudyAnalysis:
             lines.append(f"the responses come from {len(hashes)} different protocols (protocol_hash)")
         return lines
 
+    def sample_size_warnings(self):
+        """Lines on what the number of participants allows the within-subject tests (within_subject.py)."""
+        return [
+            f"{task.task}: {line}"
+            for task in (self.adjustment, self.rating)
+            for line in task.within.warnings(self.alpha)
+        ]
+
+    def friedman(self):
+        """DataFrame ``task, statistic, p_value, n_participants``: Friedman's test of each task."""
+        return friedman_table([(task.task, task.within) for task in (self.adjustment, self.rating)])
+
     def intra_lower_pct(self):
         """Mean over conditions of how much lower intra- than total variance is, in percent."""
         values = self.variance["intra_lower_pct"].to_numpy(dtype=float)
@@ -98,9 +119,10 @@ def analyse(responses, source="responses", evaluation=None, holm=False, alpha=AL
     spearman_task, spearman_values = ("adjustment", adjustment_values)
     if adjustment_values.empty:
         spearman_task, spearman_values = ("rating", rating_values)
-    numerical = None
+    numerical = perceptual = perceptual_note = None
     if evaluation is not None:
         numerical = compare_with_numerical(evaluation, rating.medians(), adjustment.medians())
+        perceptual, perceptual_note = perceptual_correlation(evaluation, rating.medians())
     return StudyAnalysis(
         source=source,
         responses=responses,
@@ -111,6 +133,8 @@ def analyse(responses, source="responses", evaluation=None, holm=False, alpha=AL
         spearman_task=spearman_task,
         variance=variance_decomposition(adjustment_values, adjustment.conditions),
         numerical=numerical,
+        perceptual=perceptual,
+        perceptual_note=perceptual_note,
         holm=holm,
         alpha=alpha,
     )
@@ -124,4 +148,4 @@ def _task(values, task, higher_is_better, holm, alpha):
     wilcoxon = pairwise_rank_sum(groups, alpha=alpha, holm=holm)
     different = wilcoxon.loc[wilcoxon["significant"], ["condition_a", "condition_b"]].itertuples(index=False)
     letters = compact_letters(order, [tuple(pair) for pair in different])
-    return TaskAnalysis(task, groups, summarise(groups), wilcoxon, letters)
+    return TaskAnalysis(task, groups, summarise(groups), wilcoxon, letters, within_subject(values, order, alpha))

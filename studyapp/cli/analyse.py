@@ -1,9 +1,12 @@
 """``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] -o REPORT_DIR``: the paper's Sec. 9-10.
 
 RESULTS_DIR is a results folder or an exported responses .csv. Writes the
-Wilcoxon, summary and Spearman tables, Figs. 7-9 (PNG and SVG) and
-report.html into REPORT_DIR (see studyapp/analysis/report_folder.py).
-Participants short of responses are listed on stderr and in the report.
+paper's pooled Wilcoxon rank-sum tables, the within-subject Friedman and
+signed-rank tables, the summary and Spearman tables, Figs. 7-9 (PNG and SVG)
+and report.html into REPORT_DIR (see studyapp/analysis/report_folder.py);
+with --evaluation, the numerical comparisons and perceptual_correlation.csv.
+Participants short of responses, and too few participants for a test, are
+listed on stderr and in the report.
 """
 
 import sys
@@ -12,14 +15,17 @@ import sys
 def register(subparsers):
     parser = subparsers.add_parser(
         "analyse",
-        help="Wilcoxon and Spearman analyses, Figs. 7-9 and report.html from study responses",
-        description="Analyse study responses as the paper's Sec. 9-10: pairwise Wilcoxon rank-sum tests, "
-        "medians and quartiles, per-participant Spearman rho, Figs. 7-9 and one self-contained report.html.",
+        help="Wilcoxon, Friedman and Spearman analyses, Figs. 7-9 and report.html from study responses",
+        description="Analyse study responses as the paper's Sec. 9-10: pairwise Wilcoxon rank-sum tests on "
+        "trials pooled across participants (the paper's), the within-subject Friedman and Holm-corrected "
+        "signed-rank tests on per-participant medians, medians and quartiles, per-participant Spearman rho, "
+        "Figs. 7-9 and one self-contained report.html.",
     )
     parser.add_argument("results", metavar="RESULTS_DIR", help="a results folder, or a responses .csv from 'studyapp export'")
     parser.add_argument("-o", "--output", metavar="REPORT_DIR", required=True, help="folder for the tables, figures and report.html")
-    parser.add_argument("--evaluation", metavar="DIR", help="an 'studyapp evaluate -o DIR' folder (or its evaluation.json): compare with the numerical rankings")
-    parser.add_argument("--holm", action="store_true", help="Holm-correct the p-values of each task's pairwise tests")
+    parser.add_argument("--evaluation", metavar="DIR", help="an 'studyapp evaluate -o DIR' folder (or its evaluation.json): compare with the numerical rankings, "
+                        "and noisiness with audio_distance (perceptual_correlation.csv)")
+    parser.add_argument("--holm", action="store_true", help="Holm-correct the p-values of each task's pooled rank-sum tests (the signed-rank tests always are)")
     parser.add_argument("--alpha", type=float, default=0.05, help="significance threshold (default 0.05, the paper's)")
     parser.add_argument("--trials", type=int, metavar="N", help="adjustment trials each participant owes per condition (default: the most any participant has)")
     parser.set_defaults(func=run)
@@ -46,8 +52,10 @@ def run(args):
     expected = {"adjustment": args.trials} if args.trials else None
     study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected)
     say(f"{len(study.participants)} participants, {len(responses)} responses")
-    for line in study.warnings():
+    for line in study.warnings() + study.sample_size_warnings():
         say(f"warning: {line}")
+    if study.perceptual_note:
+        say(f"note: {study.perceptual_note}")
     if not study.missing.empty:
         say(f"{len(study.missing)} short participant/condition combinations listed in missing_trials.csv")
     write_report_folder(study, args.output, progress=say, evaluation_path=args.evaluation, expected=expected)

@@ -13,14 +13,20 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
 EXPORT_COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash"]
-# what `studyapp analyse` must write (issue 7): table -> columns, and figure stems (PNG + SVG)
+# what `studyapp analyse` must write (issues 7 and 12): table -> columns, and figure stems (PNG + SVG)
+SIGNED_RANK = ["condition_a", "condition_b", "statistic", "p_value", "p_holm", "effect_size", "significant"]
 TABLES = {
     "wilcoxon_adjustment.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
     "wilcoxon_rating.csv": ["condition_a", "condition_b", "statistic", "p_value", "significant"],
     "summary_adjustment.csv": ["condition", "n", "median", "q1", "q3"],
     "summary_rating.csv": ["condition", "n", "median", "q1", "q3"],
     "spearman_participants.csv": ["participant", "rho", "p_value"],
+    "friedman.csv": ["task", "statistic", "p_value", "n_participants"],
+    "signed_rank_adjustment.csv": SIGNED_RANK,
+    "signed_rank_rating.csv": SIGNED_RANK,
 }
+# with --evaluation
+PERCEPTUAL = ["comparison", "metric", "n", "rho", "p_value", "paper_rho", "conditions"]
 FIGURES = ["fig7_adjustment", "fig8_rating", "fig9_scatter"]
 
 # A synthetic study shaped like the paper's (Sec. 8.4, Figs. 7-8): breakdown

@@ -2,12 +2,18 @@
 
 import contextlib
 import io
+import json
 
+import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 
+from studyapp.analysis.report import intra_variance_headline
 from studyapp.cli import main
 from tests.analysis.conftest import FIGURES, SYNTHETIC_FMAX, SYNTHETIC_NOISINESS, TABLES, synthetic_responses
+
+POOLED = "pooled across participants, as the paper did; trials are not independent"
 
 
 
@@ -55,7 +61,57 @@ def test_report_is_self_contained(report):
     for condition in SYNTHETIC_FMAX:
         assert condition in html
     lower = pd.read_csv(out / "variance_adjustment.csv")["intra_lower_pct"].mean()
-    assert f"Intra-subject variance is on average <b>{lower:.0f}%</b> lower" in html
+    assert lower > 0 and f"Intra-subject variance is on average <b>{lower:.0f}%</b> lower" in html
+    assert intra_variance_headline(lower) in html
+
+
+def test_within_subject_tables_beside_the_pooled_ones(report):
+    _, out, err = report
+    assert len(pd.read_csv(out / "signed_rank_adjustment.csv")) == 9 * 8 // 2
+    assert len(pd.read_csv(out / "signed_rank_rating.csv")) == 8 * 7 // 2
+    responses = pd.read_csv(out / "responses_analysed.csv")
+    friedman = pd.read_csv(out / "friedman.csv").set_index("task")
+    assert list(friedman.index) == ["adjustment", "rating"]
+    for task, column in (("adjustment", "fmax"), ("rating", "rating")):
+        rows = responses[responses["task"] == task]
+        medians = rows.groupby(["participant", "condition"])[column].median().unstack()
+        reference = stats.friedmanchisquare(*medians.to_numpy().T)
+        assert friedman.loc[task, "n_participants"] == 9  # P03 lacks two FOAW trials, not FOAW
+        assert friedman.loc[task, ["statistic", "p_value"]].tolist() == pytest.approx(
+            [reference.statistic, reference.pvalue], rel=1e-10)
+        table = pd.read_csv(out / f"signed_rank_{task}.csv")
+        assert (table["p_holm"] >= table["p_value"]).all()
+        assert table["significant"].tolist() == (table["p_holm"] < 0.05).tolist()
+    html = (out / "report.html").read_text()
+    assert f"Pairwise Wilcoxon rank-sum p-values, {POOLED}" in html
+    assert "Friedman test across conditions" in html and "Wilcoxon signed-rank tests, Holm-corrected" in html
+    # nine participants and 36 pairs: 36 x 2^-8 = 0.14, so no Holm-corrected pair can be significant
+    assert "after Holm&#x27;s correction over 36 pairs no pair can be significant with 9 participants" in html
+    assert "warning: adjustment: after Holm's correction over 36 pairs" in err
+    settings = json.loads((out / "analysis_settings.json").read_text())
+    assert POOLED in settings["tests"]["wilcoxon_adjustment.csv"]
+    assert "signed-rank" in settings["tests"]["signed_rank_rating.csv"]
+
+
+def test_two_participants_pooled_p_is_labelled_and_within_subject_p_is_honest(tmp_path):
+    # The issue: with 2 participants the pooled rank-sum test reports p ~ 3e-5 for LVT against the rest.
+    synthetic_responses(participants=2, trials=6).to_csv(tmp_path / "r.csv", index=False)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert main(["analyse", str(tmp_path / "r.csv"), "-o", str(tmp_path / "out")]) == 0
+    out = tmp_path / "out"
+    pooled = pd.read_csv(out / "wilcoxon_adjustment.csv").set_index(["condition_a", "condition_b"])
+    assert pooled.loc[("LVT", "FOAW"), "p_value"] < 1e-4
+    within = pd.read_csv(out / "signed_rank_adjustment.csv").set_index(["condition_a", "condition_b"])
+    assert within.loc[("LVT", "FOAW"), "p_value"] == 0.5  # 2^(1-2): the smallest p two participants allow
+    assert not within["significant"].any()
+    assert (pd.read_csv(out / "friedman.csv")["n_participants"] == 2).all()
+    lines = err.getvalue().splitlines()
+    for task in ("adjustment", "rating"):
+        assert (f"studyapp analyse: warning: {task}: a signed-rank test on 2 participants cannot reach p < 0.05 "
+                "two-sided: the smallest attainable p is 2^(1-n) = 0.5; 6 participants are needed") in lines
+        assert any(line.startswith(f"studyapp analyse: warning: {task}: Friedman's test with 2 participants")
+                   for line in lines)
 
 
 def test_missing_trials_are_reported_not_dropped(report):

@@ -2,6 +2,7 @@
 
 import json
 import math
+import re
 
 import pandas as pd
 import pytest
@@ -95,3 +96,35 @@ def test_bad_evaluation_names_the_field(tmp_path, content, field):
 def test_missing_evaluation_names_the_file(tmp_path):
     with pytest.raises(InputDataError, match="evaluation.json"):
         load_evaluation(tmp_path)
+
+
+@pytest.mark.parametrize("lower, text", [
+    (61.4, "<b>61%</b> lower than"),
+    (-2.0, "<b>2%</b> higher than"),
+    (-50.0, "<b>50%</b> higher than"),
+    (0.3, "<b>about equal to</b> the total"),
+    (-0.4, "<b>about equal to</b> the total"),
+    (math.nan, "cannot be computed"),
+])
+def test_intra_variance_headline_says_lower_or_higher(lower, text):
+    from studyapp.analysis.report import intra_variance_headline
+
+    headline = intra_variance_headline(lower)
+    assert text in headline and not re.search(r"[-\u2212]\s*\d", headline)
+
+
+def test_report_says_higher_when_intra_subject_variance_exceeds_the_total():
+    # Each participant gives 1 then 3 in both conditions: intra = 2, total = var(1, 3, 1, 3) = 4/3,
+    # so intra is 50% higher than total; the report used to print "-50% lower".
+    from studyapp.analysis.report import report_html
+    from studyapp.analysis.responses import check_responses
+    from studyapp.analysis.study import analyse
+
+    rows = [(p, "adjustment", c, t, v, None) for p in ("P1", "P2") for c in ("A", "B") for t, v in ((1, 1.0), (2, 3.0))]
+    frame = pd.DataFrame(rows, columns=["participant", "task", "condition", "trial", "fmax", "rating"])
+    study = analyse(check_responses(frame, "two.csv"))
+    assert study.intra_lower_pct() == pytest.approx(-50.0)
+    html = report_html(study, {})
+    assert "Intra-subject variance is on average <b>50%</b> higher than the total variance" in html
+    assert not re.search(r"[-\u2212]\s*\d+%", html)
+    assert "intra lower by (%; &lt; 0: higher)" in html
