@@ -14,7 +14,9 @@ recordings are read; the default patience is then ``PERCEPTUAL_PATIENCE``.
 from studyapp.cli import perceptual_options
 
 PAPER_PATIENCE = 1000  # the paper's stopping rule
-PERCEPTUAL_PATIENCE = 100  # a closed-loop simulation per case and candidate: keeps a full run near 10 min on 2 cores
+# Each set costs a closed-loop simulation per case (eight by default): at a tenth of the paper's rule a run
+# of the thirteen took 2549 sets, 170 s of CPU (docs/evaluation.md).
+PERCEPTUAL_PATIENCE = 100
 
 
 def register(sub):

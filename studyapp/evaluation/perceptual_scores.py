@@ -13,9 +13,9 @@ Default cases (``Cases()``): F_max = 1, 2.2, 4.4 and 7.7 N (the rating task's
 gain, the paper's Sec. 8, and three of its recording gains up to the high-gain
 half), seeds 0 and 1, 2 s each (about three and a half strokes) at 5 kHz:
 eight pairs of simulations, 16 s of simulated bowing per estimator, about
-0.2 s of computing on one core. Two seeds because one seed's score varies by
-about +-0.05 between seeds at the same F_max; the cases are the same for every
-estimator and parameter set, so comparisons between them are paired.
+0.1-0.2 s of computing on one core. Two seeds because one case's score can
+differ by 0.1 between seeds at the same F_max; the cases are the same for
+every estimator and parameter set, so comparisons between them are paired.
 
 A simulation in which the loop faults (a non-finite value stops it: the force
 drops to 0, the bow lifts) scores ``inf`` on its case, so the optimiser never

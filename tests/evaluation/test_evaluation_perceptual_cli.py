@@ -43,6 +43,20 @@ def test_evaluate_adds_the_audio_distance(recording, tmp_path, capsys):
     assert len(rows) == 3
 
 
+def test_evaluate_prints_the_distances(recording, capsys):
+    assert main(["evaluate", str(recording), "--estimators", "LOWPASS,LEVANT,FOAW", "--perceptual", *SHORT]) == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("audio distance to TRUE"))
+    cases = ps.Cases(5000.0, (1.0,), (3,), 0.5)
+    expected = {name: ps.estimator_score(cases, name, {})["audio_distance"] for name in ("LOWPASS", "LEVANT", "FOAW")}
+    table = [line.split() for line in lines[start + 1:start + 4]]
+    assert [row[0] for row in table] == sorted(expected, key=expected.get)
+    assert [float(row[1]) for row in table] == pytest.approx([expected[row[0]] for row in table], rel=1e-3)
+    assert lines[start + 4].startswith("Spearman rho")
+    assert "perceptual: FOAW (3/3)" in captured.err
+
+
 def test_evaluate_without_the_option_is_unchanged(recording, capsys):
     assert main(["evaluate", str(recording), "--estimators", "LOWPASS", "--json"]) == 0
     document = json.loads(capsys.readouterr().out)
@@ -62,6 +76,15 @@ def test_optimise_for_the_audio_distance(tmp_path, capsys):
     assert data["objective"]["LOWPASS"] <= default
     tuned = ps.estimator_score(ps.Cases(5000.0, (1.0,), (3,), 0.5), "LOWPASS", {"cutoff_hz": cutoff})
     assert math.isclose(data["objective"]["LOWPASS"], tuned["audio_distance"], rel_tol=1e-12)
+
+
+def test_a_checkpoint_of_other_cases_is_refused(tmp_path, capsys):
+    out = tmp_path / "P.toml"
+    run = ["optimise", "--objective", "perceptual", "--estimators", "LOWPASS", "--patience", "2", "--workers", "1",
+           "--quiet", "-o", str(out), "--perceptual-fmax", "1", "--perceptual-seeds", "3"]
+    assert main([*run, "--perceptual-duration", "0.5"]) == 0
+    assert main([*run, "--perceptual-duration", "0.5", "--resume"]) == 0
+    _fails(capsys, [*run, "--perceptual-duration", "0.6", "--resume"], "differs in: perceptual")
 
 
 def test_the_default_patience_depends_on_the_objective():
