@@ -3,10 +3,12 @@
 Per estimator and recording: error E and delay D, both also as percent of
 LOWPASS; the global objective and ranking; pairwise Wilcoxon rank-sum tests;
 Fig. 5-style box plots (a: F_max 0-7.7 N, b: 2.2-12.1 N); and with
-``--validation DIR`` the Sec. 7.3 comparison on an independent set.
+``--validation DIR`` the Sec. 7.3 comparison on an independent set. With
+``--perceptual``, each estimator's ``audio_distance`` (the string's sound with
+it in the loop against TRUE's, paper Sec. 10; cli/perceptual_options.py).
 """
 
-from studyapp.cli import delay_option
+from studyapp.cli import delay_option, perceptual_options
 
 
 def register(sub):
@@ -26,6 +28,10 @@ def register(sub):
                    help="write evaluation.json, evaluation.csv, wilcoxon.csv and the Fig. 5 plots here")
     p.add_argument("--validation", metavar="DIR",
                    help="also evaluate this independent set and compare at matching F_max (Sec. 7.3)")
+    p.add_argument("--perceptual", action="store_true",
+                   help="also simulate each estimator in the loop and measure its audio against TRUE's "
+                        "(audio_distance, perceptual.png)")
+    perceptual_options.add_options(p, "--perceptual")
     p.set_defaults(func=run)
 
 
@@ -50,6 +56,7 @@ def run(args):
     params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes), unavailable)
     for name, reason in unavailable.items():
         print(f"studyapp evaluate: {name} skipped, {reason}", file=sys.stderr)
+    cases = perceptual_options.cases(args, min(t.rate for t in takes), args.perceptual, "--perceptual")
     result = evaluate(Dataset(takes, args.max_lag, delay_method=args.delay), params)
     document = result.to_json()
     document["provenance"] = provenance(
@@ -67,13 +74,18 @@ def run(args):
                                  "validation_recording_sha256": [t.sha256 for t in other]}
         validation = (summary, rows)
         document["validation"] = summary
+    perceptual = None if cases is None else perceptual_options.add_to_evaluation(cases, result, document)
     if output is not None:
         _write_outputs(output, result, document, validation)
+        if perceptual is not None:
+            perceptual_options.write_outputs(output, perceptual, result.names)
     if args.json:
         json.dump(document, sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:
         _print_table(result, validation)
+        if perceptual is not None:
+            perceptual_options.print_table(perceptual, result.names)
     return 0
 
 

@@ -4,20 +4,37 @@ Runs the objective-sum optimiser with adaptive normalisation over the
 recordings and writes the tuned parameters with their provenance. Progress
 (best objective per estimator) goes to stderr; a checkpoint beside the output
 lets ``--resume`` continue an interrupted run to the same result.
+
+``--objective perceptual`` (paper Sec. 10's future work) tunes each estimator
+for the least ``audio_distance`` instead: every candidate set is simulated in
+the closed loop on the perceptual cases (cli/perceptual_options.py), so no
+recordings are read; the default patience is then ``PERCEPTUAL_PATIENCE``.
 """
 
-from studyapp.cli import delay_option
+from studyapp.cli import delay_option, perceptual_options
+
+PAPER_PATIENCE = 1000  # the paper's stopping rule
+# Each set costs a closed-loop simulation per case (eight by default): at a tenth of the paper's rule a run
+# of the thirteen took 2549 sets, 170 s of CPU (docs/evaluation.md).
+PERCEPTUAL_PATIENCE = 100
 
 
 def register(sub):
     p = sub.add_parser("optimise", help="tune estimators on recordings (objective sum, pure adaptive search)")
-    p.add_argument("recordings", nargs="+", metavar="RECORDING",
-                   help="recording files (.npz/.h5/.csv) or directories of them (e.g. from simulate-set)")
+    p.add_argument("recordings", nargs="*", metavar="RECORDING",
+                   help="recording files (.npz/.h5/.csv) or directories of them (e.g. from simulate-set); "
+                        "none with --objective perceptual")
     p.add_argument("-o", "--output", required=True, metavar="PARAMS.toml", help="where to write the tuned parameters")
     p.add_argument("--estimators", nargs="+", metavar="NAMES",
                    help="estimators to tune, comma or space separated (default: the paper's thirteen)")
-    p.add_argument("--patience", type=int, default=1000,
-                   help="stop an estimator after this many new sets without improvement (default 1000)")
+    p.add_argument("--objective", choices=("paper", "perceptual"), default="paper",
+                   help="what to minimise: the paper's objective sum of error and delay over the recordings, or "
+                        "the audio distance to TRUE in the closed loop (default paper)")
+    p.add_argument("--rate", type=float, metavar="HZ",
+                   help="sample rate of the perceptual simulations (--objective perceptual; default 5000)")
+    p.add_argument("--patience", type=int,
+                   help=f"stop an estimator after this many new sets without improvement "
+                        f"(default {PAPER_PATIENCE}; {PERCEPTUAL_PATIENCE} with --objective perceptual)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--reference", choices=("lvt", "true"), default="lvt",
                    help="reference velocity: the LVT tachometer (paper) or the true velocity (default lvt)")
@@ -35,6 +52,7 @@ def register(sub):
     p.add_argument("--checkpoint", metavar="FILE", help="checkpoint file (default: OUTPUT.checkpoint.json)")
     p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    perceptual_options.add_options(p, "--objective perceptual")
     p.set_defaults(func=run)
 
 
@@ -54,6 +72,9 @@ def run(args):
     from studyapp.evaluation.provenance import provenance
     from studyapp.evaluation.space import PAPER_ESTIMATORS, Space
 
+    perceptual = args.objective == "perceptual"
+    if args.patience is None:
+        args.patience = PERCEPTUAL_PATIENCE if perceptual else PAPER_PATIENCE
     output = Path(args.output)
     if output.suffix.lower() != ".toml":
         raise UserError(f"-o {output}: expected a .toml file")
@@ -66,44 +87,73 @@ def run(args):
     if args.workers is not None and args.workers < 1:
         raise UserError(f"--workers {args.workers}: allowed is an integer of at least 1")
     names = estimator_names(args.estimators, PAPER_ESTIMATORS)
-    paths = expand_paths(args.recordings)
-    takes = load_takes(paths, args.reference)  # checks every file before any work starts
-    rate = min(t.rate for t in takes)
+    cases = perceptual_options.cases(args, 5000.0 if args.rate is None else args.rate, perceptual,
+                                     "--objective perceptual")
+    if perceptual:
+        if args.recordings:
+            raise UserError(f"{args.recordings[0]}: --objective perceptual reads no recordings (it simulates "
+                            "its own cases: --perceptual-fmax, --perceptual-seeds, --rate)")
+        paths, takes, rate = [], [], cases.rate
+    else:
+        if args.rate is not None:
+            raise UserError("--rate: only with --objective perceptual (the recordings give the rate)")
+        if not args.recordings:
+            raise UserError("no recordings given: --objective paper needs RECORDING files or directories")
+        paths = expand_paths(args.recordings)
+        takes = load_takes(paths, args.reference)  # checks every file before any work starts
+        rate = min(t.rate for t in takes)
     ranges = parse_ranges(args.range)
     spaces = {name: Space(name, rate, args.tune, ranges=ranges.get(name)) for name in names}
-    source = RecordingFiles(tuple(paths), args.reference, args.max_lag, tuple(names), delay_method=args.delay)
     checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
     if args.resume and not checkpoint.is_file():
         raise UserError(f"--resume: no checkpoint at {checkpoint}")
 
-    fingerprint = {
-        "recordings": [t.sha256 for t in takes], "reference": args.reference,
-        "max_lag_s": args.max_lag, "delay": args.delay, "tune": args.tune,
-    }
+    if perceptual:
+        from studyapp.evaluation import perceptual_scores
+
+        objective = partial(perceptual_scores.perceptual_objective_task, cases)
+        fingerprint = {"objective": "perceptual", "perceptual": cases.describe(), "tune": args.tune}
+        initializer, initargs = perceptual_scores.warm_up, (cases, tuple(names))
+    else:
+        objective = partial(raw_objectives_task, RecordingFiles(tuple(paths), args.reference, args.max_lag,
+                                                                tuple(names), delay_method=args.delay))
+        fingerprint = {
+            "recordings": [t.sha256 for t in takes], "reference": args.reference,
+            "max_lag_s": args.max_lag, "delay": args.delay, "tune": args.tune,
+        }
+        initializer, initargs = warm_up, (tuple(names), rate, True)
     optimiser = Optimiser(
-        spaces, partial(raw_objectives_task, source), None, patience=args.patience, seed=args.seed,
+        spaces, objective, None, patience=args.patience, seed=args.seed,
         max_sets=args.max_sets, checkpoint=checkpoint, fingerprint=fingerprint,
         progress=None if args.quiet else Progress(sys.stderr),
     )
+    if perceptual and not args.quiet:
+        optimiser.progress = perceptual_options.distance_progress(optimiser.progress, optimiser)
     if args.resume:
         optimiser.resume(checkpoint)
-    optimiser.executor = make_executor(args.workers, args.scheduler, warm_up, (tuple(names), rate, True))
+    optimiser.executor = make_executor(args.workers, args.scheduler, initializer, initargs)
     try:
         if not args.scheduler:
             # Compile the fast loops once here, before the first task starts the worker processes:
             # forked workers inherit them (spawned ones run the initializer).
-            warm_up(names, rate, fast=True)
+            initializer(*initargs)
         result = optimiser.run()
     finally:
         optimiser.executor.shutdown(wait=True, cancel_futures=True)
+    if perceptual:
+        settings = {f"perceptual_{k}": v for k, v in cases.describe().items() if k != "rate"}
+        objective_values = {name: raw[0] for name, raw in result.raw.items()}  # audio_distance
+    else:
+        settings = {"reference": args.reference, "max_lag_s": args.max_lag, "delay": args.delay, "recordings": paths,
+                    "recording_sha256": [t.sha256 for t in takes]}
+        objective_values = result.objectives
     info = provenance(
-        command="studyapp optimise", seed=args.seed, patience=args.patience, tune=args.tune,
-        reference=args.reference, max_lag_s=args.max_lag, delay=args.delay, rate=rate, recordings=paths,
-        recording_sha256=[t.sha256 for t in takes], iterations=result.iterations,
+        command="studyapp optimise", objective=args.objective, seed=args.seed, patience=args.patience,
+        tune=args.tune, rate=rate, **settings, iterations=result.iterations,
         parameter_sets_evaluated=result.evaluated, seconds=round(result.seconds, 3), resumed=result.resumed,
     )
     params_file.write(
-        output, result.params, provenance=info, objective=result.objectives,
+        output, result.params, provenance=info, objective=objective_values,
         comment="Estimator parameters tuned by studyapp optimise (paper Sec. 6.3; our Table 1).\n"
                 "Use with: studyapp evaluate RECORDINGS... --params " + output.name,
     )

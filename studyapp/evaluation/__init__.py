@@ -6,6 +6,8 @@
     search.AdaptiveSearch, space.Space   pure adaptive search in each parameter's natural scale
     optimiser.Optimiser            the whole procedure: executor, checkpoints, progress
     report.evaluate, tradeoff.tradeoff   Fig. 5's comparison; cost against accuracy per rate
+    perceptual.audio_distance, perceptual_scores.perceptual_scores   Sec. 10: the sound with each
+                                   estimator in the loop against TRUE's (specific loudness in Bark bands)
 
 Command line: ``studyapp optimise``, ``studyapp evaluate``, ``studyapp tradeoff``.
 """
