@@ -3,7 +3,9 @@
 Per estimator and recording: error E and delay D, both also as percent of
 LOWPASS; the global objective and ranking; pairwise Wilcoxon rank-sum tests;
 Fig. 5-style box plots (a: F_max 0-7.7 N, b: 2.2-12.1 N); and with
-``--validation DIR`` the Sec. 7.3 comparison on an independent set.
+``--validation DIR`` the Sec. 7.3 comparison on an independent set; with
+``--compare-paper`` our Table 1 and findings beside the paper's
+(``evaluation/paper_comparison.py``).
 """
 
 
@@ -23,6 +25,8 @@ def register(sub):
                    help="write evaluation.json, evaluation.csv, wilcoxon.csv and the Fig. 5 plots here")
     p.add_argument("--validation", metavar="DIR",
                    help="also evaluate this independent set and compare at matching F_max (Sec. 7.3)")
+    p.add_argument("--compare-paper", action="store_true",
+                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv to -o DIR")
     p.set_defaults(func=run)
 
 
@@ -41,6 +45,8 @@ def run(args):
     output = Path(args.output) if args.output else None
     if output is not None and output.exists() and not output.is_dir():
         raise UserError(f"-o {output}: exists and is not a directory")
+    if args.compare_paper and output is None:
+        raise UserError("--compare-paper: needs -o DIR, the folder its two tables are written to")
     takes = load_takes(expand_paths(args.recordings), args.reference)
     params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes))
     result = evaluate(Dataset(takes, args.max_lag), params)
@@ -55,6 +61,10 @@ def run(args):
         document["validation"] = summary
     if output is not None:
         _write_outputs(output, result, document, validation)
+    if args.compare_paper:
+        from studyapp.evaluation import paper_comparison
+
+        paper_comparison.write(output, result, [t.position for t in takes], validation[0] if validation else None)
     if args.json:
         json.dump(document, sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
