@@ -5,7 +5,9 @@ LOWPASS; the global objective and ranking; pairwise Wilcoxon rank-sum tests;
 Fig. 5-style box plots (a: F_max 0-7.7 N, b: 2.2-12.1 N); and with
 ``--validation DIR`` the Sec. 7.3 comparison on an independent set. With
 ``--perceptual``, each estimator's ``audio_distance`` (the string's sound with
-it in the loop against TRUE's, paper Sec. 10; cli/perceptual_options.py).
+it in the loop against TRUE's, paper Sec. 10; cli/perceptual_options.py); with
+``--compare-paper`` our Table 1 and findings beside the paper's
+(``evaluation/paper_comparison.py``).
 """
 
 from studyapp.cli import delay_option, perceptual_options
@@ -32,6 +34,8 @@ def register(sub):
                    help="also simulate each estimator in the loop and measure its audio against TRUE's "
                         "(audio_distance, perceptual.png)")
     perceptual_options.add_options(p, "--perceptual")
+    p.add_argument("--compare-paper", action="store_true",
+                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv to -o DIR")
     p.set_defaults(func=run)
 
 
@@ -51,6 +55,8 @@ def run(args):
     output = Path(args.output) if args.output else None
     if output is not None and output.exists() and not output.is_dir():
         raise UserError(f"-o {output}: exists and is not a directory")
+    if args.compare_paper and output is None:
+        raise UserError("--compare-paper: needs -o DIR, the folder its two tables are written to")
     takes = load_takes(expand_paths(args.recordings), args.reference)
     unavailable = {}
     params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes), unavailable)
@@ -79,6 +85,10 @@ def run(args):
         _write_outputs(output, result, document, validation)
         if perceptual is not None:
             perceptual_options.write_outputs(output, perceptual, result.names)
+    if args.compare_paper:
+        from studyapp.evaluation import paper_comparison
+
+        paper_comparison.write(output, result, [t.position for t in takes], validation[0] if validation else None)
     if args.json:
         json.dump(document, sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")

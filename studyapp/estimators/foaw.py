@@ -53,6 +53,12 @@ State (``foaw_state_size(N)`` = 3 + 4 (N + 1) slots):
 written at ``head`` and ``head + N + 1`` so that the samples of ages 0 .. N
 are contiguous from ``head`` (no modulo in the inner loop).
 Parameters: ``[N, d, rate]``.
+
+``window_sizes(position, window, margin)`` returns the window n chosen at
+every sample, read from that slot while the kernel runs over the whole input
+(the paper's Sec. 7.4 counts the steps at which FOAW's window is at its
+maximum). The rate is not an argument: the decision is made in samples and
+in the units of x, only the output slope is scaled by the rate.
 """
 
 import numpy as np
@@ -126,6 +132,37 @@ def foaw_core(s, at, window, margin, rate, x):
         chosen = n
     s[at + CHOSEN] = chosen
     return best * rate
+
+
+@njit(cache=True, error_model="numpy")
+def _window_loop(xs, window, margin, out):
+    s = np.zeros(foaw_state_size(window))
+    last = 0.0  # the guard's rule (dispatch.step_guarded): a non-finite sample repeats the last finite one
+    for i in range(xs.shape[0]):
+        x = xs[i]
+        if np.isfinite(x):
+            last = x
+        else:
+            x = last
+        foaw_core(s, 0, window, margin, 1.0, x)
+        out[i] = int(s[CHOSEN])
+
+
+def window_sizes(position, window, margin):
+    """The window n (1 .. ``window``) FOAW chooses at each sample of ``position``, started from rest.
+
+    The same kernel as the estimator's, so the same decision: the output of
+    ``create("FOAW", rate, window=window, margin=margin).process(position)``
+    is, at every sample, the least-squares slope over the window given here.
+    """
+    window = SPEC.param("window").validate(SPEC.name, window, None)
+    margin = SPEC.param("margin").validate(SPEC.name, margin, None)
+    xs = np.ascontiguousarray(position, dtype=np.float64)
+    if xs.ndim != 1:
+        raise ValueError(f"position: expected one dimension, got shape {xs.shape}")
+    out = np.empty(xs.shape[0], dtype=np.int64)
+    _window_loop(xs, window, margin, out)
+    return out
 
 
 @njit(cache=True, inline="always")

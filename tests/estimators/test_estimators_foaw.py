@@ -6,7 +6,7 @@ from numba import njit
 
 from studyapp.estimators import create
 from studyapp.estimators.dispatch import GUARD
-from studyapp.estimators.foaw import CHOSEN, foaw_core, foaw_state_size
+from studyapp.estimators.foaw import CHOSEN, foaw_core, foaw_state_size, window_sizes
 
 
 def brute_force(y, window, margin, rate):
@@ -84,6 +84,43 @@ def test_foaw_picks_the_longest_window_within_the_margin(rate, window, noise, ma
     np.testing.assert_array_equal(chosen, ref_chosen)
     np.testing.assert_allclose(vel, ref_vel, rtol=1e-7, atol=1e-9)
     assert len(np.unique(chosen)) >= window // 2 and np.any(chosen == window) and np.any(chosen < 4)
+
+
+def _slopes_over(x, chosen, rate):
+    """numpy.polyfit's slope over the ``chosen[k] + 1`` newest samples at every k (history = first sample)."""
+    hist = np.concatenate((np.full(chosen.max(), x[0]), x))
+    out = np.empty(len(x))
+    for k, n in enumerate(chosen):
+        ages = np.arange(n + 1)
+        out[k] = np.polyfit(-ages / rate, hist[k + chosen.max() - ages], 1)[0]
+    return out
+
+
+def test_window_sizes_are_the_estimators_windows():
+    """The windows of ``window_sizes`` are the brute-force search's, and the estimator's output is their slope."""
+    rate, window, noise, margin = 5000.0, 17, 6.4e-5, 1.001e-4
+    rng = np.random.default_rng(12)
+    slope = np.repeat(rng.uniform(-0.5, 0.5, 12), 100)
+    x = 0.011 + np.cumsum(slope) / rate + rng.uniform(-noise, noise, slope.size)
+    chosen = window_sizes(x, window, margin)
+    assert chosen.dtype.kind == "i" and len(np.unique(chosen)) >= window // 2
+    np.testing.assert_array_equal(chosen, brute_force(x, window, margin, rate)[1])
+    output = create("FOAW", rate, window=window, margin=margin).process(x)
+    np.testing.assert_allclose(output, _slopes_over(x, chosen, rate), rtol=1e-7, atol=1e-9)
+
+
+def test_window_sizes_on_closed_forms_and_bad_samples():
+    rate, kink, window = 5000.0, 100, 17
+    k = np.arange(200)
+    x = 0.02 + np.where(k < kink, 0.3 * k, 0.3 * kink - 0.8 * (k - kink)) / rate
+    chosen = window_sizes(x, window, 1e-9)
+    assert np.all(chosen[window:kink + 1] == window)  # a straight line: the largest window
+    assert list(chosen[kink + 1:kink + window + 1]) == list(range(1, window + 1))  # samples since the kink
+    x[[0, 50, 120]] = [np.nan, np.inf, np.nan]  # replaced by the last finite sample, as the estimator does
+    _, from_state = stepped(create("FOAW", rate, window=window, margin=1e-4), x)
+    np.testing.assert_array_equal(window_sizes(x, window, 1e-4), from_state)
+    with pytest.raises(ValueError, match="window"):
+        window_sizes(x, 0, 1e-4)
 
 
 def test_foaw_blocks_continue_the_stream():

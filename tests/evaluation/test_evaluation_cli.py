@@ -1,5 +1,7 @@
 """Bad input to optimise, evaluate and tradeoff: exit code 2, one line on stderr, no output file."""
 
+import sys
+
 import pytest
 
 from studyapp.cli import main
@@ -59,11 +61,7 @@ def test_bad_settings(recording, tmp_path, capsys):
     assert not out.exists()
 
 
-def test_scheduler_without_dask(recording, tmp_path, capsys):
-    try:
-        import distributed  # noqa: F401
-        pytest.skip("dask.distributed is installed")
-    except ImportError:
-        pass
+def test_scheduler_without_dask(recording, tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # importing it now fails, as when it is not installed
     _fails(capsys, ["optimise", str(recording), "-o", str(tmp_path / "P.toml"), "--scheduler",
                     "tcp://127.0.0.1:8786"], "dask.distributed")
