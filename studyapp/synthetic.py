@@ -13,12 +13,17 @@ Sensors (paper Sec. 4.2): LVDT position with 15 um RMS Gaussian noise and
 16-bit quantisation over 2.2 cm; LVT velocity through the tachometer's band
 (a 2nd-order Butterworth at 500 Hz, started at rest on the first sample) with
 0.115 mm/s RMS noise, so the LVT reference lags the true velocity as the
-paper's did; accelerometer with 0.22 m/s^2 RMS noise on the stroke's
-acceleration. The exact velocity is returned too.
+paper's did. A digital filter's cut-off must lie below Nyquist, so below
+about 1.02 kHz the band is the highest the rate allows, ``NYQUIST_FRACTION *
+rate`` (the rule of the model's sensors and every estimator cut-off).
+Accelerometer with 0.22 m/s^2 RMS noise on the stroke's acceleration. The
+exact velocity is returned too.
 """
 
 import numpy as np
 from scipy import signal
+
+from studyapp.estimators.spec import NYQUIST_FRACTION
 
 LVDT_NOISE_M = 15e-6
 LVDT_RANGE_M = 0.022
@@ -49,7 +54,7 @@ def stick_slip(rate, duration, f0=110.0, ripple=0.02, v0=0.05, f_stroke=0.5, sli
     position = v0 / w * (1.0 - np.cos(w * t)) - v0 / w + x_ripple
     acceleration = v0 * w * np.cos(w * t)
     q = LVDT_RANGE_M / 2**LVDT_BITS
-    band = signal.butter(2, LVT_BAND_HZ, fs=rate, output="sos")
+    band = signal.butter(2, min(LVT_BAND_HZ, NYQUIST_FRACTION * rate), fs=rate, output="sos")
     lvt = signal.sosfilt(band, velocity, zi=signal.sosfilt_zi(band) * velocity[0])[0]
     measured = np.round((position + rng.normal(0.0, LVDT_NOISE_M, n)) / q) * q
     return {

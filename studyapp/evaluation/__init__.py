@@ -5,6 +5,7 @@
     search.AdaptiveSearch, space.Space   pure adaptive search in each parameter's natural scale
     optimiser.Optimiser            the whole procedure: executor, checkpoints, progress
     report.evaluate, tradeoff.tradeoff   Fig. 5's comparison; cost against accuracy per rate
+    retune.retune                  the optimiser re-run at one rate (``tradeoff --tune``)
 
 Command line: ``studyapp optimise``, ``studyapp evaluate``, ``studyapp tradeoff``.
 """
