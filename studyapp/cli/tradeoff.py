@@ -61,7 +61,7 @@ def run(args):
     from studyapp.evaluation.progress import Progress
     from studyapp.evaluation.provenance import provenance
     from studyapp.evaluation.simulated import PAPER_DELAY, delay_methods
-    from studyapp.evaluation.tradeoff import DEFAULT_FMAX, DEFAULT_RATES, tradeoff
+    from studyapp.evaluation.tradeoff import DEFAULT_FMAX, DEFAULT_RATES, check_available, tradeoff
 
     started = time.monotonic()
     output = Path(args.output)
@@ -85,6 +85,8 @@ def run(args):
     # Validated at the highest rate: a value that can exist at no rate is an error in the file;
     # one that cannot exist at some of the rates makes the estimator not available there.
     params, file_provenance = parameter_sets(args.params, args.estimators, RATE_MAX)
+    params_rate = float(file_provenance.get("rate", 5000.0))
+    check_available(params, rates, params_rate, args.windows)
     delay = args.delay
     if delay not in delay_methods():
         print(f"tradeoff: --delay {delay}: this build's metric has only eq. 22; delays are measured with "
@@ -103,7 +105,7 @@ def run(args):
     try:
         trade = tradeoff(
             params, rates=rates, fmax_values=fmax, duration=args.duration, seed=args.seed, reference=args.reference,
-            params_rate=float(file_provenance.get("rate", 5000.0)), windows=args.windows,
+            params_rate=params_rate, windows=args.windows,
             cost_samples=args.cost_samples, delay_method=delay, tune_patience=patience if args.tune else None,
             executor=executor, source_name="tuned" if args.tune else "params" if args.params else "table1",
             progress=say,

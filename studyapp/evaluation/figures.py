@@ -196,7 +196,8 @@ def rate_figure(table):
         ax.grid(alpha=0.3)
     axes[0].set_yscale("log")
     axes[2].set_yscale("log")
-    axes[2].legend(fontsize=7, ncol=2)
+    if names:
+        axes[2].legend(fontsize=7, ncol=2)
     fig.tight_layout()
     return fig
 

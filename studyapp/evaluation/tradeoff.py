@@ -82,6 +82,14 @@ def params_at_rate(params, rate, params_rate, windows="seconds"):
     return available, missing
 
 
+def check_available(params, rates, params_rate, windows="seconds"):
+    """Raise a ``UserError`` when no estimator of ``params`` can run at any of ``rates``."""
+    if not any(params_at_rate(params, rate, params_rate, windows)[0] for rate in rates):
+        _, missing = params_at_rate(params, rates[0], params_rate, windows)
+        raise UserError(f"no estimator is available at {', '.join(f'{r:g}' for r in rates)} Hz: "
+                        + "; ".join(missing.values()))
+
+
 @dataclass
 class Trade:
     """The trade table and how it was made."""
@@ -144,6 +152,7 @@ def tradeoff(params, rates=DEFAULT_RATES, fmax_values=DEFAULT_FMAX, duration=2.0
         from studyapp.evaluation.executors import InlineExecutor
 
         executor = InlineExecutor()
+    check_available(params, rates, params_rate, windows)
     source_name = source_name or ("tuned" if tune else "table1")
     say = progress or (lambda line: None)
     trade = Trade(rows=[])

@@ -215,6 +215,22 @@ def test_progress_and_unavailable_estimators_on_screen(tmp_path, capsys):
     assert "Traceback" not in captured.err
 
 
+@pytest.mark.filterwarnings("error")
+def test_a_rate_where_no_estimator_is_available_still_gets_its_outputs(tmp_path, monkeypatch):
+    from studyapp.evaluation import figures
+
+    made = {}
+    monkeypatch.setattr(figures, "written", lambda fig, stem: made.setdefault(stem.name, fig))
+    out = tmp_path / "t"
+    assert main(["tradeoff", "--rates", "1000", "5000", "--estimators", "COMP2", "--fmax", "1", "--duration", "0.1",
+                 "--cost-samples", "1000", "-o", str(out)]) == 0
+    rows = _csv(out / "tradeoff.csv")
+    assert [(r["rate"], r["available"]) for r in rows] == [("1000.0", "False"), ("5000.0", "True")]
+    assert sorted(made) == ["pareto_1000Hz", "pareto_5000Hz", "tradeoff", "tradeoff_rates"]
+    for fig in made.values():
+        assert text_overlaps(fig) == [] and texts_outside(fig) == []
+
+
 def test_tune_gives_the_parameters_of_optimise_on_the_same_recordings(tmp_path):
     """Re-tuning at a rate is the paper's optimiser on that rate's data: same result as simulate + optimise."""
     import tomllib
@@ -269,4 +285,6 @@ def test_bad_options(tmp_path, capsys):
     _fails(capsys, ["tradeoff", "--patience", "5", "-o", str(out)], "only with --tune")
     _fails(capsys, ["tradeoff", "--workers", "2", "-o", str(out)], "only with --tune")
     _fails(capsys, ["tradeoff", "--delay", "late", "-o", str(out)], "--delay")
+    _fails(capsys, ["tradeoff", "--rates", "1000", "2000", "--estimators", "COMP2", "-o", str(out)],
+           "no estimator is available at 1000, 2000 Hz: COMP2 parameter 'hpf_hz'")
     assert not out.exists()
