@@ -77,10 +77,14 @@ class Optimiser:
     matters; without it, ever smaller gains from zooming in on a continuous
     optimum would keep postponing the stopping rule).
     ``fingerprint`` (a JSON-able dict) identifies the run for checkpoints.
+    ``starts``: name -> the first parameter set of that estimator (default its
+    space's start, Table 1); ``studyapp tradeoff`` starts from Table 1 made
+    for the rate (windows kept in seconds).
     """
 
     def __init__(self, spaces, objective, executor, patience=1000, seed=0, tolerance=None,
-                 max_sets=None, checkpoint=None, checkpoint_interval=30.0, progress=None, fingerprint=None):
+                 max_sets=None, checkpoint=None, checkpoint_interval=30.0, progress=None, fingerprint=None,
+                 starts=None):
         if not spaces:
             raise UserError("no estimators to optimise")
         self.spaces = dict(spaces)
@@ -97,13 +101,15 @@ class Optimiser:
         self.checkpoint = checkpoint
         self.checkpoint_interval = float(checkpoint_interval)
         self.progress = progress
+        starts = dict(starts or {})
         self.fingerprint = {
             "seed": self.seed, "patience": self.patience, "max_sets": self.max_sets,
             "spaces": {name: space.describe() for name, space in self.spaces.items()},
+            **({"starts": starts} if starts else {}),
             **(fingerprint or {}),
         }
         self.searches = {
-            name: AdaptiveSearch(space, estimator_seed(self.seed, name), self.patience)
+            name: AdaptiveSearch(space, estimator_seed(self.seed, name), self.patience, starts.get(name))
             for name, space in self.spaces.items()
         }
         self.sum = None

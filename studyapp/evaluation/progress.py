@@ -4,7 +4,8 @@ One line at most every ``interval`` seconds (and a last one at the end):
 iteration, parameter sets evaluated, elapsed time, then for each estimator its
 best F_g under the scale in force and, after a slash, how many new sets in a
 row have not improved it (it stops at the patience), or ``*`` once it has
-stopped searching.
+stopped searching. ``prefix`` starts every line (``studyapp tradeoff`` names
+the rate there).
 On a terminal the line is redrawn in place; in a log each update is a line.
 """
 
@@ -13,7 +14,8 @@ import time
 
 
 class Progress:
-    def __init__(self, stream=None, interval=2.0):
+    def __init__(self, stream=None, interval=2.0, prefix=""):
+        self.prefix = str(prefix)
         self.stream = sys.stderr if stream is None else stream
         self.interval = float(interval)
         self.started = time.monotonic()
@@ -30,7 +32,7 @@ class Progress:
             f"{name} {value:.4g}" + ("*" if name in done else f"/{waiting[name]}" if name in waiting else "")
             for name, value in objectives.items()
         ]
-        line = f"iter {iteration} sets {evaluated} {now - self.started:.0f}s | " + "  ".join(parts)
+        line = self.prefix + f"iter {iteration} sets {evaluated} {now - self.started:.0f}s | " + "  ".join(parts)
         if self.tty:
             self.stream.write("\r\033[K" + line + ("\n" if final else ""))
         else:

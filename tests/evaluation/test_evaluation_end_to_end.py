@@ -140,7 +140,8 @@ def test_tradeoff_writes_table_and_plots(optimised, tmp_path):
         (5000.0, "LOWPASS"), (5000.0, "LEASTSQ"), (10000.0, "LOWPASS"), (10000.0, "LEASTSQ")]
     for r in rows:
         assert float(r["cost_ns_per_sample"]) > 0 and float(r["error_median"]) > 0
-        assert float(r["delay_median_ms"]) == pytest.approx(1e3 * float(r["delay_median"]) / float(r["rate"]))
+        assert float(r["delay_median_us"]) == pytest.approx(1e6 * float(r["delay_median"]) / float(r["rate"]))
+        assert r["available"] == "True" and r["parameters_source"] == "params"
     for rate in ("5000.0", "10000.0"):
         assert any(r["pareto"] == "True" for r in rows if r["rate"] == rate)
     # Windows keep their duration: LEASTSQ's window doubles from 5 to 10 kHz.
