@@ -78,9 +78,12 @@ def test_worker_runs_switches_source_and_fmax_and_stops_cleanly():
         assert set(tel["fmax"][:switch]) == {1.0} and set(tel["fmax"][switch:]) == {3.0}
         assert np.all(np.abs(tel["force"]) <= tel["fmax"] * 1.01)
         assert np.max(np.abs(tel["force"][switch:])) > 0  # the string does push back
-        # the source velocity was the LVT before the switch and KALLEV's estimate after
-        np.testing.assert_array_equal(tel["source_velocity"][:switch], tel["velocity_lvt"][:switch])
-        np.testing.assert_array_equal(tel["source_velocity"][switch:], tel["estimates"]["KALLEV"][switch:])
+        # the source velocity was the LVT before its switch and KALLEV's estimate after; the two
+        # commands are separate, so on a loaded machine the worker may apply them a block apart
+        source = np.flatnonzero(tel["source_velocity"] != tel["velocity_lvt"])[0]
+        assert (tel["start"] + source) % block == 0 and abs(source - switch) <= block
+        np.testing.assert_array_equal(tel["source_velocity"][:source], tel["velocity_lvt"][:source])
+        np.testing.assert_array_equal(tel["source_velocity"][source:], tel["estimates"]["KALLEV"][source:])
         assert set(tel["estimates"]) == {"KALLEV", "LOWPASS"}
         # estimates track the true velocity (a sanity check of the rows' wiring, not of the estimators)
         assert np.corrcoef(tel["estimates"]["LOWPASS"], tel["velocity_true"])[0, 1] > 0.5
