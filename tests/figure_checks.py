@@ -40,7 +40,6 @@ def text_boxes(fig):
         FigureCanvasAgg(fig)
     drawn = _drawn_texts(fig)
     renderer = fig.canvas.get_renderer()
-    undrawn = _undrawn_tick_labels(fig)
     boxes = []
     for artist in dict.fromkeys(drawn):
         if not artist.get_visible() or not artist.get_text().strip():

@@ -60,7 +60,6 @@ def run(args):
     from studyapp.evaluation.parameter_sets import parameter_sets
     from studyapp.evaluation.progress import Progress
     from studyapp.evaluation.provenance import provenance
-    from studyapp.evaluation.simulated import PAPER_DELAY, delay_methods
     from studyapp.evaluation.tradeoff import DEFAULT_FMAX, DEFAULT_RATES, check_available, tradeoff
 
     started = time.monotonic()
@@ -88,10 +87,6 @@ def run(args):
     params_rate = float(file_provenance.get("rate", 5000.0))
     check_available(params, rates, params_rate, args.windows)
     delay = args.delay
-    if delay not in delay_methods():
-        print(f"tradeoff: --delay {delay}: this build's metric has only eq. 22; delays are measured with "
-              f"'{PAPER_DELAY}'", file=sys.stderr)
-        delay = PAPER_DELAY
 
     def say(line):
         print(line, file=sys.stderr, flush=True)

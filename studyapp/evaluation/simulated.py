@@ -10,32 +10,18 @@ the result, as ``dataset.RecordingFiles`` does for files. The optimiser's
 tasks (``dataset.raw_objectives_task``) take either.
 
 The delay of every estimate is measured with ``delay_method`` (see
-``metric.py``); ``delay_methods()`` says which methods this build's metric has.
+``metric.py``).
 """
 
-import inspect
 from dataclasses import dataclass
 
-from studyapp.errors import UserError
 from studyapp.evaluation.dataset import DEFAULT_MAX_LAG_S, Dataset, take_from_recording
-
-PAPER_DELAY = "paper"  # eq. 22 as the paper wrote it: lags 0..max_lag, unnormalised
-
-
-def delay_methods():
-    """The delay methods ``Dataset`` can measure with (``("paper",)`` until it takes ``delay_method``)."""
-    if "delay_method" in inspect.signature(Dataset).parameters:
-        return ("normalised", PAPER_DELAY)
-    return (PAPER_DELAY,)
+from studyapp.evaluation.metric import DEFAULT_METHOD
 
 
-def make_dataset(takes, max_lag_s=DEFAULT_MAX_LAG_S, delay_method=PAPER_DELAY, fast=True):
+def make_dataset(takes, max_lag_s=DEFAULT_MAX_LAG_S, delay_method=DEFAULT_METHOD, fast=True):
     """A ``Dataset`` of ``takes`` whose delays are measured with ``delay_method``."""
-    if delay_method not in delay_methods():
-        raise UserError(f"--delay {delay_method}: this build's metric measures only {', '.join(delay_methods())}")
-    if "delay_method" in inspect.signature(Dataset).parameters:
-        return Dataset(takes, max_lag_s, fast=fast, delay_method=delay_method)
-    return Dataset(takes, max_lag_s, fast=fast)
+    return Dataset(takes, max_lag_s, fast=fast, delay_method=delay_method)
 
 
 def simulate_takes(rate, fmax_values, duration, seed, reference="lvt"):
@@ -64,7 +50,7 @@ class SimulatedSet:
     seed: int = 0
     reference: str = "lvt"
     max_lag_s: float = DEFAULT_MAX_LAG_S
-    delay_method: str = PAPER_DELAY
+    delay_method: str = DEFAULT_METHOD
 
     def load(self):
         dataset = _LOADED.get(self)

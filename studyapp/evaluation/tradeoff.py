@@ -43,7 +43,8 @@ from studyapp.errors import ParameterError, UserError
 from studyapp.evaluation.pareto import pareto_front
 from studyapp.evaluation.report import evaluate
 from studyapp.evaluation.retune import retune
-from studyapp.evaluation.simulated import PAPER_DELAY, SimulatedSet
+from studyapp.evaluation.metric import DEFAULT_METHOD
+from studyapp.evaluation.simulated import SimulatedSet
 
 DEFAULT_RATES = (5000.0, 10000.0, 20000.0, 40000.0)
 DEFAULT_FMAX = (0.5, 1.4, 2.2, 4.4, 7.7)
@@ -134,7 +135,7 @@ def _rows(rate, result, costs, source):
 
 def tradeoff(params, rates=DEFAULT_RATES, fmax_values=DEFAULT_FMAX, duration=2.0, seed=0, reference="lvt",
              params_rate=5000.0, windows="seconds", max_lag_s=0.02, cost=None, cost_samples=100_000,
-             delay_method=PAPER_DELAY, tune_patience=None, executor=None, source_name=None, progress=None,
+             delay_method=DEFAULT_METHOD, tune_patience=None, executor=None, source_name=None, progress=None,
              tuning_progress=None):
     """The ``Trade`` of the estimators of ``params`` (name -> values) at each of ``rates``.
 

@@ -126,17 +126,12 @@ def test_optimiser_starts_from_the_given_sets():
     assert first == {"LOWPASS": {"cutoff_hz": 1000.0}, "COMP1": {"cutoff_hz": 317.0}}  # COMP1: Table 1
 
 
-def test_make_dataset_passes_the_delay_method_when_the_metric_takes_it(monkeypatch):
+def test_make_dataset_passes_the_delay_method():
     from studyapp.evaluation import simulated
 
-    class WithMethod:
-        def __init__(self, takes, max_lag_s, fast=False, delay_method="normalised"):
-            self.delay_method = delay_method
-
-    monkeypatch.setattr(simulated, "Dataset", WithMethod)
-    assert simulated.delay_methods() == ("normalised", "paper")
-    assert simulated.make_dataset([], 0.02, "paper").delay_method == "paper"
-    assert simulated.make_dataset([], 0.02, "normalised").delay_method == "normalised"
+    for method in ("paper", "normalised"):
+        recipe = simulated.SimulatedSet(rate=5000.0, fmax_values=(2.2,), duration=0.1, delay_method=method)
+        assert recipe.load().delay_method == method
 
 
 # -- the command --------------------------------------------------------------------------------
@@ -180,7 +175,6 @@ def test_delay_is_reported_in_samples_and_microseconds_and_matches_the_metric(ex
     """The 1 kHz LOWPASS row, recomputed independently: simulate, run the estimator, measure."""
     from studyapp.estimators import create
     from studyapp.evaluation import delay_and_error
-    from studyapp.evaluation.simulated import delay_methods
     from studyapp.model import simulate
 
     _, out = extremes
@@ -195,11 +189,9 @@ def test_delay_is_reported_in_samples_and_microseconds_and_matches_the_metric(ex
     est = create("LOWPASS", 1000.0, **row["parameters"]).process(
         rec["position"], rec["acceleration"], rec["velocity_lvt"])
     method = json.loads((out / "tradeoff.json").read_text())["provenance"]["delay_method"]
-    assert method == ("normalised" if "normalised" in delay_methods() else "paper")
-    import inspect
+    assert method == "normalised"
 
-    kwargs = {"method": method} if "method" in inspect.signature(delay_and_error).parameters else {}
-    d, e = delay_and_error(rec["velocity_lvt"], est, 20, **kwargs)  # max_lag: 0.02 s at 1 kHz
+    d, e = delay_and_error(rec["velocity_lvt"], est, 20, method=method)  # max_lag: 0.02 s at 1 kHz
     assert row["delay_median"] == d and row["error_median"] == pytest.approx(e, rel=1e-12)
 
 
