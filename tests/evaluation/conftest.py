@@ -24,3 +24,26 @@ def synthetic_recording(fmax, rate=5000.0, duration=1.0, seed=0):
 @pytest.fixture(scope="session")
 def synthetic():
     return stick_slip
+
+
+@pytest.fixture(scope="session")
+def short_recording(tmp_path_factory):
+    """A 0.3 s synthetic recording at F_max = 1 N, saved as .npz (for command-line tests)."""
+    from studyapp.recording import save
+
+    path = tmp_path_factory.mktemp("short_recording") / "fmax_1.npz"
+    save(synthetic_recording(1.0, duration=0.3), path)
+    return path
+
+
+def fails_with_one_line(capsys, argv, match):
+    """``studyapp argv`` exits 2 with one line on stderr that names ``match``, and no traceback."""
+    from studyapp.cli import main
+
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("studyapp: error:") and match in lines[0]
+    assert "Traceback" not in err

@@ -8,23 +8,16 @@ import pytest
 
 from studyapp.cli import main
 from studyapp.evaluation import perceptual_scores as ps
-from tests.evaluation.conftest import synthetic_recording
+from tests.evaluation.conftest import fails_with_one_line
 
 SHORT = ["--perceptual-fmax", "1", "--perceptual-seeds", "3", "--perceptual-duration", "0.5"]
 
 
-@pytest.fixture(scope="module")
-def recording(tmp_path_factory):
-    from studyapp.recording import save
-
-    path = tmp_path_factory.mktemp("perceptual_cli") / "fmax_1.npz"
-    save(synthetic_recording(1.0, duration=0.3), path)
-    return path
 
 
-def test_evaluate_adds_the_audio_distance(recording, tmp_path, capsys):
+def test_evaluate_adds_the_audio_distance(short_recording, tmp_path, capsys):
     out = tmp_path / "eval"
-    assert main(["evaluate", str(recording), "--estimators", "LOWPASS,LEVANT", "--json", "-o", str(out),
+    assert main(["evaluate", str(short_recording), "--estimators", "LOWPASS,LEVANT", "--json", "-o", str(out),
                  "--perceptual", *SHORT]) == 0
     document = json.loads(capsys.readouterr().out)
     cases = ps.Cases(5000.0, (1.0,), (3,), 0.5)
@@ -43,8 +36,8 @@ def test_evaluate_adds_the_audio_distance(recording, tmp_path, capsys):
     assert len(rows) == 3
 
 
-def test_evaluate_prints_the_distances(recording, capsys):
-    assert main(["evaluate", str(recording), "--estimators", "LOWPASS,LEVANT,FOAW", "--perceptual", *SHORT]) == 0
+def test_evaluate_prints_the_distances(short_recording, capsys):
+    assert main(["evaluate", str(short_recording), "--estimators", "LOWPASS,LEVANT,FOAW", "--perceptual", *SHORT]) == 0
     captured = capsys.readouterr()
     lines = captured.out.splitlines()
     start = next(i for i, line in enumerate(lines) if line.startswith("audio distance to TRUE"))
@@ -57,8 +50,8 @@ def test_evaluate_prints_the_distances(recording, capsys):
     assert "perceptual: FOAW (3/3)" in captured.err
 
 
-def test_evaluate_without_the_option_is_unchanged(recording, capsys):
-    assert main(["evaluate", str(recording), "--estimators", "LOWPASS", "--json"]) == 0
+def test_evaluate_without_the_option_is_unchanged(short_recording, capsys):
+    assert main(["evaluate", str(short_recording), "--estimators", "LOWPASS", "--json"]) == 0
     document = json.loads(capsys.readouterr().out)
     assert "perceptual" not in document and "audio_distance" not in document["estimators"]["LOWPASS"]
 
@@ -84,7 +77,7 @@ def test_a_checkpoint_of_other_cases_is_refused(tmp_path, capsys):
            "--quiet", "-o", str(out), "--perceptual-fmax", "1", "--perceptual-seeds", "3"]
     assert main([*run, "--perceptual-duration", "0.5"]) == 0
     assert main([*run, "--perceptual-duration", "0.5", "--resume"]) == 0
-    _fails(capsys, [*run, "--perceptual-duration", "0.6", "--resume"], "differs in: perceptual")
+    fails_with_one_line(capsys, [*run, "--perceptual-duration", "0.6", "--resume"], "differs in: perceptual")
 
 
 def test_the_default_patience_depends_on_the_objective():
@@ -101,28 +94,22 @@ def test_the_default_patience_depends_on_the_objective():
     assert args.objective == "paper" and args.patience is None
 
 
-def _fails(capsys, argv, match):
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("studyapp: error:") and match in lines[0]
 
 
-def test_bad_input(recording, tmp_path, capsys):
+def test_bad_input(short_recording, tmp_path, capsys):
     out = tmp_path / "P.toml"
     perceptual = ["optimise", "--objective", "perceptual", "-o", str(out)]
-    _fails(capsys, [*perceptual, str(recording)], "reads no recordings")
-    _fails(capsys, [*perceptual, "--perceptual-fmax", "-1"], "--perceptual-fmax")
-    _fails(capsys, [*perceptual, "--perceptual-fmax", "500"], "--perceptual-fmax")
-    _fails(capsys, [*perceptual, "--perceptual-seeds", "-3"], "--perceptual-seeds")
-    _fails(capsys, [*perceptual, "--perceptual-duration", "0"], "--perceptual-duration")
-    _fails(capsys, [*perceptual, "--rate", "10"], "--rate")
-    _fails(capsys, ["optimise", "-o", str(out)], "no recordings given")
-    _fails(capsys, ["optimise", str(recording), "-o", str(out), "--rate", "5000"], "--rate")
-    _fails(capsys, ["optimise", str(recording), "-o", str(out), "--perceptual-seeds", "1"], "--objective perceptual")
-    _fails(capsys, ["evaluate", str(recording), "--perceptual-fmax", "1"], "--perceptual")
-    _fails(capsys, ["evaluate", str(recording), "--perceptual", "--perceptual-duration", "-2",
+    fails_with_one_line(capsys, [*perceptual, str(short_recording)], "reads no recordings")
+    fails_with_one_line(capsys, [*perceptual, "--perceptual-fmax", "-1"], "--perceptual-fmax")
+    fails_with_one_line(capsys, [*perceptual, "--perceptual-fmax", "500"], "--perceptual-fmax")
+    fails_with_one_line(capsys, [*perceptual, "--perceptual-seeds", "-3"], "--perceptual-seeds")
+    fails_with_one_line(capsys, [*perceptual, "--perceptual-duration", "0"], "--perceptual-duration")
+    fails_with_one_line(capsys, [*perceptual, "--rate", "10"], "--rate")
+    fails_with_one_line(capsys, ["optimise", "-o", str(out)], "no recordings given")
+    fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(out), "--rate", "5000"], "--rate")
+    fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(out), "--perceptual-seeds", "1"],
+                        "--objective perceptual")
+    fails_with_one_line(capsys, ["evaluate", str(short_recording), "--perceptual-fmax", "1"], "--perceptual")
+    fails_with_one_line(capsys, ["evaluate", str(short_recording), "--perceptual", "--perceptual-duration", "-2",
                     "-o", str(tmp_path / "eval")], "--perceptual-duration")
     assert not out.exists() and not (tmp_path / "eval").exists()

@@ -1,7 +1,7 @@
 """``studyapp tradeoff``: re-tuning per rate, rates 1-96 kHz, error and delay beside cost, labels that never overlap.
 
 Short runs on real ``studyapp.model.simulate`` output (a few tenths of a
-second per recording, tiny patience, two or three estimators where the test
+second per short_recording, tiny patience, two or three estimators where the test
 allows); the figures are checked on the command's own output for all thirteen
 estimators with matplotlib's renderer (tests/figure_checks.py).
 """
@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from studyapp.cli import main
+from tests.evaluation.conftest import fails_with_one_line
 from tests.figure_checks import text_overlaps, texts_outside
 
 
@@ -28,13 +29,6 @@ def _rows(path):
     return [{k: float("nan") if v is None else v for k, v in r.items()} for r in rows]
 
 
-def _fails(capsys, argv, match):
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("studyapp: error:") and match in lines[0]
 
 
 # -- the label layout ---------------------------------------------------------------------------
@@ -272,11 +266,11 @@ def test_bad_options(tmp_path, capsys):
     out = tmp_path / "t"
     params = tmp_path / "P.toml"
     params.write_text("[LOWPASS]\ncutoff_hz = 300\n")
-    _fails(capsys, ["tradeoff", "--tune", "--params", str(params), "-o", str(out)], "--params")
-    _fails(capsys, ["tradeoff", "--tune", "--patience", "0", "-o", str(out)], "--patience 0")
-    _fails(capsys, ["tradeoff", "--patience", "5", "-o", str(out)], "only with --tune")
-    _fails(capsys, ["tradeoff", "--workers", "2", "-o", str(out)], "only with --tune")
-    _fails(capsys, ["tradeoff", "--delay", "late", "-o", str(out)], "--delay")
-    _fails(capsys, ["tradeoff", "--rates", "1000", "2000", "--estimators", "COMP2", "-o", str(out)],
+    fails_with_one_line(capsys, ["tradeoff", "--tune", "--params", str(params), "-o", str(out)], "--params")
+    fails_with_one_line(capsys, ["tradeoff", "--tune", "--patience", "0", "-o", str(out)], "--patience 0")
+    fails_with_one_line(capsys, ["tradeoff", "--patience", "5", "-o", str(out)], "only with --tune")
+    fails_with_one_line(capsys, ["tradeoff", "--workers", "2", "-o", str(out)], "only with --tune")
+    fails_with_one_line(capsys, ["tradeoff", "--delay", "late", "-o", str(out)], "--delay")
+    fails_with_one_line(capsys, ["tradeoff", "--rates", "1000", "2000", "--estimators", "COMP2", "-o", str(out)],
            "no estimator is available at 1000, 2000 Hz: COMP2 parameter 'hpf_hz'")
     assert not out.exists()
