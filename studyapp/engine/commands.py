@@ -22,23 +22,21 @@ Kinds and values:
     stop          None
 
 MIDI actions map a control (see midi.ControlMap) to a command. The default
-for live use (``default_actions``): knob 1 sets F_max on a logarithmic scale
-as in the paper's adjustment task (Sec. 8.2: "increased logarithmically by
-turning to the right"; knob at 0 gives F_max = 0), knob 2 the volume, and pad
-i selects the i-th velocity source of the scene.
+for live use (``default_actions``): knob 1 sets F_max through the app's one
+knob law (model/fmax_knob.py, the paper's logarithmic map of Sec. 8.2) over
+``LIVE_RANGE``, knob 2 the volume, and pad i selects the i-th velocity source
+of the scene.
 """
 
-import math
 import time
 
 from studyapp.errors import ParameterError
+from studyapp.model.fmax_knob import KNOB_MAX, LIVE_RANGE, fmax_from_knob
 
 KINDS = (
     "source", "fmax", "hand_target", "bowing", "gesture", "reset_string", "volume", "mute",
     "learn", "clear_fault", "stall", "stop",
 )
-
-FMAX_KNOB_RANGE = (0.1, 20.0)  # N: knob step 1 .. knob step 127
 
 
 def command(kind, value=None, sent=None):
@@ -47,23 +45,7 @@ def command(kind, value=None, sent=None):
     return (kind, value, time.monotonic() if sent is None else sent)
 
 
-def knob_to_fmax(value, low=FMAX_KNOB_RANGE[0], high=FMAX_KNOB_RANGE[1]):
-    """Knob position in [0, 1] (7-bit steps) -> F_max: 0 at the bottom, then ``low`` .. ``high`` logarithmically."""
-    step = round(value * 127)
-    if step <= 0:
-        return 0.0
-    return low * (high / low) ** ((step - 1) / 126)
-
-
-def fmax_to_knob(fmax, low=FMAX_KNOB_RANGE[0], high=FMAX_KNOB_RANGE[1]):
-    """The inverse of ``knob_to_fmax`` (nearest 7-bit step), for showing an F_max on a knob."""
-    if fmax <= 0:
-        return 0.0
-    step = 1 + round(126 * math.log(max(fmax, low) / low) / math.log(high / low))
-    return min(step, 127) / 127
-
-
-def default_actions(sources, fmax_range=FMAX_KNOB_RANGE):
+def default_actions(sources, fmax_range=LIVE_RANGE):
     """``{control: action}`` for live use: knob1 F_max, knob2 volume, pad i the i-th source."""
     actions = {"knob1": ("fmax_log", *fmax_range), "knob2": ("volume",)}
     for i, name in enumerate(list(sources)[:8], start=1):
@@ -75,7 +57,7 @@ def action_command(action, value, sent):
     """The command an action makes from a control value in [0, 1], or ``None`` (e.g. a pad released)."""
     kind = action[0]
     if kind == "fmax_log":
-        return command("fmax", knob_to_fmax(value, action[1], action[2]), sent)
+        return command("fmax", fmax_from_knob(value * KNOB_MAX, action[1], action[2]), sent)
     if kind == "fmax_linear":
         return command("fmax", action[1] + value * (action[2] - action[1]), sent)
     if kind == "volume":

@@ -14,7 +14,7 @@ condition in the loop (``source``) is fixed for the trial; ``fmax`` is read
 after each event. No Qt, no I/O.
 """
 
-from studyapp.experiment.fmax_knob import fmax_from_knob
+from studyapp.model.fmax_knob import fmax_from_knob
 from studyapp.experiment.rating_task import check_knob_value
 
 

@@ -22,7 +22,7 @@ knob turn) and ``fmax`` (0 until a condition is selected, so nothing plays an
 unchosen condition) are read after each event. No Qt, no I/O.
 """
 
-from studyapp.experiment.fmax_knob import KNOB_MAX
+from studyapp.model.fmax_knob import KNOB_MAX
 
 
 def check_knob_value(value):

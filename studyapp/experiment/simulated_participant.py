@@ -45,7 +45,7 @@ import math
 
 import numpy as np
 
-from studyapp.experiment.fmax_knob import KNOB_MAX
+from studyapp.model.fmax_knob import KNOB_MAX
 from studyapp.experiment.noisiness import velocity_noise
 
 

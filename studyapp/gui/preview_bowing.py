@@ -15,8 +15,7 @@ import time
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
-from studyapp.engine.commands import fmax_to_knob
-from studyapp.experiment.fmax_knob import KNOB_MAX
+from studyapp.model.fmax_knob import LIVE_RANGE, knob_from_fmax
 
 PREVIEW_FMAX = 1.0  # N, the rating task's F_max
 
@@ -52,7 +51,7 @@ class PreviewBowing:
             return
         if self.bowing_since is None:
             if c.state not in ("starting", "running", "paused"):
-                self.console.turn_knob(0, round(fmax_to_knob(PREVIEW_FMAX) * KNOB_MAX))
+                self.console.turn_knob(0, knob_from_fmax(PREVIEW_FMAX, *LIVE_RANGE))
                 self.console.set_gesture("strokes")
                 self.console.set_bowing(True)
             self.bowing_since = self.clock()

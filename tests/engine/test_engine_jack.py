@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 
-from studyapp.engine.commands import knob_to_fmax
+from studyapp.model.fmax_knob import LIVE_RANGE, fmax_from_knob
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
 
@@ -71,7 +71,7 @@ def test_a_control_change_from_another_process_sets_fmax_within_one_block(jack_s
             time.sleep(0.01)
         assert controls, "no control event reached the engine"
         control, value, arrived, latency, blocks_late, applied_block = controls[0]
-        expected = knob_to_fmax(100 / 127)
+        expected = fmax_from_knob(100, *LIVE_RANGE)
         assert control == "knob1" and value == pytest.approx(100 / 127)
         assert blocks_late <= 1
         assert 0 <= latency

@@ -10,6 +10,7 @@ import pytest
 from studyapp.engine import commands
 from studyapp.engine.midi import ControlMap, MidiInput, open_input
 from studyapp.errors import ParameterError
+from studyapp.model.fmax_knob import LIVE_RANGE, fmax_from_knob
 
 
 class FakeInput(mido.ports.BaseInput):
@@ -79,21 +80,19 @@ def test_learn_mode_binds_the_next_control_that_moves():
     assert "pad1" not in cmap.to_dict() and cmap.to_dict()["knob2"] == {"note": 36, "channel": 1}
 
 
-def test_knob_one_sets_fmax_logarithmically_from_zero():
-    assert commands.knob_to_fmax(0.0) == 0.0
-    assert commands.knob_to_fmax(1 / 127) == pytest.approx(0.1)
-    assert commands.knob_to_fmax(1.0) == pytest.approx(20.0)
-    steps = [commands.knob_to_fmax(k / 127) for k in range(1, 128)]
-    ratios = [b / a for a, b in zip(steps, steps[1:])]
-    assert max(ratios) == pytest.approx(min(ratios))  # equal ratios: logarithmic
-    for k in range(128):
-        assert commands.fmax_to_knob(commands.knob_to_fmax(k / 127)) == pytest.approx(k / 127)
+def test_knob_one_uses_the_one_knob_law_over_the_live_range():
+    actions = commands.default_actions(["LVT"])
+    for step in (0, 1, 64, 127):
+        value = commands.action_command(actions["knob1"], step / 127, sent=0.0)[1]
+        assert value == pytest.approx(fmax_from_knob(step, *LIVE_RANGE))
+    assert commands.action_command(actions["knob1"], 1 / 127, 0.0)[1] == pytest.approx(0.1)
+    assert commands.action_command(actions["knob1"], 1.0, 0.0)[1] == pytest.approx(20.0)
 
 
 def test_default_actions_drive_the_engine_commands():
     actions = commands.default_actions(["KALLEV", "LOWPASS", "LVT"])
     kind, value, sent = commands.action_command(actions["knob1"], 100 / 127, sent=1.0)
-    assert (kind, sent) == ("fmax", 1.0) and value == pytest.approx(commands.knob_to_fmax(100 / 127))
+    assert (kind, sent) == ("fmax", 1.0) and value == pytest.approx(fmax_from_knob(100, *LIVE_RANGE))
     assert commands.action_command(actions["pad2"], 1.0, 2.0)[:2] == ("source", "LOWPASS")
     assert commands.action_command(actions["pad2"], 0.0, 2.0) is None  # releasing a pad does nothing
     assert commands.action_command(actions["knob2"], 0.5, 2.0)[:2] == ("volume", 0.5)

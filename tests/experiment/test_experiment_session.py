@@ -11,7 +11,7 @@ import pytest
 
 from studyapp.errors import UserError
 from studyapp.experiment.export import COLUMNS, export_responses, write_responses
-from studyapp.experiment.fmax_knob import fmax_from_knob
+from studyapp.model.fmax_knob import fmax_from_knob
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import SessionLog, read_events

@@ -1,12 +1,11 @@
 """Task logic: scripted event sequences give the expected logged responses."""
 
-import math
-
+import numpy as np
 import pytest
 
 from studyapp.experiment.adjustment_task import AdjustmentTask
-from studyapp.experiment.fmax_knob import fmax_from_knob, knob_from_fmax
 from studyapp.experiment.rating_task import RatingTask, normalise_ratings
+from studyapp.model.fmax_knob import fmax_from_knob, knob_from_fmax
 
 CONDITIONS = ("LOWPASS", "LEVANT", "KALLEV", "LVT")
 
@@ -91,23 +90,22 @@ def test_adjustment_sequence_with_overshoot():
     knobs = [r for r in records if r["type"] == "knob"]
     assert [r["value"] for r in knobs] == [60, 100, 96]
     response = records[-1]
-    expected = 40.0 * (10 ** (3 * 96 / 127) - 1) / (10**3 - 1)
+    expected = 40.0 * 10 ** (-3 * (127 - 96) / 126)
     assert response == {
         "type": "response", "task": "adjustment", "condition": "LOWPASS", "trial": 2,
         "fmax": pytest.approx(expected), "value": 96,
-        "peak_fmax": pytest.approx(40.0 * (10 ** (3 * 100 / 127) - 1) / 999), "duration": 1.0,
+        "peak_fmax": pytest.approx(40.0 * 10 ** (-3 * 27 / 126)), "duration": 1.0,
     }
     assert task.done and task.knob(0, 5) == [] and task.fmax == pytest.approx(expected)
 
 
 def test_fmax_knob_map_is_logarithmic_from_zero_to_the_ceiling():
     assert fmax_from_knob(0, 40.0, 3.0) == 0.0
+    assert fmax_from_knob(1, 40.0, 3.0) == pytest.approx(0.04)  # the ceiling 3 decades down
     assert fmax_from_knob(127, 40.0, 3.0) == pytest.approx(40.0)
-    # Near the top, one step multiplies F_max by about 10^(d/127).
-    ratio = fmax_from_knob(120, 40.0, 3.0) / fmax_from_knob(119, 40.0, 3.0)
-    assert ratio == pytest.approx(10 ** (3 / 127), rel=2e-3)
-    values = [fmax_from_knob(k, 12.0, 2.0) for k in range(128)]
-    assert all(b > a for a, b in zip(values, values[1:]))
-    for k in (1, 17, 64, 126):
-        assert knob_from_fmax(fmax_from_knob(k, 12.0, 2.0), 12.0, 2.0) == pytest.approx(k)
-    assert math.isclose(fmax_from_knob(127 / 3, 999.0, 3.0), 9.0)  # 10^1 - 1 = 9
+    values = [fmax_from_knob(k, 12.0, 2.0) for k in range(1, 128)]
+    ratios = np.array(values[1:]) / np.array(values[:-1])
+    np.testing.assert_allclose(ratios, 10 ** (2 / 126))  # equal ratios: logarithmic
+    for k in range(128):
+        assert knob_from_fmax(fmax_from_knob(k, 12.0, 2.0), 12.0, 2.0) == k
+    assert knob_from_fmax(1e-9, 12.0, 2.0) == 1 and knob_from_fmax(1e9, 12.0, 2.0) == 127

@@ -11,14 +11,14 @@ pytest.importorskip("pytestqt")
 
 pytestmark = pytest.mark.gui
 
-FMAX_STEP = 56  # knob 1 position for F_max ~1 N on the preview's live knob (engine.commands.knob_to_fmax)
+FMAX_STEP = 56  # knob 1 position for F_max ~1 N on the preview's live knob (model.fmax_knob, LIVE_RANGE)
 
 
 def bow_preview(console, qapp):
     """Bow the preview engine at ~1 N with the scripted strokes, through the console's controls."""
-    from studyapp.engine.commands import knob_to_fmax
+    from studyapp.model.fmax_knob import LIVE_RANGE, fmax_from_knob
 
-    assert 0.9 < knob_to_fmax(FMAX_STEP / 127) < 1.1
+    assert 0.9 < fmax_from_knob(FMAX_STEP, *LIVE_RANGE) < 1.1
     console.turn_knob(0, FMAX_STEP)
     console.set_gesture("strokes")
     console.set_bowing(True)

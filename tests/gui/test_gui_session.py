@@ -7,7 +7,7 @@ import pytest
 from PySide6.QtCore import QPoint, Qt
 
 from studyapp.experiment.export import export_responses
-from studyapp.experiment.fmax_knob import fmax_from_knob
+from studyapp.model.fmax_knob import fmax_from_knob
 from tests.gui.conftest import DEMO, ENGINE_START, wait_until
 
 pytest.importorskip("pytestqt")
