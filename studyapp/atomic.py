@@ -12,16 +12,21 @@ from pathlib import Path
 
 
 @contextlib.contextmanager
-def atomic_path(target):
-    """Yield a temporary path beside ``target``; rename it to ``target`` on success."""
+def atomic_path(target, mode=None):
+    """Yield a temporary path beside ``target``; rename it to ``target`` on success.
+
+    ``mode`` (e.g. 0o600) sets the file's permissions; by default they follow the umask.
+    """
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent)
     # mkstemp makes the file private (0600); an output should get the usual
     # permissions, as open() would give it under the user's umask
-    umask = os.umask(0)
-    os.umask(umask)
-    os.fchmod(fd, 0o666 & ~umask)
+    if mode is None:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    os.fchmod(fd, mode)
     os.close(fd)
     try:
         yield Path(tmp)
@@ -33,7 +38,7 @@ def atomic_path(target):
 
 
 @contextlib.contextmanager
-def atomic_open(target, mode="w", **kwargs):
+def atomic_open(target, mode="w", permissions=None, **kwargs):
     """Open a temporary file beside ``target``; it replaces ``target`` when closed without error."""
-    with atomic_path(target) as tmp, open(tmp, mode, **kwargs) as f:
+    with atomic_path(target, permissions) as tmp, open(tmp, mode, **kwargs) as f:
         yield f

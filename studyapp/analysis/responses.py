@@ -27,11 +27,13 @@ TASKS = ("rating", "adjustment")
 _TEXT_COLUMNS = ["participant", "session", "task", "condition", "protocol_hash"]
 
 
-def load_responses(source):
+def load_responses(source, problems=None):
     """Checked responses from ``source``: a ``.csv`` export or a results folder.
 
     Returns ``(responses, label)``; ``label`` names the source in messages. A
-    results folder is exported with ``studyapp.experiment.export.export_responses``.
+    results folder is exported with ``studyapp.experiment.export.export_responses``,
+    which appends to ``problems`` (a list) one line per session it skipped or log
+    line it left out; without ``problems`` the first of them is an error.
     """
     path = Path(source)
     if path.suffix.lower() == ".csv":
@@ -50,7 +52,7 @@ def load_responses(source):
                 f"{path}: reading a results folder needs studyapp.experiment.export, which is not "
                 "installed; pass an exported responses.csv instead"
             ) from None
-        return check_responses(export_responses(path), str(path)), str(path)
+        return check_responses(export_responses(path, problems), str(path)), str(path)
     raise UserError(f"{path}: expected a results folder or an exported responses .csv file")
 
 

@@ -6,7 +6,8 @@ signed-rank tables, the summary and Spearman tables, Figs. 7-9 (PNG and SVG)
 and report.html into REPORT_DIR (see studyapp/analysis/report_folder.py);
 with --evaluation, the numerical comparisons and perceptual_correlation.csv.
 Participants short of responses, and too few participants for a test, are
-listed on stderr and in the report.
+listed on stderr and in the report. An unreadable session or damaged log line
+in RESULTS_DIR is skipped with a warning (refused with --strict).
 """
 
 import sys
@@ -28,6 +29,9 @@ def register(subparsers):
     parser.add_argument("--holm", action="store_true", help="Holm-correct the p-values of each task's pooled rank-sum tests (the signed-rank tests always are)")
     parser.add_argument("--alpha", type=float, default=0.05, help="significance threshold (default 0.05, the paper's)")
     parser.add_argument("--trials", type=int, metavar="N", help="adjustment trials each participant owes per condition (default: the most any participant has)")
+    parser.add_argument("--strict", action="store_true",
+                        help="refuse (exit 2) a results folder with an unreadable session or log line; by default "
+                             "such data is skipped with a warning")
     parser.set_defaults(func=run)
 
 
@@ -36,7 +40,7 @@ def run(args):
     from studyapp.analysis.report_folder import write_report_folder
     from studyapp.analysis.responses import load_responses
     from studyapp.analysis.study import analyse
-    from studyapp.errors import ParameterError
+    from studyapp.errors import ParameterError, UserError
 
     if not 0.0 < args.alpha < 1.0:
         raise ParameterError(f"--alpha {args.alpha:g}: allowed 0 < alpha < 1")
@@ -47,7 +51,13 @@ def run(args):
         print(f"studyapp analyse: {message}", file=sys.stderr, flush=True)
 
     say(f"reading {args.results}")
-    responses, label = load_responses(args.results)
+    problems = []
+    responses, label = load_responses(args.results, problems)
+    for problem in problems:
+        say(f"warning: {problem}")
+    if problems and args.strict:
+        raise UserError(f"{args.results}: {len(problems)} unreadable session(s) or log line(s), listed above; "
+                        "nothing written: allowed without --strict (the readable data is analysed, with warnings)")
     evaluation = load_evaluation(args.evaluation) if args.evaluation else None
     expected = {"adjustment": args.trials} if args.trials else None
     study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected)

@@ -1,9 +1,14 @@
-"""``studyapp export RESULTS_DIR [-o responses.csv]``: every response as one tidy CSV.
+"""``studyapp export RESULTS_DIR [-o responses.csv] [--strict]``: every response as one tidy CSV.
 
 One row per response (long format), first the columns ``participant, session,
 task, condition, trial, fmax, rating, time, protocol_hash``; see
 ``studyapp.experiment.export`` for their meaning. RESULTS_DIR may be the
 results folder, one study's folder, a participant's or a session's.
+
+A session that cannot be read is skipped and a damaged log line left out,
+each with a warning on stderr naming the file (and line); the export goes on
+with everything readable. With ``--strict`` any such problem refuses the
+export instead (exit 2, nothing written).
 """
 
 
@@ -12,15 +17,26 @@ def register(sub):
     parser.add_argument("results", metavar="RESULTS_DIR", help="results folder (or any folder inside it)")
     parser.add_argument("-o", "--output", default="responses.csv", metavar="FILE.csv",
                         help="output CSV (default: responses.csv)")
+    parser.add_argument("--strict", action="store_true",
+                        help="refuse (exit 2, nothing written) if any session or log line cannot be read; "
+                             "by default such data is skipped with a warning")
     parser.set_defaults(func=run)
 
 
 def run(args):
     import sys
 
-    from studyapp.experiment.export import write_responses
+    from studyapp.errors import UserError
+    from studyapp.experiment.export import export_responses, save_responses
 
-    frame = write_responses(args.results, args.output)
+    problems = []
+    frame = export_responses(args.results, problems)
+    for problem in problems:
+        print(f"studyapp export: warning: {problem}", file=sys.stderr)
+    if problems and args.strict:
+        raise UserError(f"{args.results}: {len(problems)} unreadable session(s) or log line(s), listed above; "
+                        "nothing written: allowed without --strict (the readable data is exported, with warnings)")
+    save_responses(frame, args.results, args.output)
     sessions = frame.groupby(["study", "participant", "session"]).ngroups
     print(f"studyapp export: {len(frame)} responses from {sessions} sessions -> {args.output}", file=sys.stderr)
     return 0

@@ -27,6 +27,7 @@ def register(sub):
 
 
 def run(args):
+    import contextlib
     import sys
 
     from studyapp.errors import UserError
@@ -43,6 +44,7 @@ def run(args):
         return _run_in_gui(args)
 
     from studyapp.experiment.session import Session
+    from studyapp.experiment.session_log import LogWriteError
     from studyapp.experiment.session_runner import SessionRunner
     from studyapp.experiment.simulated_participant import SimulatedParticipant
 
@@ -54,16 +56,21 @@ def run(args):
     else:
         session = Session.create(protocol, args.participant, args.results, seed=args.seed,
                                  apparatus={"device": "simulated", "participant": "simulated", "audio": False})
+    for note in session.notes:
+        progress(f"warning: {note}")
     progress(f"session {session.folder} ({len(session.finished_steps())} of {len(session.schedule)} trials done)")
     runner = SessionRunner(session, progress=progress)
-    runner.begin()
     try:
+        runner.begin()
         SimulatedParticipant(session.seed).play(runner)
-    except BaseException:
-        runner.finish("interrupted")
+        complete = runner.finish()
+    except BaseException as exc:
+        if not isinstance(exc, LogWriteError):
+            # a log that cannot be written cannot take the note either: the message says why
+            with contextlib.suppress(LogWriteError):
+                runner.finish("interrupted")
         session.close()
         raise
-    complete = runner.finish()
     session.close()
     progress(f"session {'complete' if complete else 'stopped'}: {session.folder}")
     print(session.folder)

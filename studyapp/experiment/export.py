@@ -17,28 +17,32 @@ then ``study, step, value, knob, peak_fmax, duration, app_version``.
   ``peak_fmax`` the highest F_max reached in the trial.
 - ``time`` is the ISO-8601 wall time of the response (the confirm).
 
-Incomplete sessions are exported too: every confirmed response is data. The
+Incomplete sessions are exported too: every confirmed response is data. A
+session that cannot be read is skipped, and a damaged line of a log left out
+(the valid lines after it are kept); each is reported, naming the file and
+line (``studyapp export`` prints them as warnings, and with ``--strict``
+refuses to write anything). The
 CSV (``studyapp export``) reads as is in pandas and R; empty cells are missing.
 """
 
-import json
 from pathlib import Path
 
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
 from studyapp.experiment.rating_task import normalise_ratings
-from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE
-from studyapp.experiment.session_log import read_events
+from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
+from studyapp.experiment.session_log import read_log
 
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
            "study", "step", "value", "knob", "peak_fmax", "duration", "app_version"]
 
 
-def _session_rows(folder):
+def _session_rows(folder, problems):
     path = folder / SESSION_FILE
+    info, notes = read_description(folder)
+    problems.extend(notes)
     try:
-        info = json.loads(path.read_text(encoding="utf-8"))
         common = {
             "participant": info["participant"],
             "session": info["session"],
@@ -46,10 +50,15 @@ def _session_rows(folder):
             "study": info["study"],
             "app_version": info["app_version"],
         }
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise InputDataError(f"{path}: not a readable session file ({exc})") from None
+    except (KeyError, TypeError) as exc:
+        raise InputDataError(f"{path}: not a readable session file (no {exc})") from None
+    log = read_log(folder / EVENTS_FILE)
+    problems.extend(log.messages(str(folder / EVENTS_FILE)))
+    if log.torn:
+        problems.append(f"{folder / EVENTS_FILE}: a torn last line ({len(log.torn)} bytes, never confirmed) "
+                        "left out")
     rows = []
-    for event in read_events(folder / EVENTS_FILE):
+    for event in log.events:
         if event.get("type") != "response":
             continue
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
@@ -65,14 +74,32 @@ def _session_rows(folder):
     return rows
 
 
-def export_responses(results_dir):
-    """A DataFrame of every response under ``results_dir`` (any level of the results layout)."""
+def session_folders_under(root):
+    """Every session folder at or below ``root`` (holding a session.json or an events.jsonl)."""
+    return sorted({p.parent for name in (SESSION_FILE, EVENTS_FILE) for p in Path(root).rglob(name)})
+
+
+def export_responses(results_dir, problems=None):
+    """A DataFrame of every response under ``results_dir`` (any level of the results layout).
+
+    A session that cannot be read is skipped, and a damaged line of a log left
+    out; each is one line appended to ``problems`` (a list) naming the file.
+    Without ``problems`` the first one raises ``InputDataError``.
+    """
     root = Path(results_dir)
     if not root.is_dir():
         raise UserError(f"{root}: no such results folder")
+    found = []
     rows = []
-    for path in sorted(root.rglob(SESSION_FILE)):
-        rows.extend(_session_rows(path.parent))
+    for folder in session_folders_under(root):
+        try:
+            rows.extend(_session_rows(folder, found))
+        except UserError as exc:
+            found.append(f"{folder}: skipped, {exc}")
+    if found and problems is None:
+        raise InputDataError(found[0])
+    if problems is not None:
+        problems.extend(found)
     frame = pd.DataFrame(rows, columns=COLUMNS)
     frame = frame.sort_values(["study", "participant", "session", "step", "knob"], kind="stable")
     frame["trial"] = frame["trial"].astype("int64")
@@ -82,13 +109,18 @@ def export_responses(results_dir):
     return frame.reset_index(drop=True)
 
 
-def write_responses(results_dir, output):
-    """Write ``export_responses(results_dir)`` to the CSV file ``output`` atomically; return the frame."""
+def write_responses(results_dir, output, problems=None):
+    """Write ``export_responses(results_dir, problems)`` to the CSV file ``output`` atomically; return the frame."""
+    frame = export_responses(results_dir, problems)
+    save_responses(frame, results_dir, output)
+    return frame
+
+
+def save_responses(frame, results_dir, output):
+    """Write the exported ``frame`` to the CSV file ``output`` atomically (refused when it is empty)."""
     from studyapp.atomic import atomic_open
 
-    frame = export_responses(results_dir)
     if frame.empty:
         raise UserError(f"{results_dir}: no responses found (no {SESSION_FILE} with confirmed responses)")
     with atomic_open(output, newline="", encoding="utf-8") as f:
         frame.to_csv(f, index=False)
-    return frame

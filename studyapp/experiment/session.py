@@ -19,10 +19,24 @@ already has one is refused: resume it, or use another participant ID.
 
 Participant IDs are pseudonyms (1 to 32 letters, digits, '_' or '-'); nothing
 else about the participant is stored.
+
+Data safety (docs/experiment.md "Data safety"):
+
+- ``create`` and ``resume`` take the participant's lock (``session_lock``)
+  before they read or write anything, and the session holds it until
+  ``close``: a second program starting the same participant is refused with
+  one line naming the holder, and writes nothing. ``create`` also holds the
+  study's lock while it enrols, so two participants never get one index.
+- The first event of ``events.jsonl`` (``session_created``) repeats the whole
+  description. A ``session.json`` that is missing or damaged is rebuilt from it
+  on resume (the damaged file is kept as ``session.json.damaged-<time>``);
+  without it the session is refused with one line.
+- Folders and files get the modes of ``data_modes`` (private by default).
 """
 
 import json
 import os
+import shutil
 from datetime import datetime
 from pathlib import Path
 
@@ -31,13 +45,16 @@ import numpy as np
 from studyapp import __version__
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
+from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
-from studyapp.experiment.session_log import SessionLog, fsync_directory, read_events, wall_time
+from studyapp.experiment.session_lock import LOCK_FILE, ParticipantLock, StudyLock
+from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
 
 SESSION_FILE = "session.json"
 EVENTS_FILE = "events.jsonl"
 FORMAT = "studyapp-session/1"
+CREATED = "session_created"
 
 
 def check_participant(participant):
@@ -47,11 +64,52 @@ def check_participant(participant):
 
 
 def session_folders(participant_folder):
-    """The session folders (holding a session.json) of one participant, oldest first."""
+    """The session folders (holding a session.json or an events.jsonl) of one participant, oldest first."""
     folder = Path(participant_folder)
     if not folder.is_dir():
         return []
-    return sorted(p.parent for p in folder.glob(f"*/{SESSION_FILE}"))
+    return sorted({p.parent for name in (SESSION_FILE, EVENTS_FILE) for p in folder.glob(f"*/{name}")})
+
+
+def _check_description(info, where):
+    if not isinstance(info, dict) or info.get("format") != FORMAT:
+        got = info.get("format") if isinstance(info, dict) else type(info).__name__
+        raise ValueError(f"format {got!r}, allowed is {FORMAT!r}")
+    for key in ("participant", "session", "seed", "protocol", "schedule"):
+        if key not in info:
+            raise ValueError(f"no {key!r}")
+    return info
+
+
+def read_description(folder):
+    """(the session's description, notes) of the session ``folder``, read without writing anything.
+
+    From session.json; when that is missing or damaged, from the ``session_created``
+    event of events.jsonl (a note says so). ``UserError`` (one line) when neither holds it.
+    """
+    folder = Path(folder)
+    path = folder / SESSION_FILE
+    try:
+        with open(path, encoding="utf-8") as f:
+            return _check_description(json.load(f), path), []
+    except (OSError, ValueError, UnicodeDecodeError) as exc:
+        problem = "missing" if isinstance(exc, FileNotFoundError) else f"damaged ({exc})"
+    created = next((e for e in read_log(folder / EVENTS_FILE).events if e.get("type") == CREATED), None)
+    try:
+        info = _check_description(created.get("description") if created else None, path)
+    except ValueError:
+        raise UserError(f"{path}: {problem}, and {folder / EVENTS_FILE} holds no session description to rebuild "
+                        "it from: allowed is to restore session.json from a backup") from None
+    return info, [f"{path}: {problem}; its content is read from the session_created event of {EVENTS_FILE}"]
+
+
+def _write_description(folder, info):
+    with atomic_open(folder / SESSION_FILE, encoding="utf-8", permissions=file_mode()) as f:
+        json.dump(info, f, indent=2)
+        f.write("\n")
+        f.flush()
+        os.fsync(f.fileno())
+    fsync_directory(folder)
 
 
 def enrolled_participants(study_folder):
@@ -68,17 +126,41 @@ def default_seed(protocol_seed, participant_index):
 
 
 class Session:
-    """An open session folder: its stored description, schedule and event log."""
+    """An open session folder: its stored description, schedule and event log.
 
-    def __init__(self, folder):
+    Opened by ``create`` or ``resume``, which hold the participant's lock; ``close`` releases it.
+    """
+
+    def __init__(self, folder, lock=None):
         self.folder = Path(folder)
-        with open(self.folder / SESSION_FILE, encoding="utf-8") as f:
-            self.info = json.load(f)
-        if self.info.get("format") != FORMAT:
-            raise UserError(f"{self.folder / SESSION_FILE}: format {self.info.get('format')!r}: allowed is {FORMAT!r}")
+        self.lock = lock
+        self.notes = []  # what opening it found or repaired, one line each, for the program to show
+        try:
+            self._open()
+        except BaseException:
+            self._release()
+            raise
+
+    def _open(self):
+        self.info, notes = read_description(self.folder)
+        if notes:
+            # rebuild session.json: the damaged one is kept beside it, never overwritten
+            damaged = self.folder / SESSION_FILE
+            try:
+                if damaged.exists():
+                    stamp = datetime.now().strftime("%Y%m%dT%H%M%S")
+                    os.replace(damaged, damaged.with_name(f"{SESSION_FILE}.damaged-{stamp}"))
+                    notes.append(f"{damaged}: the damaged file is kept as {SESSION_FILE}.damaged-{stamp}")
+                _write_description(self.folder, self.info)
+            except OSError as exc:
+                raise LogWriteError(f"{damaged}: cannot rebuild it ({exc.strerror or exc}): "
+                                    "allowed is to free disk space and try again") from None
+            notes.append(f"{damaged}: rebuilt from {EVENTS_FILE}")
+        self.notes.extend(notes)
         self.protocol = parse_protocol(self.info["protocol"]["text"], self.info["protocol"]["path"])
         self.schedule = [Trial.from_dict(d) for d in self.info["schedule"]]
         self.log = SessionLog(self.folder / EVENTS_FILE)
+        self.notes.extend(self.log.notes)
 
     @property
     def participant(self):
@@ -108,7 +190,13 @@ class Session:
         return self.next_trial() is None
 
     def close(self):
-        self.log.close()
+        if hasattr(self, "log"):
+            self.log.close()
+        self._release()
+
+    def _release(self):
+        if self.lock is not None:
+            self.lock.release()
 
     @classmethod
     def create(cls, protocol, participant, results, seed=None, apparatus=None):
@@ -116,11 +204,45 @@ class Session:
         check_participant(participant)
         study_folder = Path(results) / protocol.study
         participant_folder = study_folder / participant
-        existing = session_folders(participant_folder)
-        if existing:
-            raise UserError(
-                f"participant {participant!r} already has a session in {existing[-1]}: "
-                "allowed is --resume to continue it, or another participant ID")
+        try:
+            made = make_folders(participant_folder)
+        except OSError as exc:
+            raise UserError(f"{participant_folder}: cannot create the folder ({exc.strerror or exc}): "
+                            "allowed is a writable results folder (--results)") from None
+        folder = None
+        try:
+            lock = ParticipantLock(participant_folder, participant)
+        except BaseException:
+            _remove_made(made)
+            raise
+        try:
+            existing = session_folders(participant_folder)
+            if existing:
+                raise UserError(
+                    f"participant {participant!r} already has a session in {existing[-1]}: "
+                    "allowed is --resume to continue it, or another participant ID")
+            with StudyLock(study_folder):
+                folder, info = cls._describe(protocol, participant, study_folder, participant_folder,
+                                             seed, apparatus)
+                make_folders(folder)
+                _write_description(folder, info)
+            session = cls(folder, lock)
+            session.log.append({"type": CREATED, "description": info})
+            return session
+        except BaseException as failure:
+            lock.release()
+            if folder is not None:
+                shutil.rmtree(folder, ignore_errors=True)  # only just made: it holds no response yet
+            _remove_made(made)
+            if isinstance(failure, OSError):
+                raise UserError(f"{folder or participant_folder}: cannot create the session "
+                                f"({failure.strerror or failure}): allowed is a writable results folder "
+                                "with free space") from None
+            raise
+
+    @staticmethod
+    def _describe(protocol, participant, study_folder, participant_folder, seed, apparatus):
+        """(the new session's folder, its description): enrolment index, seed, schedule, protocol."""
         index = len([p for p in enrolled_participants(study_folder) if p != participant])
         seed = default_seed(protocol.seed, index) if seed is None else int(seed)
         schedule, squares = build_schedule(protocol, index)
@@ -150,35 +272,44 @@ class Session:
             "apparatus": {"rate": protocol.rate, "knobs": protocol.knobs, "pads": protocol.pads,
                           "gesture": protocol.gesture, **(apparatus or {})},
         }
-        folder.mkdir(parents=True)
-        with atomic_open(folder / SESSION_FILE, encoding="utf-8") as f:
-            json.dump(info, f, indent=2)
-            f.write("\n")
-            f.flush()
-            os.fsync(f.fileno())
-        fsync_directory(folder)
-        return cls(folder)
+        return folder, info
 
     @classmethod
     def resume(cls, protocol, participant, results, seed=None):
-        """Reopen ``participant``'s unfinished session of ``protocol`` under ``results``."""
+        """Reopen ``participant``'s unfinished session of ``protocol`` under ``results``.
+
+        Everything is checked, read-only, before the log is opened (which may repair it).
+        """
         check_participant(participant)
         participant_folder = Path(results) / protocol.study / participant
-        folders = session_folders(participant_folder)
-        if not folders:
+        if not session_folders(participant_folder):
             raise UserError(f"participant {participant!r} has no session to resume in {participant_folder}: "
                             "allowed is to start one without --resume")
-        session = cls(folders[-1])
-        stored = session.info["protocol"]["sha256"]
-        if stored != protocol.sha256:
-            session.close()
-            raise UserError(f"{protocol.path}: differs from the protocol of session {session.folder} "
-                            f"(sha256 {stored[:12]}...): allowed is the protocol file the session started with")
-        if seed is not None and int(seed) != session.seed:
-            session.close()
-            raise UserError(f"--seed {seed}: session {session.folder} has seed {session.seed}: "
-                            "allowed is to leave out --seed when resuming")
-        if session.complete:
-            session.close()
-            raise UserError(f"session {session.folder} is already complete: nothing to resume")
-        return session
+        lock = ParticipantLock(participant_folder, participant)
+        try:
+            folder = session_folders(participant_folder)[-1]
+            info, _ = read_description(folder)
+            stored = info["protocol"]["sha256"]
+            if stored != protocol.sha256:
+                raise UserError(f"{protocol.path}: differs from the protocol of session {folder} "
+                                f"(sha256 {stored[:12]}...): allowed is the protocol file the session started with")
+            if seed is not None and int(seed) != info["seed"]:
+                raise UserError(f"--seed {seed}: session {folder} has seed {info['seed']}: "
+                                "allowed is to leave out --seed when resuming")
+            done = {e.get("step") for e in read_events(folder / EVENTS_FILE) if e.get("type") == "response"}
+            if all(t["step"] in done for t in info["schedule"]):
+                raise UserError(f"session {folder} is already complete: nothing to resume")
+        except BaseException:
+            lock.release()
+            raise
+        return cls(folder, lock)
+
+
+def _remove_made(made):
+    """Remove the folders ``make_folders`` made (newest first) if nothing but a lock is in them."""
+    for folder in reversed(made):
+        try:
+            (folder / LOCK_FILE).unlink(missing_ok=True)
+            folder.rmdir()
+        except OSError:
+            return

@@ -2,22 +2,53 @@
 
 One JSON object per line. ``append`` stamps each event with ``seq`` (0, 1, 2,
 ... over the whole session, across resumes), ``mono`` (``time.monotonic()``,
-seconds; comparable within one run of the program only) and ``wall`` (local
-ISO-8601 time with its UTC offset, millisecond precision), writes the line,
-flushes it and ``os.fsync``s the file before returning, so an event that
-``append`` returned from survives a crash of the program or of the machine.
+seconds; comparable within one run of the program only), ``wall`` (local
+ISO-8601 time with its UTC offset, millisecond precision) and, as its last
+key, ``crc``: the CRC-32 (8 hex digits) of the line's bytes without the
+``,"crc":"..."`` part. It writes the line with one ``os.write``, and
+``os.fsync``s the file before returning, so an event that ``append`` returned
+from survives a crash of the program or of the machine.
 
-A crash can at worst leave a torn last line (the machine lost power during
-the write). ``read_events`` skips it, and opening the log for appending
-truncates it first (recording how many bytes it dropped in a ``log_repaired``
-event), so the file stays valid JSON-lines.
+Reading (``read_log``) checks every line and never lets one bad line hide
+the others:
+
+- a complete line that is not a JSON object or fails its checksum is
+  *damaged*: it is left out, reported by its line number, and the valid lines
+  after it are kept. Opening the log for appending leaves it in place (nothing
+  but a torn last line is ever removed), copies it to ``events.jsonl.damaged``
+  and logs a ``log_damaged`` event the first time it is seen.
+- the bytes after the last newline are a *torn* last line (the machine lost
+  power, or the disk filled, during a write; the event was never confirmed).
+  Opening the log for appending copies them to ``events.jsonl.torn-<time>``,
+  truncates them and logs a ``log_repaired`` event. A torn line that passes
+  its checksum lacks only its newline, which is added instead.
+
+Every such finding is also a line in ``SessionLog.notes`` for the program to
+show. A write that fails (disk full, file too large, I/O error) is undone by
+truncating the file back to its last complete line, and raises
+``LogWriteError``: the file stays valid, and resuming continues it.
 """
 
 import json
 import os
+import re
 import time
+import zlib
+from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
+
+from studyapp.atomic import atomic_open
+from studyapp.errors import UserError
+from studyapp.experiment.data_modes import file_mode, open_file
+
+DAMAGED_SUFFIX = ".damaged"
+TORN_SUFFIX = ".torn-"
+_CRC_TAIL = re.compile(rb',"crc":"([0-9a-f]{8})"\}$')
+
+
+class LogWriteError(UserError):
+    """The session log could not be written (disk full, a write error); nothing was torn."""
 
 
 def wall_time():
@@ -25,27 +56,77 @@ def wall_time():
     return datetime.now().astimezone().isoformat(timespec="milliseconds")
 
 
-def _good_prefix(data):
-    """(events, length) of the complete, valid lines at the start of ``data`` (bytes)."""
-    events, end = [], 0
-    for line in data.splitlines(keepends=True):
-        if not line.endswith(b"\n"):
-            break
-        try:
-            events.append(json.loads(line))
-        except ValueError:
-            break
-        end += len(line)
-    return events, end
+def encode(record):
+    """The log line (bytes, newline included) of ``record``, its CRC-32 appended as key ``crc``."""
+    body = json.dumps(record, separators=(",", ":"), allow_nan=False).encode("utf-8")
+    return body[:-1] + b',"crc":"%08x"}\n' % zlib.crc32(body)
+
+
+def decode(line):
+    """(event, None) for a valid line (bytes, no newline), else (None, why it is damaged)."""
+    try:
+        event = json.loads(line)
+    except ValueError:
+        return None, "not valid JSON"
+    if not isinstance(event, dict) or "type" not in event:
+        return None, "not an event"
+    if "crc" in event:
+        match = _CRC_TAIL.search(line)
+        if match is None or zlib.crc32(line[: match.start()] + b"}") != int(match.group(1), 16):
+            return None, "checksum mismatch"
+        del event["crc"]
+    return event, None
+
+
+@dataclass
+class LogScan:
+    """What ``scan`` found in a log's bytes."""
+
+    events: list = field(default_factory=list)
+    lines: list = field(default_factory=list)      # the 1-based line number of each event
+    damaged: list = field(default_factory=list)    # (line number, reason, raw bytes with newline)
+    torn: bytes = b""                              # an incomplete last line
+    completed: bool = False                        # the last line was whole but for its newline
+
+    def messages(self, name):
+        """One line per damaged line, naming ``name`` (e.g. the file) and the line number."""
+        return [f"{name} line {n}: damaged ({why}), left out; the lines after it are kept"
+                for n, why, _ in self.damaged]
+
+
+def scan(data):
+    """Check every line of ``data`` (the bytes of a log); see the module docstring."""
+    result = LogScan()
+    *complete, tail = data.split(b"\n")
+    for number, line in enumerate(complete, start=1):
+        event, why = decode(line)
+        if event is None:
+            result.damaged.append((number, why, line + b"\n"))
+        else:
+            result.events.append(event)
+            result.lines.append(number)
+    if tail:
+        event, _ = decode(tail)
+        if event is not None and _CRC_TAIL.search(tail):
+            result.events.append(event)
+            result.lines.append(len(complete) + 1)
+            result.completed = True
+        else:
+            result.torn = tail
+    return result
+
+
+def read_log(path):
+    """``scan`` of the log at ``path`` (empty when there is none)."""
+    try:
+        return scan(Path(path).read_bytes())
+    except FileNotFoundError:
+        return LogScan()
 
 
 def read_events(path):
-    """The events of the log at ``path`` (a torn or corrupt tail is left out)."""
-    try:
-        data = Path(path).read_bytes()
-    except FileNotFoundError:
-        return []
-    return _good_prefix(data)[0]
+    """The valid events of the log at ``path`` (damaged lines and a torn tail left out)."""
+    return read_log(path).events
 
 
 def fsync_directory(path):
@@ -57,36 +138,92 @@ def fsync_directory(path):
         os.close(fd)
 
 
+def _write_copy(path, data):
+    with atomic_open(path, "wb", permissions=file_mode()) as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+
+
 class SessionLog:
     """Appends events to ``path``, each one on disk before ``append`` returns."""
 
     def __init__(self, path):
         self.path = Path(path)
+        self.notes = []
         existed = self.path.exists()
-        data = self.path.read_bytes() if existed else b""
-        events, end = _good_prefix(data)
-        self._file = open(self.path, "ab")
-        if end < len(data):
-            self._file.truncate(end)
-            self._file.seek(end)
+        self._fd = open_file(self.path, os.O_WRONLY | os.O_APPEND)
+        try:
+            self._open(existed)
+        except BaseException:
+            os.close(self._fd)
+            raise
+
+    def _open(self, existed):
         if not existed:
             fsync_directory(self.path.parent)
-        self.seq = events[-1]["seq"] + 1 if events else 0
-        if end < len(data):
-            self.append({"type": "log_repaired", "dropped_bytes": len(data) - end})
+        data = self.path.read_bytes()
+        log = scan(data)
+        self._size = len(data) - len(log.torn)
+        self.seq = max((e["seq"] for e in log.events if isinstance(e.get("seq"), int)), default=-1) + 1
+        repairs = []
+        if log.torn:
+            stamp = datetime.now().strftime("%Y%m%dT%H%M%S")
+            copy = self.path.with_name(f"{self.path.name}{TORN_SUFFIX}{stamp}")
+            self._guard(lambda: _write_copy(copy, log.torn))
+            self._guard(lambda: (os.ftruncate(self._fd, self._size), os.fsync(self._fd)))
+            self.notes.append(f"{self.path}: a torn last line ({len(log.torn)} bytes, an event never "
+                              f"confirmed) removed; a copy is kept in {copy.name}")
+            repairs.append({"type": "log_repaired", "dropped_bytes": len(log.torn), "copy": copy.name})
+        elif log.completed:
+            self._write(b"\n")
+            self.notes.append(f"{self.path}: the last line lacked its newline (checksum valid): completed")
+        if log.damaged:
+            side = self.path.with_name(self.path.name + DAMAGED_SUFFIX)
+            quarantined = b"".join(raw for _, _, raw in log.damaged)
+            first_time = not side.exists() or side.read_bytes() != quarantined
+            if first_time:
+                self._guard(lambda: _write_copy(side, quarantined))
+                repairs.append({"type": "log_damaged", "lines": [n for n, _, _ in log.damaged],
+                                "copy": side.name})
+            self.notes.extend(m.replace("left out;", f"set aside in {side.name};")
+                              for m in log.messages(str(self.path)))
+        for event in repairs:
+            self.append(event)
+
+    def _guard(self, action):
+        try:
+            action()
+        except OSError as exc:
+            raise LogWriteError(f"{self.path}: cannot repair the session log ({exc.strerror or exc}): "
+                                "allowed is to free disk space and try again") from None
+
+    def _write(self, line):
+        try:
+            done = 0
+            while done < len(line):
+                done += os.write(self._fd, line[done:])
+            os.fsync(self._fd)
+        except OSError as exc:
+            try:
+                os.ftruncate(self._fd, self._size)  # take back a partial line: the file stays whole
+            except OSError:
+                pass  # then the next open removes it as a torn last line, keeping a copy
+            raise LogWriteError(f"{self.path}: cannot write the session log ({exc.strerror or exc}): the session "
+                                "stopped, nothing torn: free disk space, then resume it") from None
+        self._size += len(line)
 
     def append(self, event):
         """Stamp ``event`` (a dict with a ``type``), write it durably and return the stamped copy."""
         record = {"seq": self.seq, "mono": time.monotonic(), "wall": wall_time(), **event}
-        line = json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n"
-        self._file.write(line.encode("utf-8"))
-        self._file.flush()
-        os.fsync(self._file.fileno())
+        self._write(encode(record))
         self.seq += 1
         return record
 
     def close(self):
-        self._file.close()
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None
 
     def __enter__(self):
         return self

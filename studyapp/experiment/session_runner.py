@@ -14,6 +14,9 @@ every adjustment trial starts from a string at rest with F_max = 0. Headless,
 the default builds ``studyapp.model.ClosedLoop`` in-process; the GUI passes a
 factory for the real-time engine.
 
+An event the log cannot write (a full disk) sets F_max to zero before the
+``LogWriteError`` reaches the caller, which stops the session (it can be resumed).
+
 On resume, the rating trial gets back the knob positions logged before the
 interruption. An interrupted adjustment trial starts again from F_max = 0 (a
 sudden return to a high F_max could be unsafe on a real device).
@@ -24,6 +27,7 @@ import numpy as np
 from studyapp import __version__
 from studyapp.experiment.adjustment_task import AdjustmentTask
 from studyapp.experiment.rating_task import RatingTask
+from studyapp.experiment.session_log import LogWriteError
 
 
 def closed_loop_factory(protocol, audio=False):
@@ -58,7 +62,14 @@ class SessionRunner:
     def log(self, event):
         if self.trial is not None:
             event = {"step": self.trial.step, "task": self.trial.task, **event}
-        return self.session.log.append(event)
+        try:
+            return self.session.log.append(event)
+        except LogWriteError:
+            # what is not logged did not happen: no force the log cannot account for
+            if self.loop is not None:
+                self.loop.set_fmax(0.0)
+                self._loop_fmax = 0.0
+            raise
 
     def begin(self):
         """Log the start of this run of the program (the first, or a resume)."""

@@ -105,7 +105,7 @@ def test_simulated_participant_rates_by_noise_and_finds_breakdown(tmp_path, prot
     events = session.events()
     session.close()
     types = [e["type"] for e in events]
-    assert types[0] == "run_start" and types[-2:] == ["session_end", "run_stop"]
+    assert types[:2] == ["session_created", "run_start"] and types[-2:] == ["session_end", "run_stop"]
     responses = [e for e in events if e["type"] == "response"]
     assert [e["step"] for e in responses] == [0, 1, 2, 3]
     rating = {r["condition"]: r["rating"] for r in responses[0]["responses"]}

@@ -1,0 +1,104 @@
+"""One running session per participant: an exclusive OS lock on the participant's folder.
+
+``ParticipantLock(folder)`` takes ``fcntl.flock(LOCK_EX | LOCK_NB)`` on
+``<participant folder>/.lock`` and holds it until ``release`` (the session's
+``close``) or until the process ends. The kernel drops a flock when its
+holder dies, however it dies (SIGKILL, a crash, a power cut), so a stale lock
+never needs clearing: the next start simply takes it. The file keeps one line
+naming the latest holder (host, PID, start time); a start that finds the lock
+taken is refused with that line, so two programs (two ``run --resume``, a
+``run`` and the GUI, two consoles) can never write one participant's log at once.
+
+flock is advisory and local: it holds between programs on one machine, and
+on NFS only where the server supports it (Linux NFSv4 does). Keep a results
+folder shared between machines on one machine's disk.
+
+``StudyLock(folder)`` is the same lock held on a study folder for the moment
+it takes to enrol a participant, so two participants started at once get
+different enrolment indices (and Latin-square rows).
+"""
+
+import fcntl
+import json
+import os
+import socket
+from pathlib import Path
+
+from studyapp.errors import UserError
+from studyapp.experiment.data_modes import open_file
+from studyapp.experiment.session_log import wall_time
+
+LOCK_FILE = ".lock"
+
+
+def _acquire(path, blocking):
+    """An fd holding flock on ``path``, or None when another process holds it (``blocking`` False)."""
+    while True:
+        fd = open_file(path, os.O_RDWR)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
+        except BlockingIOError:
+            os.close(fd)
+            return None
+        # The file may have been replaced while we waited (a participant folder
+        # removed after a failed start): a lock on an unlinked file locks nothing.
+        try:
+            same = os.stat(path).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            return fd
+        os.close(fd)
+
+
+def _holder(path):
+    try:
+        text = Path(path).read_text(encoding="utf-8").strip()
+        holder = json.loads(text)
+        return f"PID {holder['pid']} on host {holder['host']} since {holder['started']}"
+    except (OSError, ValueError, KeyError, TypeError):
+        return "a program that is still starting"
+
+
+class ParticipantLock:
+    """The exclusive lock on a participant's folder (``UserError`` naming the holder when taken)."""
+
+    def __init__(self, folder, participant):
+        self.path = Path(folder) / LOCK_FILE
+        try:
+            self._fd = _acquire(self.path, blocking=False)
+        except OSError as exc:
+            raise UserError(f"{self.path}: cannot lock the participant's folder ({exc.strerror or exc}): "
+                            "allowed is a writable results folder") from None
+        if self._fd is None:
+            raise UserError(f"participant {participant!r} is in a session already, held by {_holder(self.path)} "
+                            f"(lock {self.path}): allowed is to wait until it ends, or another participant ID")
+        holder = {"pid": os.getpid(), "host": socket.gethostname(), "started": wall_time()}
+        try:
+            os.ftruncate(self._fd, 0)
+            os.pwrite(self._fd, (json.dumps(holder) + "\n").encode("utf-8"), 0)
+        except OSError:
+            pass  # a full disk: the lock holds all the same, only its holder goes unnamed
+
+    def release(self):
+        if self._fd is not None:
+            os.close(self._fd)  # closing the last fd of the open file drops the flock
+            self._fd = None
+
+    @property
+    def held(self):
+        return self._fd is not None
+
+
+class StudyLock:
+    """A short exclusive lock on a study folder (waits for the holder; ``with StudyLock(folder):``)."""
+
+    def __init__(self, folder):
+        self.path = Path(folder) / LOCK_FILE
+
+    def __enter__(self):
+        self._fd = _acquire(self.path, blocking=True)
+        return self
+
+    def __exit__(self, *exc):
+        os.close(self._fd)
