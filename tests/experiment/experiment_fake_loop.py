@@ -9,6 +9,12 @@ F_max exceeds the condition's threshold while bowing.
 
 import numpy as np
 
+from studyapp.experiment.session_runner import SessionRunner
+from studyapp.experiment.simulated_participant import SimulatedParticipant
+
+NOISE = {"LVT": 1e-4, "LOWPASS": 1e-3, "LEVANT": 1e-2}
+THRESHOLD = {"LVT": 20.0, "LOWPASS": 5.0, "LEVANT": 10.0}
+
 
 class Monitor:
     def __init__(self):
@@ -68,3 +74,18 @@ def factory(noise=None, threshold=None, made=None):
         return loop
 
     return make_loop
+
+
+def run_simulated(session, made=None, trials=None):
+    """Play ``session`` (all of it, or its next ``trials``) with the simulated participant on fake loops."""
+    runner = SessionRunner(session, make_loop=factory(NOISE, THRESHOLD, made))
+    runner.begin()
+    participant = SimulatedParticipant(session.seed, bow_time=0.1, probe_time=0.02)
+    if trials is None:
+        participant.play(runner)
+    else:
+        for _ in range(trials):
+            trial = runner.start_trial()
+            rng = np.random.default_rng([session.seed, trial.step])
+            (participant.rate if trial.task == "rating" else participant.adjust)(runner, rng)
+    return runner

@@ -17,12 +17,10 @@ from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import SessionLog, read_events
 from studyapp.experiment.session_runner import SessionRunner
 from studyapp.experiment.simulated_participant import SimulatedParticipant
-from tests.experiment.experiment_fake_loop import factory
+from tests.experiment.experiment_fake_loop import NOISE, THRESHOLD, factory, run_simulated
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "protocols" / "demo.toml"
-NOISE = {"LVT": 1e-4, "LOWPASS": 1e-3, "LEVANT": 1e-2}
-THRESHOLD = {"LVT": 20.0, "LOWPASS": 5.0, "LEVANT": 10.0}
 CONTRACT = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash"]
 
 
@@ -81,20 +79,6 @@ def test_existing_participant_is_refused_and_resume_is_checked(tmp_path, protoco
         Session.resume(load_protocol(changed), "P01", tmp_path)
     with pytest.raises(UserError, match="participant ID"):
         Session.create(protocol, "../escape", tmp_path)
-
-
-def run_simulated(session, made=None, trials=None):
-    runner = SessionRunner(session, make_loop=factory(NOISE, THRESHOLD, made))
-    runner.begin()
-    participant = SimulatedParticipant(session.seed, bow_time=0.1, probe_time=0.02)
-    if trials is None:
-        participant.play(runner)
-    else:
-        for _ in range(trials):
-            trial = runner.start_trial()
-            rng = __import__("numpy").random.default_rng([session.seed, trial.step])
-            (participant.rate if trial.task == "rating" else participant.adjust)(runner, rng)
-    return runner
 
 
 def test_simulated_participant_rates_by_noise_and_finds_breakdown(tmp_path, protocol):
