@@ -21,6 +21,7 @@ from studyapp.experiment.export import export_responses
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import LogWriteError, SessionLog, read_log
+from studyapp.experiment.session_runner import closed_loop_factory
 from tests.experiment.experiment_fake_loop import run_simulated
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -192,6 +193,17 @@ def test_a_write_error_stops_the_runner_at_zero_force_and_tears_nothing(tmp_path
     assert (session.folder / "events.jsonl").read_bytes() == before
 
 
+def warm_numba_cache(protocol):
+    """Load (or compile and cache) the loop's functions here first: under the file-size
+    limit, numba could not write its cache files, which are larger than the limit."""
+    make_loop = closed_loop_factory(protocol)
+    for conditions in [protocol.rating.conditions, *[(c,) for c in protocol.adjustment.conditions]]:
+        loop = make_loop({c: protocol.estimator_params(c) for c in conditions}, conditions[0], 0)
+        loop.set_bowing(True)
+        loop.set_fmax(1.0)
+        loop.run(50)
+
+
 def _limit_file_size(limit):
     def preexec():
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit then fails with EFBIG
@@ -200,6 +212,7 @@ def _limit_file_size(limit):
 
 
 def test_a_full_disk_stops_the_run_in_one_line_and_resume_continues(tmp_path, protocol):
+    warm_numba_cache(protocol)
     results = tmp_path / "results"
     argv = [sys.executable, "-m", "studyapp", "run", "--protocol", str(DEMO), "--participant", "F01",
             "--headless", "--simulated-participant", "--results", str(results), "--seed", "3"]
