@@ -103,6 +103,22 @@ def read_description(folder):
     return info, [f"{path}: {problem}; its content is read from the session_created event of {EVENTS_FILE}"]
 
 
+def _rebuild_description(folder, info):
+    """Write session.json anew from ``info``, keeping a damaged one beside it; return the notes."""
+    damaged = folder / SESSION_FILE
+    notes = []
+    try:
+        if damaged.exists():
+            stamp = datetime.now().strftime("%Y%m%dT%H%M%S")
+            os.replace(damaged, damaged.with_name(f"{SESSION_FILE}.damaged-{stamp}"))
+            notes.append(f"{damaged}: the damaged file is kept as {SESSION_FILE}.damaged-{stamp}")
+        _write_description(folder, info)
+    except OSError as exc:
+        raise LogWriteError(f"{damaged}: cannot rebuild it ({exc.strerror or exc}): "
+                            "allowed is to free disk space and try again") from None
+    return notes + [f"{damaged}: rebuilt from {EVENTS_FILE}"]
+
+
 def _write_description(folder, info):
     with atomic_open(folder / SESSION_FILE, encoding="utf-8", permissions=file_mode()) as f:
         json.dump(info, f, indent=2)
@@ -144,18 +160,7 @@ class Session:
     def _open(self):
         self.info, notes = read_description(self.folder)
         if notes:
-            # rebuild session.json: the damaged one is kept beside it, never overwritten
-            damaged = self.folder / SESSION_FILE
-            try:
-                if damaged.exists():
-                    stamp = datetime.now().strftime("%Y%m%dT%H%M%S")
-                    os.replace(damaged, damaged.with_name(f"{SESSION_FILE}.damaged-{stamp}"))
-                    notes.append(f"{damaged}: the damaged file is kept as {SESSION_FILE}.damaged-{stamp}")
-                _write_description(self.folder, self.info)
-            except OSError as exc:
-                raise LogWriteError(f"{damaged}: cannot rebuild it ({exc.strerror or exc}): "
-                                    "allowed is to free disk space and try again") from None
-            notes.append(f"{damaged}: rebuilt from {EVENTS_FILE}")
+            notes += _rebuild_description(self.folder, self.info)
         self.notes.extend(notes)
         self.protocol = parse_protocol(self.info["protocol"]["text"], self.info["protocol"]["path"])
         self.schedule = [Trial.from_dict(d) for d in self.info["schedule"]]
@@ -227,7 +232,11 @@ class Session:
                 make_folders(folder)
                 _write_description(folder, info)
             session = cls(folder, lock)
-            session.log.append({"type": CREATED, "description": info})
+            try:
+                session.log.append({"type": CREATED, "description": info})
+            except BaseException:
+                session.log.close()
+                raise
             return session
         except BaseException as failure:
             lock.release()
@@ -288,7 +297,7 @@ class Session:
         lock = ParticipantLock(participant_folder, participant)
         try:
             folder = session_folders(participant_folder)[-1]
-            info, _ = read_description(folder)
+            info, rebuild = read_description(folder)
             stored = info["protocol"]["sha256"]
             if stored != protocol.sha256:
                 raise UserError(f"{protocol.path}: differs from the protocol of session {folder} "
@@ -298,7 +307,11 @@ class Session:
                                 "allowed is to leave out --seed when resuming")
             done = {e.get("step") for e in read_events(folder / EVENTS_FILE) if e.get("type") == "response"}
             if all(t["step"] in done for t in info["schedule"]):
-                raise UserError(f"session {folder} is already complete: nothing to resume")
+                # resuming is the way to repair a session: its session.json too, when it is complete
+                repaired = " (its session.json rebuilt from events.jsonl)" if rebuild else ""
+                if rebuild:
+                    _rebuild_description(folder, info)
+                raise UserError(f"session {folder} is already complete{repaired}: nothing to resume")
         except BaseException:
             lock.release()
             raise

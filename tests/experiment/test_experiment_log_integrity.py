@@ -151,6 +151,18 @@ def test_a_damaged_session_json_is_rebuilt_from_the_log_on_resume(tmp_path, prot
     assert sorted(e["step"] for e in final) == [0, 1, 2, 3]
 
 
+def test_resuming_a_complete_session_still_rebuilds_its_session_json(tmp_path, protocol):
+    session = Session.create(protocol, "D03", tmp_path, seed=1)
+    run_simulated(session).finish()
+    session.close()
+    path = session.folder / "session.json"
+    original = path.read_bytes()
+    path.unlink()
+    with pytest.raises(UserError, match=r"already complete \(its session.json rebuilt from events.jsonl\)"):
+        Session.resume(protocol, "D03", tmp_path)
+    assert path.read_bytes() == original
+
+
 def test_an_unreadable_session_is_refused_in_one_line_and_skipped_by_export(tmp_path, protocol, capsys):
     good = two_trials(tmp_path, protocol, "D01")
     bad = two_trials(tmp_path, protocol, "D02")
@@ -233,3 +245,17 @@ def test_a_full_disk_stops_the_run_in_one_line_and_resume_continues(tmp_path, pr
     session.close()
     final = responses(read_log(events_file).events)
     assert sorted(e["step"] for e in final) == [0, 1, 2, 3]
+
+
+def test_analyse_reports_an_unreadable_session_and_strict_refuses(tmp_path, protocol, capsys):
+    results = tmp_path / "results"
+    two_trials(results, protocol, "D01")
+    bad = two_trials(results, protocol, "D02")
+    (bad / "events.jsonl").write_bytes(b"\n".join((bad / "events.jsonl").read_bytes().split(b"\n")[1:]))
+    (bad / "session.json").unlink()
+    report = tmp_path / "report"
+    assert main(["analyse", str(results), "-o", str(report), "--strict"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert f"studyapp analyse: warning: {bad}: skipped, {bad / 'session.json'}: missing" in err[1]
+    assert err[-1].startswith("studyapp: error: ") and "--strict" in err[-1] and "Traceback" not in "".join(err)
+    assert not report.exists()
