@@ -16,7 +16,6 @@ from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import SessionLog, read_events
 from studyapp.experiment.session_runner import SessionRunner
-from studyapp.experiment.simulated_participant import SimulatedParticipant
 from tests.experiment.experiment_fake_loop import NOISE, THRESHOLD, factory, run_simulated
 
 ROOT = Path(__file__).resolve().parents[2]
