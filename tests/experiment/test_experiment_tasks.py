@@ -1,8 +1,11 @@
 """Task logic: scripted event sequences give the expected logged responses."""
 
+import json
+
 import numpy as np
 import pytest
 
+from studyapp.experiment.tasks import task_type
 from studyapp.experiment.tasks.adjustment import AdjustmentTrial
 from studyapp.experiment.tasks.rating import RatingTrial, normalise_ratings
 from studyapp.model.fmax_knob import fmax_from_knob, knob_from_fmax
@@ -109,3 +112,15 @@ def test_fmax_knob_map_is_logarithmic_from_zero_to_the_ceiling():
     for k in range(128):
         assert knob_from_fmax(fmax_from_knob(k, 12.0, 2.0), 12.0, 2.0) == k
     assert knob_from_fmax(1e-9, 12.0, 2.0) == 1 and knob_from_fmax(1e9, 12.0, 2.0) == 127
+
+
+def test_ratings_are_normalised_once_and_exported_as_logged():
+    task = RatingTrial(CONDITIONS, fmax=1.0)
+    records = play(task, [("knob", 0, 90), ("knob", 1, 10), ("knob", 2, 127), ("knob", 3, 37), ("pad", 0)])
+    response = records[-1]
+    rows = task_type("rating").export_rows(json.loads(json.dumps(response)))  # as read back from events.jsonl
+    # Closed form: noisiness = (max - k) / (max - min) over this participant's knob positions.
+    expected = {"LOWPASS": 37 / 117, "LEVANT": 1.0, "KALLEV": 0.0, "LVT": 90 / 117}
+    assert {r["condition"]: r["rating"] for r in rows} == pytest.approx(expected)
+    assert [r["rating"] for r in rows] == [r["rating"] for r in response["responses"]]
+    assert [(r["knob"], r["value"]) for r in rows] == [(0, 90), (1, 10), (2, 127), (3, 37)]
