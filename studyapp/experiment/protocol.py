@@ -151,9 +151,9 @@ def parse_protocol(text, source="<protocol>"):
     """Validate protocol ``text`` (TOML); ``source`` names the file in error messages."""
     from studyapp import estimators
     from studyapp.estimators.registry import spec as estimator_spec
+    from studyapp.estimators.spec import RATE_MAX, RATE_MIN
     from studyapp.experiment.task_type import Bounds
     from studyapp.experiment.tasks import task_names, task_type
-    from studyapp.estimators.spec import RATE_MAX, RATE_MIN
     from studyapp.model.loop import GESTURES
 
     try:
