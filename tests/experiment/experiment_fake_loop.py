@@ -85,7 +85,5 @@ def run_simulated(session, made=None, trials=None):
         participant.play(runner)
     else:
         for _ in range(trials):
-            trial = runner.start_trial()
-            rng = np.random.default_rng([session.seed, trial.step])
-            (participant.rate if trial.task == "rating" else participant.adjust)(runner, rng)
+            participant.play_trial(runner, runner.start_trial())
     return runner
