@@ -209,7 +209,8 @@ def warm_numba_cache(protocol):
     """Load (or compile and cache) the loop's functions here first: under the file-size
     limit, numba could not write its cache files, which are larger than the limit."""
     make_loop = closed_loop_factory(protocol)
-    for conditions in [protocol.rating.conditions, *[(c,) for c in protocol.adjustment.conditions]]:
+    every = [tuple(protocol.task(name).conditions) for name in protocol.tasks]
+    for conditions in every + [(c,) for c in set().union(*every)]:
         loop = make_loop({c: protocol.estimator_params(c) for c in conditions}, conditions[0], 0)
         loop.set_bowing(True)
         loop.set_fmax(1.0)

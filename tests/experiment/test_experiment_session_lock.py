@@ -119,14 +119,14 @@ def test_two_resumes_at_once_run_the_session_once(tmp_path, protocol):
         line = assert_refused(pair[loser])
         winner = pair[1 - loser]
         assert f"held by PID {winner.pid} on host {socket.gethostname()}" in line
-        assert winner.poll() is None  # it held the lock while the other was refused, and runs on
     finally:
         for p in pair:
             p.kill()
             p.communicate()
     events = read_log(next((tmp_path / "demo" / "L05").glob("*/events.jsonl"))).events
     types = [e["type"] for e in events]
-    steps = [e["step"] for e in events if e["type"] == "trial_start"]
-    assert types.count("run_start") == 1 and "session_end" not in types  # only the winner ever wrote
-    assert steps == sorted(set(steps))  # no trial begun twice
+    begun = [e["step"] for e in events if e["type"] == "trial_start"]
+    answered = [e["step"] for e in events if e["type"] == "response"]
+    assert types.count("run_start") == 1 and types.count("session_end") <= 1  # only the winner ever wrote
+    assert begun == sorted(set(begun)) and answered == sorted(set(answered))  # nothing begun or answered twice
     assert [e["seq"] for e in events] == list(range(len(events)))
