@@ -242,6 +242,7 @@ class Worker:
     def step(self, started):
         """One block; returns (finished, wall-clock compute, CPU time of this thread)."""
         cpu_started = time.thread_time()
+        self.safety.before_block(self.status.force_enable)
         out = self.loop.run(self.block)
         self.safety.check(out, force_enable=self.status.force_enable)
         if self.sink.render:
