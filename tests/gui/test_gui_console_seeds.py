@@ -10,7 +10,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from studyapp.cli import main as cli
-from tests.gui.conftest import DEMO, ENGINE_START, wait_until
+from tests.gui.conftest import DEMO
 
 pytest.importorskip("pytestqt")
 
@@ -40,8 +40,7 @@ def seeds_in(results):
             for p in PARTICIPANTS}
 
 
-def test_two_participants_started_from_the_console_get_the_command_lines_seeds(idle_console, qapp, qtbot,
-                                                                              tmp_path, capsys):
+def test_two_participants_started_from_the_console_get_the_command_lines_seeds(idle_console, qtbot, tmp_path, capsys):
     console = idle_console
     c = console.controller
     protocol = tmp_path / "seeds.toml"
@@ -57,8 +56,7 @@ def test_two_participants_started_from_the_console_get_the_command_lines_seeds(i
             console.abort_session()
             assert c.state == "aborted"
     finally:
-        assert console.choose_protocol(str(DEMO))
-        wait_until(qapp, lambda: c.engine is not None, ENGINE_START)
+        assert console.choose_protocol(str(DEMO))  # the next test's idle_console waits for its engine
 
     cli_results = tmp_path / "cli"
     for participant in PARTICIPANTS:
