@@ -12,19 +12,22 @@ from studyapp.evaluation.significance import not_different_from_best, pairwise, 
 from tests.evaluation.conftest import stick_slip
 
 
-def test_rank_sum_exact_p_for_separated_samples():
-    # 5 vs 5, completely separated: exact two-sided p = 2 / C(10, 5) = 2 / 252.
-    u, p = rank_sum([1, 2, 3, 4, 5], [6, 7, 8, 9, 10])
-    assert p == pytest.approx(2 / 252)
-    assert u == 0.0
+def test_rank_sum_of_recordings_drops_non_finite_values():
+    # The finite values 1, 2, 3 against 4, 5, 6: exact p = 2 / C(6, 3), z = -4.5 / sqrt(21 / 4).
+    z, p = rank_sum([1, np.nan, 2, 3], [4, 5, np.inf, 6])
+    assert p == pytest.approx(0.1, rel=1e-12)
+    assert z == pytest.approx(stats.ranksums([1, 2, 3], [4, 5, 6]).statistic, rel=1e-12)
+    z, p = rank_sum([1.0, np.nan], [2.0, 3.0])
+    assert np.isnan(z) and p == 1.0
+    assert rank_sum([2.0, 2.0, 2.0], [2.0, 2.0]) == (0.0, 1.0)
 
 
-def test_rank_sum_with_ties_agrees_with_the_normal_approximation():
+def test_rank_sum_with_ties_is_the_tie_corrected_normal_approximation():
     rng = np.random.default_rng(0)
     a, b = rng.integers(0, 5, 30), rng.integers(1, 6, 30)
     _, p = rank_sum(a, b)
-    z = stats.ranksums(a, b).pvalue  # no tie correction: close, not equal
-    assert p == pytest.approx(z, rel=0.1)
+    assert p == pytest.approx(stats.mannwhitneyu(a, b, method="asymptotic", use_continuity=False).pvalue, rel=1e-10)
+    assert p < stats.ranksums(a, b).pvalue  # ranksums has no tie correction: larger variance, larger p
 
 
 def test_pairwise_and_best_group():
