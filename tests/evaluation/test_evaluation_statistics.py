@@ -67,8 +67,16 @@ def test_report_matches_the_metric_and_lowpass_is_100_percent():
     assert np.allclose(result.error_pct("LOWPASS"), 100.0)
     assert np.allclose(result.delay_pct("LOWPASS"), 100.0)
     assert np.allclose(result.error_pct("BDIFF"), 100 * result.errors["BDIFF"] / result.errors["LOWPASS"])
-    # Each recording's E and D are normalised to [0, 1] across the three estimators: 0 <= F_g <= 2n.
-    assert all(0.0 <= result.objective[n] <= 6.0 for n in params)
+    # Eqs. 29-32: each recording's E and |D| are scaled to [0, 1] across the three estimators (min -> 0,
+    # max -> 1; all equal -> 0); F_g (eq. 27) is their sum over the recordings.
+    def scaled(m):
+        spread = m.max(axis=0) - m.min(axis=0)
+        return np.where(spread > 0, (m - m.min(axis=0)) / np.where(spread > 0, spread, 1.0), 0.0)
+
+    errors = np.array([result.errors[n] for n in params])
+    delays = np.abs(np.array([result.delays[n] for n in params], dtype=float))
+    expected = (scaled(errors) + scaled(delays)).sum(axis=1)
+    assert [result.objective[n] for n in params] == pytest.approx(expected, rel=1e-12)
     assert result.ranking == sorted(params, key=result.objective.get)
     doc = result.to_json()
     assert set(doc) >= {"estimators", "ranking"}
