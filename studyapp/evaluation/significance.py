@@ -35,12 +35,12 @@ def pairwise(samples, alpha=ALPHA):
     """Rows {a, b, n_a, n_b, median_a, median_b, statistic, p, significant} for every pair of ``samples``."""
     rows = []
     for a, b in itertools.combinations(samples, 2):
-        u, p = rank_sum(samples[a], samples[b])
+        z, p = rank_sum(samples[a], samples[b])
         rows.append({
             "a": a, "b": b, "n_a": int(np.isfinite(samples[a]).sum()), "n_b": int(np.isfinite(samples[b]).sum()),
             "median_a": float(np.nanmedian(samples[a])) if np.isfinite(samples[a]).any() else float("nan"),
             "median_b": float(np.nanmedian(samples[b])) if np.isfinite(samples[b]).any() else float("nan"),
-            "statistic": u, "p": p, "significant": bool(p < alpha),
+            "statistic": z, "p": p, "significant": bool(p < alpha),
         })
     return rows
 
