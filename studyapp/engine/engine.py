@@ -48,6 +48,7 @@ from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
 from studyapp.errors import ParameterError, UserError
+from studyapp.model.sources import with_pseudo_sources
 
 POLL = 0.01  # s between watchdog checks
 START_TIMEOUT = 120.0  # s for the worker to import, compile and prime
@@ -92,7 +93,7 @@ class Engine:
         estimators = c.estimators if isinstance(c.estimators, dict) else {n: {} for n in c.estimators}
         names = Bank(c.rate, estimators).names
         c.estimators = dict(zip(names, estimators.values()))
-        allowed = list(names) + ["LVT", "TRUE"]
+        allowed = with_pseudo_sources(names)
         if c.source not in allowed:
             raise ParameterError(f"source {c.source!r}: allowed are {', '.join(allowed)}")
         fmax = float(c.fmax)
@@ -152,7 +153,7 @@ class Engine:
         self._commands.put(cmd.command(kind, value))
 
     def set_source(self, name):
-        allowed = list(self.names) + ["LVT", "TRUE"]
+        allowed = with_pseudo_sources(self.names)
         if name not in allowed:
             raise ParameterError(f"source {name!r}: allowed are {', '.join(allowed)}")
         self.send("source", name)
