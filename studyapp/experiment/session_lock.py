@@ -22,6 +22,7 @@ import fcntl
 import json
 import os
 import socket
+import time
 from pathlib import Path
 
 from studyapp.errors import UserError
@@ -52,12 +53,16 @@ def _acquire(path, blocking):
 
 
 def _holder(path):
-    try:
-        text = Path(path).read_text(encoding="utf-8").strip()
-        holder = json.loads(text)
-        return f"PID {holder['pid']} on host {holder['host']} since {holder['started']}"
-    except (OSError, ValueError, KeyError, TypeError):
-        return "a program that is still starting"
+    """The holder's line; the holder writes it just after taking the lock, so wait a moment for it."""
+    deadline = time.monotonic() + 1.0
+    while True:
+        try:
+            holder = json.loads(Path(path).read_text(encoding="utf-8"))
+            return f"PID {holder['pid']} on host {holder['host']} since {holder['started']}"
+        except (OSError, ValueError, KeyError, TypeError):
+            if time.monotonic() > deadline:
+                return "a program that has not said which (an older version, or one still starting)"
+            time.sleep(0.02)
 
 
 class ParticipantLock:

@@ -118,7 +118,7 @@ def test_two_resumes_at_once_run_the_session_once(tmp_path, protocol):
         loser = first_to_exit(pair)
         line = assert_refused(pair[loser])
         winner = pair[1 - loser]
-        assert f"held by PID {winner.pid} on host {socket.gethostname()}" in line
+        assert f"held by PID {winner.pid} on host {socket.gethostname()}" in line, line
     finally:
         for p in pair:
             p.kill()
