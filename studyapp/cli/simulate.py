@@ -42,11 +42,13 @@ def run(args):
     import sys
 
     from studyapp import recording
+    from studyapp.cli import output_paths
     from studyapp.estimators.spec import validate_rate
     from studyapp.model import simulate
     from studyapp.model.loop import check_fmax
 
     recording.check_path(args.output)
+    output_paths.check_file(args.output)
     validate_rate(args.rate)
     check_fmax(args.fmax)
     check_source(args.source)

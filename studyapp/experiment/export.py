@@ -27,6 +27,7 @@ from pathlib import Path
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.experiment import response_event
 from studyapp.experiment.rating_task import normalise_ratings
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_log import read_events
@@ -50,8 +51,12 @@ def _session_rows(folder):
         raise InputDataError(f"{path}: not a readable session file ({exc})") from None
     rows = []
     for event in read_events(folder / EVENTS_FILE):
-        if event.get("type") != "response":
+        if isinstance(event, dict) and event.get("type") != "response":
             continue
+        wrong = response_event.problem(event)
+        if wrong is not None:
+            seq = event.get("seq") if isinstance(event, dict) else "?"
+            raise InputDataError(f"{folder / EVENTS_FILE}: response event seq {seq}: {wrong}")
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
                 "time": event["wall"], "step": event["step"], "duration": event.get("duration")}
         if event["task"] == "rating":

@@ -15,11 +15,11 @@ same study exactly when their hashes agree.
 
 import hashlib
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from studyapp.errors import UserError
+from studyapp.small_files import parse_toml, read_bytes
 
 TASKS = ("rating", "adjustment")
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
@@ -173,10 +173,7 @@ def parse_protocol(text, source="<protocol>"):
     from studyapp.estimators.spec import RATE_MAX, RATE_MIN
     from studyapp.model.loop import GESTURES
 
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{source}: not valid TOML ({exc})") from None
+    document = parse_toml(text, source)
     known_tables = ("study", "apparatus", "estimators", *TASKS)
     for name in document:
         if name not in known_tables:
@@ -265,10 +262,7 @@ def parse_protocol(text, source="<protocol>"):
 def load_protocol(path):
     """Read and validate the protocol file at ``path``; its hash is the SHA-256 of its bytes."""
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise UserError(f"{path}: cannot read the protocol ({exc.strerror or exc})") from None
+    data = read_bytes(path, "protocol")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
