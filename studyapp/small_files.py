@@ -26,7 +26,7 @@ def read_bytes(path, what):
                 raise UserError(f"{path}: not a regular file: allowed is a {what} file")
             data = f.read(LIMIT_BYTES + 1)
     except FileNotFoundError:
-        raise UserError(f"{path}: no such {what} file") from None
+        raise UserError(f"{path}: cannot read the {what}: no such file") from None
     except IsADirectoryError:
         raise UserError(f"{path}: is a folder: allowed is a {what} file") from None
     except OSError as exc:
