@@ -140,7 +140,8 @@ class _Fields:
     def conditions(self, key, known, at_least, at_most):
         allowed = (f"a list of {at_least} to {at_most} different estimator names from: {', '.join(known)}")
         value = self.get(key, allowed)
-        if not isinstance(value, list) or not at_least <= len(value) <= at_most:
+        if (not isinstance(value, list) or not at_least <= len(value) <= at_most
+                or not all(isinstance(name, str) for name in value)):
             self.fail(key, f"= {value!r}", allowed)
         for name in value:
             if name not in known:
@@ -184,7 +185,8 @@ def parse_protocol(text, source="<protocol>"):
     title = study.string("title", default=name)
     tasks_allowed = "a list of the tasks to run, in order: 'rating', 'adjustment' or both"
     tasks = study.get("tasks", tasks_allowed)
-    if (not isinstance(tasks, list) or not tasks or len(set(tasks)) != len(tasks)
+    if (not isinstance(tasks, list) or not tasks or not all(isinstance(t, str) for t in tasks)
+            or len(set(tasks)) != len(tasks)
             or any(t not in TASKS for t in tasks)):
         study.fail("tasks", f"= {tasks!r}", tasks_allowed)
     seed = study.integer("seed", 0, 2**32 - 1)
