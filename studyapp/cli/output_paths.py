@@ -21,7 +21,7 @@ def _existing_parent(path, option):
             raise UserError(f"{option} {path}: {parent} is a broken link")
         parent = parent.parent
     if not parent.is_dir():
-        raise UserError(f"{option} {path}: {parent} is a file, not a folder")
+        raise UserError(f"{option} {path}: cannot create a file in {parent}: it is a file, not a directory")
     try:
         fd, probe = tempfile.mkstemp(prefix=".studyapp-probe.", dir=parent)
     except OSError as exc:
@@ -34,7 +34,7 @@ def check_file(path, option="-o", inputs=()):
     """Raise ``UserError`` unless ``path`` can become a file (it is not a folder nor one of ``inputs``)."""
     path = Path(path)
     if path.is_dir():
-        raise UserError(f"{option} {path}: is a folder: allowed is a file name")
+        raise UserError(f"{option} {path}: is a directory: allowed is a file name")
     if path.exists() and not path.is_file():
         raise UserError(f"{option} {path}: is not a regular file")
     for source in inputs:
@@ -47,7 +47,7 @@ def check_folder(path, option="-o"):
     """Raise ``UserError`` unless ``path`` is a writable folder or can be created as one."""
     path = Path(path)
     if path.exists() and not path.is_dir():
-        raise UserError(f"{option} {path}: exists and is not a folder")
+        raise UserError(f"{option} {path}: exists and is not a directory")
     if path.is_dir():
         try:
             fd, probe = tempfile.mkstemp(prefix=".studyapp-probe.", dir=path)
