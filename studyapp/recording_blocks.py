@@ -12,13 +12,13 @@ from the ``t`` column to 6 decimals, as ``recording.load`` finds it. Every
 problem is one ``InputDataError`` naming the file.
 """
 
-import json
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from studyapp.errors import InputDataError
+from studyapp.recording import parse_meta
 
 SUFFIXES = (".npz", ".h5", ".hdf5")
 
@@ -83,7 +83,7 @@ class RecordingBlocks:
                 raise InputDataError(f"{self.path}: member {member!r} is not an .npy array")
             if member == "__meta__.npy":
                 with self._zip.open(member) as f:
-                    self.meta = _meta(str(np.lib.format.read_array(f, allow_pickle=False)), self.path)
+                    self.meta = parse_meta(str(np.lib.format.read_array(f, allow_pickle=False)), self.path)
             else:
                 members[member[:-4]] = member
         self._members = members
@@ -99,7 +99,7 @@ class RecordingBlocks:
 
         self._h5 = h5py.File(self.path, "r")
         raw = self._h5.attrs.get("meta", "{}")
-        self.meta = _meta(raw.decode() if isinstance(raw, bytes) else str(raw), self.path)
+        self.meta = parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), self.path)
         return {name: self._h5[name].shape for name in self._h5.keys()}
 
     def _rate(self):
@@ -149,12 +149,3 @@ class RecordingBlocks:
     def __exit__(self, *exc):
         self.close()
 
-
-def _meta(text, path):
-    try:
-        meta = json.loads(text)
-    except json.JSONDecodeError:
-        raise InputDataError(f"{path}: metadata is not valid JSON") from None
-    if not isinstance(meta, dict):
-        raise InputDataError(f"{path}: metadata must be a JSON object")
-    return meta

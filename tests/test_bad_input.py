@@ -308,3 +308,14 @@ def test_bad_input_is_refused_by_the_command(case, inputs, tmp_path):
                           capture_output=True, text=True, timeout=120, env=env, cwd=out,
                           preexec_fn=_limit_memory)
     assert_refused(proc.returncode, proc.stderr, before, (_tree(inputs), _tree(out)))
+
+
+def test_a_recording_csv_with_a_byte_order_mark_is_accepted(tmp_path):
+    from studyapp.recording import COLUMNS, Recording, load, save
+
+    rec = Recording(1000.0, {name: np.arange(5.0) * (i + 1) / 1000 for i, name in enumerate(COLUMNS)})
+    save(rec, tmp_path / "plain.csv")
+    (tmp_path / "excel.csv").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "plain.csv").read_bytes())
+    loaded = load(tmp_path / "excel.csv")
+    assert loaded.rate == 1000.0 and list(loaded.columns) == list(COLUMNS)
+    np.testing.assert_array_equal(loaded["position"], rec["position"])
