@@ -2,7 +2,9 @@
 
 Prints the engine's status once a second on stderr; with ``--json`` prints one
 JSON object on stdout at exit:
-``{"rate", "achieved_rate", "deadline_misses", "audio_underruns", "faults", "midi_messages", ...}``.
+``{"rate", "achieved_rate", "deadline_misses", "audio_underruns", "faults", "midi_messages",
+"events_dropped", ...}``; ``events_dropped`` counts the worker's events (MIDI control events, notices)
+that its event ring overwrote before this process read them.
 Stops after ``--seconds`` or on Ctrl-C / SIGTERM, always cleanly (no orphan
 process, no shared memory left behind).
 """
@@ -109,6 +111,7 @@ def run(args):
         "audio_underruns": summary.get("audio_underruns", 0),
         "faults": list(engine.faults),
         "midi_messages": summary.get("midi_messages", 0),
+        "events_dropped": engine.events_dropped,
         "seconds": summary.get("seconds", 0.0),
         "block": engine.info.get("block"),
         "load_max": summary.get("load_max", 0.0),
@@ -121,5 +124,6 @@ def run(args):
         print(json.dumps(result))
     else:
         say(f"live: done: {result['achieved_rate']:.0f} Hz achieved, {result['deadline_misses']} deadline misses, "
-            f"{result['audio_underruns']} underruns, {len(result['faults'])} faults")
+            f"{result['audio_underruns']} underruns, {len(result['faults'])} faults, "
+            f"{result['events_dropped']} events dropped")
     return 1 if engine.tripped else 0

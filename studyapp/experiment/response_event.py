@@ -34,14 +34,15 @@ def problem(event):
         return f"event {event!r}: allowed is a JSON object"
     checks = [
         ("step", _integer(event.get("step"), 0), "an integer >= 0"),
-        ("task", event.get("task") in TASKS, " or ".join(TASKS)),
+        ("task", isinstance(event.get("task"), str) and event.get("task") in task_names(), " or ".join(task_names())),
         ("trial", _integer(event.get("trial"), 1), "an integer >= 1"),
         ("fmax", _number(event.get("fmax")), "a finite number >= 0"),
         ("wall", _text(event.get("wall")), "the time as ISO-8601 text"),
     ]
+    if event.get("task") != "rating":
+        checks.append(("condition", _text(event.get("condition")), "an estimator name"))
     if event.get("task") == "adjustment":
-        checks += [("condition", _text(event.get("condition")), "an estimator name"),
-                   ("value", _integer(event.get("value"), 0), "a knob position, an integer >= 0")]
+        checks.append(("value", _integer(event.get("value"), 0), "a knob position, an integer >= 0"))
     for name, ok, allowed in checks:
         if not ok:
             return f"{name} = {event.get(name)!r}: allowed is {allowed}"
@@ -51,12 +52,11 @@ def problem(event):
 
 
 def _rating_problem(responses):
-    allowed = "a list of {condition, knob, value} objects, the knob positions not all equal"
-    if not isinstance(responses, list) or len(responses) < 2 or not all(isinstance(r, dict) for r in responses):
+    allowed = "a list of {condition, knob, value, rating} objects"
+    if not isinstance(responses, list) or not responses or not all(isinstance(r, dict) for r in responses):
         return f"responses = {responses!r}: allowed is {allowed}"
     for r in responses:
-        if not (_text(r.get("condition")) and _integer(r.get("knob"), 0) and _integer(r.get("value"), 0)):
+        if not (_text(r.get("condition")) and _integer(r.get("knob"), 0) and _integer(r.get("value"), 0)
+                and _number(r.get("rating"))):
             return f"responses item {r!r}: allowed is {allowed}"
-    if len({r["value"] for r in responses}) == 1:
-        return f"responses = {responses!r}: allowed is {allowed}"
     return None
