@@ -4,16 +4,17 @@ A log line can be valid JSON and still not be a response the tasks wrote (an
 edited file, another program's line): a missing field, a text where a number
 belongs, an unknown task. ``problem(event)`` names the first such field, so the
 reader can stop with one line naming the file, the event and the field, rather
-than with a ``KeyError`` deep in pandas. Fields (``rating_task``,
-``adjustment_task``): ``step`` an integer >= 0, ``task``, ``trial`` an integer
->= 1, ``fmax`` a finite number >= 0 (N), ``wall`` the time as text; an
-adjustment's ``condition`` and knob ``value``; a rating's ``responses``, each
-with ``condition``, ``knob`` and ``value``, at least two knob positions apart.
+than with a ``KeyError`` deep in pandas. Fields (``studyapp.experiment.tasks``,
+what each task type's ``export_rows`` reads): ``step`` an integer >= 0,
+``task`` a registered task, ``trial`` an integer >= 1, ``fmax`` a finite
+number >= 0 (N), ``wall`` the time as text; a rating's ``responses``, each
+with ``condition``, ``knob``, ``value`` and ``rating``; any other task's
+``condition``, and an adjustment's knob ``value``.
 """
 
 import math
 
-TASKS = ("rating", "adjustment")
+from studyapp.experiment.tasks import task_names
 
 
 def _integer(value, low):
@@ -34,7 +35,7 @@ def problem(event):
         return f"event {event!r}: allowed is a JSON object"
     checks = [
         ("step", _integer(event.get("step"), 0), "an integer >= 0"),
-        ("task", isinstance(event.get("task"), str) and event.get("task") in task_names(), " or ".join(task_names())),
+        ("task", isinstance(event.get("task"), str) and event.get("task") in task_names(), ", ".join(task_names())),
         ("trial", _integer(event.get("trial"), 1), "an integer >= 1"),
         ("fmax", _number(event.get("fmax")), "a finite number >= 0"),
         ("wall", _text(event.get("wall")), "the time as ISO-8601 text"),
