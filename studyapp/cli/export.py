@@ -26,9 +26,11 @@ def register(sub):
 def run(args):
     import sys
 
+    from studyapp.cli import output_paths
     from studyapp.errors import UserError
     from studyapp.experiment.export import export_responses, save_responses
 
+    output_paths.check_file(args.output)
     problems = []
     frame = export_responses(args.results, problems)
     for problem in problems:

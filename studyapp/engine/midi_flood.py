@@ -36,6 +36,8 @@ import tempfile
 import textwrap
 import time
 
+from studyapp.model.sources import LVT_SENSOR
+
 KNOBS = 8
 JACK_RATE = 48000
 JACK_PERIOD = 1024  # frames: tests/engine/conftest.py explains why not 256 on a loaded VM
@@ -132,7 +134,7 @@ def _engine():
     from studyapp.engine.config import EngineConfig
     from studyapp.engine.engine import Engine
 
-    return Engine(EngineConfig(rate=5000.0, source="LVT", fmax=0.5, audio="null", midi="virtual")).start()
+    return Engine(EngineConfig(rate=5000.0, source=LVT_SENSOR, fmax=0.5, audio="null", midi="virtual")).start()
 
 
 def quiet(seconds):

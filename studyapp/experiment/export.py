@@ -34,6 +34,7 @@ from pathlib import Path
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.experiment import response_event
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
@@ -43,10 +44,14 @@ COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rati
 
 
 def _session_rows(folder, problems):
+    """The rows of one session; an unreadable session is skipped (a line in ``problems``).
+
+    Damaged log lines are left out with a line in ``problems``; a valid line that is
+    not a well-formed event is bad input (``InputDataError``).
+    """
     path = folder / SESSION_FILE
-    info, notes = read_description(folder)
-    problems.extend(notes)
     try:
+        info, notes = read_description(folder)
         common = {
             "participant": info["participant"],
             "session": info["session"],
@@ -54,17 +59,30 @@ def _session_rows(folder, problems):
             "study": info["study"],
             "app_version": info["app_version"],
         }
+    except UserError as exc:
+        problems.append(f"{folder}: skipped, {exc}")
+        return []
     except (KeyError, TypeError) as exc:
-        raise InputDataError(f"{path}: not a readable session file (no {exc})") from None
-    log = read_log(folder / EVENTS_FILE)
-    problems.extend(log.messages(str(folder / EVENTS_FILE)))
+        problems.append(f"{folder}: skipped, {path}: not a readable session file (no {exc})")
+        return []
+    problems.extend(notes)
+    events_file = folder / EVENTS_FILE
+    log = read_log(events_file)
+    problems.extend(log.messages(str(events_file)))
     if log.torn:
-        problems.append(f"{folder / EVENTS_FILE}: a torn last line ({len(log.torn)} bytes, never confirmed) "
-                        "left out")
+        problems.append(f"{events_file}: a torn last line ({len(log.torn)} bytes, never confirmed) left out")
+    if log.malformed:
+        number, _, raw = log.malformed[0]
+        raise InputDataError(f"{events_file} line {number}: {raw.strip()[:40]!r} is not an event: "
+                             "allowed is a JSON object with a 'type'")
     rows = []
     for event in log.events:
         if event.get("type") != "response":
             continue
+        wrong = response_event.problem(event)
+        if wrong is not None:
+            seq = event.get("seq") if isinstance(event, dict) else "?"
+            raise InputDataError(f"{folder / EVENTS_FILE}: response event seq {seq}: {wrong}")
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
                 "time": event["wall"], "step": event["step"], "duration": event.get("duration")}
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
@@ -81,7 +99,8 @@ def export_responses(results_dir, problems=None):
 
     A session that cannot be read is skipped, and a damaged line of a log left
     out; each is one line appended to ``problems`` (a list) naming the file.
-    Without ``problems`` the first one raises ``InputDataError``.
+    Without ``problems`` the first one raises ``InputDataError``. A malformed
+    event (valid JSON, wrong fields) raises ``InputDataError`` either way.
     """
     root = Path(results_dir)
     if not root.is_dir():
@@ -89,10 +108,7 @@ def export_responses(results_dir, problems=None):
     found = []
     rows = []
     for folder in session_folders_under(root):
-        try:
-            rows.extend(_session_rows(folder, found))
-        except UserError as exc:
-            found.append(f"{folder}: skipped, {exc}")
+        rows.extend(_session_rows(folder, found))
     if found and problems is None:
         raise InputDataError(found[0])
     if problems is not None:

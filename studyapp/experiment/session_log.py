@@ -12,9 +12,10 @@ from survives a crash of the program or of the machine.
 Reading (``read_log``) checks every line and never lets one bad line hide
 the others:
 
-- a complete line that is not a JSON object or fails its checksum is
-  *damaged*: it is left out, reported by its line number, and the valid lines
-  after it are kept. Opening the log for appending leaves it in place (nothing
+- a complete line that is not valid JSON or fails its checksum is *damaged*:
+  it is left out, reported by its line number, and the valid lines after it
+  are kept. Valid JSON that is not an event object is *malformed* (not
+  corruption: an edited file): the export refuses it, resuming treats it as damaged. Opening the log for appending leaves it in place (nothing
   but a torn last line is ever removed), copies it to ``events.jsonl.damaged``
   and logs a ``log_damaged`` event the first time it is seen.
 - the bytes after the last newline are a *torn* last line (the machine lost
@@ -85,6 +86,7 @@ class LogScan:
     events: list = field(default_factory=list)
     lines: list = field(default_factory=list)      # the 1-based line number of each event
     damaged: list = field(default_factory=list)    # (line number, reason, raw bytes with newline)
+    malformed: list = field(default_factory=list)  # the same, for valid JSON that is not an event
     torn: bytes = b""                              # an incomplete last line
     completed: bool = False                        # the last line was whole but for its newline
 
@@ -101,7 +103,7 @@ def scan(data):
     for number, line in enumerate(complete, start=1):
         event, why = decode(line)
         if event is None:
-            result.damaged.append((number, why, line + b"\n"))
+            (result.malformed if why == "not an event" else result.damaged).append((number, why, line + b"\n"))
         else:
             result.events.append(event)
             result.lines.append(number)
@@ -178,16 +180,16 @@ class SessionLog:
         elif log.completed:
             self._write(b"\n")
             self.notes.append(f"{self.path}: the last line lacked its newline (checksum valid): completed")
-        if log.damaged:
+        bad = sorted(log.damaged + log.malformed)
+        if bad:
             side = self.path.with_name(self.path.name + DAMAGED_SUFFIX)
-            quarantined = b"".join(raw for _, _, raw in log.damaged)
+            quarantined = b"".join(raw for _, _, raw in bad)
             first_time = not side.exists() or side.read_bytes() != quarantined
             if first_time:
                 self._guard(lambda: _write_copy(side, quarantined))
-                repairs.append({"type": "log_damaged", "lines": [n for n, _, _ in log.damaged],
-                                "copy": side.name})
-            self.notes.extend(m.replace("left out;", f"set aside in {side.name};")
-                              for m in log.messages(str(self.path)))
+                repairs.append({"type": "log_damaged", "lines": [n for n, _, _ in bad], "copy": side.name})
+            self.notes.extend(f"{self.path} line {n}: damaged ({why}), set aside in {side.name}; "
+                              "the lines after it are kept" for n, why, _ in bad)
         for event in repairs:
             self.append(event)
 

@@ -257,6 +257,6 @@ def test_analyse_reports_an_unreadable_session_and_strict_refuses(tmp_path, prot
     report = tmp_path / "report"
     assert main(["analyse", str(results), "-o", str(report), "--strict"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert f"studyapp analyse: warning: {bad}: skipped, {bad / 'session.json'}: missing" in err[1]
+    assert f"studyapp analyse: warning: {bad}: skipped, {bad / 'session.json'}: missing" in err[0]
     assert err[-1].startswith("studyapp: error: ") and "--strict" in err[-1] and "Traceback" not in "".join(err)
     assert not report.exists()
