@@ -148,13 +148,17 @@ def test_absurd_samples_are_bad_and_counted(which):
         steps = [one.step(x, a, v) for x, a, v in zip(dirty["position"], dirty["acceleration"], dirty["velocity"])]
         np.testing.assert_array_equal(steps, expected, err_msg=name)
         assert one.bad_samples == len(at), name
-    # a sample at the bound itself is good: counted as nothing, and it reaches the kernel
+    # a sample at the bound itself is good: not counted, and the estimators that read it see it
     edge = dict(clean)
     edge[which] = clean[which].copy()
     edge[which][60] = -bound
     bank = estimators.Bank(rate, estimators.names())
-    bank.process(edge["position"], edge["acceleration"], edge["velocity"])
+    out = bank.process(edge["position"], edge["acceleration"], edge["velocity"])
     assert np.all(bank.states[:, 3] == 0)
+    readers = [i for i, name in enumerate(bank.names) if which in estimators.describe(name)["inputs"]]
+    unchanged = estimators.Bank(rate, estimators.names()).process(clean["position"], clean["acceleration"],
+                                                                  clean["velocity"])
+    assert all(out[i, 60] != unchanged[i, 60] or out[i, 61] != unchanged[i, 61] for i in readers)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
