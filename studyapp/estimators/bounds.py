@@ -22,8 +22,11 @@ tested to be forgotten within 0.1 s, tests/estimators/test_estimators_extremes.p
 The simulated device (``studyapp simulate --rate 96000 --fmax 200``, 2 s,
 2026-11-23) peaks at 9 mm, 0.25 m/s and 264 m/s^2. The one simulated sample
 that could pass a bound is a hard hit on an end stop, which the model makes
-rigid: the acceleration of that sample is v/T, above 1e5 m/s^2 for v > 1 m/s
-at 96 kHz; the real accelerometer saturates near 4,900 m/s^2 there anyway.
+rigid (the velocity drops to 0 in one sample): the hand driven into the stops
+at 0.48 m/s (as in tests/model/test_model_extremes.py, with KALMAN observing)
+gives 1.3e4 m/s^2 at 96 kHz after the accelerometer's band, so only a hit
+above about 3.7 m/s would be held; the real accelerometer saturates near
+4,900 m/s^2 long before.
 
 A sample x of an input with bound B is good when |x| <= B; NaN compares false,
 so one test covers NaN, inf and the absurd.
