@@ -15,7 +15,7 @@ once cannot be seen without the protocol's count.
 import numpy as np
 import pandas as pd
 
-from studyapp.analysis.responses import TASKS, response_values
+from studyapp.analysis.responses import MEASURED_TASKS, response_values
 
 MISSING_COLUMNS = ["participant", "task", "condition", "expected", "present", "missing_trials"]
 
@@ -31,7 +31,7 @@ def find_missing_trials(responses, expected=None):
     expected = dict(expected or {})
     participants = sorted(responses["participant"].unique())
     rows = []
-    for task in TASKS:
+    for task in MEASURED_TASKS:
         conditions = sorted(responses.loc[responses["task"] == task, "condition"].unique())
         if not conditions:
             continue

@@ -15,6 +15,7 @@ from studyapp import __version__
 from studyapp.analysis.missing_trials import describe_missing
 from studyapp.analysis.rank_sum import POOLED
 from studyapp.analysis.signed_rank import EXACT_LIMIT
+from studyapp.experiment.tasks import task_type
 
 _STYLE = """
 body { font-family: sans-serif; max-width: 60em; margin: 1em auto; color: #222; }
@@ -184,7 +185,7 @@ def _significance_matrix(task):
 
 
 def _consistency(study):
-    task = "max F_max" if study.spearman_task == "adjustment" else "noisiness"
+    task = task_type(study.spearman_task).measure.label
     table = _table(
         ["participant", "rho", "p", "conditions"],
         [[r.participant, r.rho, r.p_value, r.conditions] for r in study.participant_spearman.itertuples()],

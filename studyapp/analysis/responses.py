@@ -2,17 +2,20 @@
 
 The export contract (``studyapp export``) gives one row per response with at
 least ``participant, session, task, condition, trial, fmax, rating, time,
-protocol_hash``. ``task`` is ``rating`` (``rating`` is the participant's
-noisiness in [0, 1], higher = noisier; ``fmax`` the task's constant F_max) or
-``adjustment`` (``fmax`` the confirmed breakdown F_max in newtons, ``trial``
-1..6). The analysis needs ``participant, task, condition, trial, fmax,
-rating``.
+protocol_hash``. ``task`` names a registered task type
+(``studyapp.experiment.tasks``), whose ``measure`` says which column holds
+its outcome and the range allowed: ``rating`` (``rating`` is the
+participant's noisiness in [0, 1], higher = noisier; ``fmax`` the task's
+constant F_max) or ``adjustment`` (``fmax`` the confirmed breakdown F_max in
+newtons, ``trial`` 1..6). Rows of a task without a measure (``listen``) are
+checked and carried, but not analysed. The analysis needs ``participant,
+task, condition, trial, fmax, rating``.
 
 A response whose value is empty (a trial begun but never confirmed) is kept
 out of the statistics but not forgotten: the missing-trials check counts it as
 missing. A value that is present but not a number, out of range, or a task that
-is neither ``rating`` nor ``adjustment`` is bad input: one line naming the file,
-the column and the row.
+is not registered is bad input: one line naming the file, the column and the
+row.
 """
 
 from pathlib import Path
@@ -21,9 +24,11 @@ import numpy as np
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.experiment.tasks import task_names, task_type
 
 REQUIRED_COLUMNS = ["participant", "task", "condition", "trial", "fmax", "rating"]
-TASKS = ("rating", "adjustment")
+TASKS = task_names()
+MEASURED_TASKS = tuple(t for t in TASKS if task_type(t).measure is not None)
 _TEXT_COLUMNS = ["participant", "session", "task", "condition", "protocol_hash"]
 
 
@@ -99,25 +104,21 @@ def check_responses(frame, label, csv_rows=False):
     if bad_trial.any():
         i = int(bad_trial.index[np.flatnonzero(bad_trial)[0]])
         raise InputDataError(f"{label}: column 'trial' at {where(i)} is {frame['trial'][i]:g}; allowed: 1, 2, 3, ...")
-    adjustment = frame["task"] == "adjustment"
-    fmax = frame["fmax"].where(adjustment)
-    bad_fmax = fmax.notna() & ~(np.isfinite(fmax) & (fmax >= 0))
-    if bad_fmax.any():
-        i = int(np.flatnonzero(bad_fmax)[0])
-        raise InputDataError(f"{label}: column 'fmax' at {where(i)} is {fmax[i]:g}; allowed: a finite F_max >= 0 N")
-    rating = frame["rating"].where(~adjustment)
-    bad_rating = rating.notna() & ~((rating >= 0) & (rating <= 1))
-    if bad_rating.any():
-        i = int(np.flatnonzero(bad_rating)[0])
-        raise InputDataError(
-            f"{label}: column 'rating' at {where(i)} is {rating[i]:g}; allowed: a normalised rating in [0, 1]"
-        )
+    for task in MEASURED_TASKS:
+        measure = task_type(task).measure
+        values = frame[measure.column].where(frame["task"] == task)
+        bad = values.notna() & ~(np.isfinite(values) & (values >= measure.low) & (values <= measure.high))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InputDataError(
+                f"{label}: column '{measure.column}' at {where(i)} is {values[i]:g}; allowed: {measure.allowed}"
+            )
     return frame
 
 
 def response_values(responses, task):
-    """The rows of ``task`` that hold a value, with that value in a column ``value``."""
-    column = "fmax" if task == "adjustment" else "rating"
+    """The rows of ``task`` that hold a value, with that value (its measure's column) in a column ``value``."""
+    column = task_type(task).measure.column
     rows = responses[(responses["task"] == task) & responses[column].notna()]
     return rows.assign(value=rows[column].astype(float))
 

@@ -28,6 +28,7 @@ from studyapp.analysis.rank_sum import pairwise_rank_sum
 from studyapp.analysis.responses import response_values
 from studyapp.analysis.summary import summarise
 from studyapp.analysis.within_subject import WithinSubject, friedman_table, within_subject
+from studyapp.experiment.tasks import task_type
 
 ALPHA = 0.05
 
@@ -114,8 +115,8 @@ def analyse(responses, source="responses", evaluation=None, holm=False, alpha=AL
     """
     adjustment_values = response_values(responses, "adjustment")
     rating_values = response_values(responses, "rating")
-    adjustment = _task(adjustment_values, "adjustment", higher_is_better=True, holm=holm, alpha=alpha)
-    rating = _task(rating_values, "rating", higher_is_better=False, holm=holm, alpha=alpha)
+    adjustment = _task(adjustment_values, "adjustment", holm=holm, alpha=alpha)
+    rating = _task(rating_values, "rating", holm=holm, alpha=alpha)
     spearman_task, spearman_values = ("adjustment", adjustment_values)
     if adjustment_values.empty:
         spearman_task, spearman_values = ("rating", rating_values)
@@ -140,7 +141,8 @@ def analyse(responses, source="responses", evaluation=None, holm=False, alpha=AL
     )
 
 
-def _task(values, task, higher_is_better, holm, alpha):
+def _task(values, task, holm, alpha):
+    higher_is_better = task_type(task).measure.higher_is_better
     medians = values.groupby("condition")["value"].median()
     # Best first; ties broken by name so the order is reproducible.
     order = sorted(medians.index, key=lambda c: (-medians[c] if higher_is_better else medians[c], c))

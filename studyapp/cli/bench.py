@@ -1,8 +1,8 @@
-"""``studyapp bench estimators|loop|live``: speed, measured (medians), never asserted in tests."""
+"""``studyapp bench estimators|loop|live|midi``: speed, measured (medians), never asserted in tests."""
 
 
 def register(sub):
-    parser = sub.add_parser("bench", help="measure speed: estimators, closed loop, live engine")
+    parser = sub.add_parser("bench", help="measure speed: estimators, closed loop, live engine, MIDI flood")
     kinds = parser.add_subparsers(dest="bench", metavar="WHAT", required=True)
 
     p = kinds.add_parser("estimators", help="ns per sample of every estimator and of the bank")
@@ -23,6 +23,13 @@ def register(sub):
                    help="block period in ms, the deadline of each block (default 2, the engine's)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.benchmark"))
+
+    p = kinds.add_parser("midi", help="the live engine under a flood of MIDI control changes (dummy JACK)")
+    p.add_argument("--rate", type=float, default=10_000.0, help="control changes per second (default 10000)")
+    p.add_argument("--seconds", type=float, default=5.0, help="flood length per run (default 5)")
+    p.add_argument("--runs", type=int, default=3, help="runs; the figures are their medians (default 3)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.engine.midi_flood"))
 
 
 def _run(module):

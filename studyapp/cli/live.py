@@ -2,7 +2,9 @@
 
 Prints the engine's status once a second on stderr; with ``--json`` prints one
 JSON object on stdout at exit:
-``{"rate", "achieved_rate", "deadline_misses", "audio_underruns", "faults", "midi_messages", ...}``.
+``{"rate", "achieved_rate", "deadline_misses", "audio_underruns", "faults", "midi_messages",
+"events_dropped", ...}``; ``events_dropped`` counts the worker's events (MIDI control events, notices)
+that its event ring overwrote before this process read them.
 Stops after ``--seconds`` or on Ctrl-C / SIGTERM, always cleanly (no orphan
 process, no shared memory left behind).
 """
@@ -11,7 +13,7 @@ process, no shared memory left behind).
 def register(sub):
     p = sub.add_parser("live", help="run the haptic loop in real time (audio out, MIDI knobs in)")
     p.add_argument("--rate", type=float, default=5000.0, help="haptic rate in Hz (default 5000)")
-    p.add_argument("--source", default="LVT", help="velocity source: an estimator, LVT or TRUE (default LVT)")
+    p.add_argument("--source", default=None, help="velocity source: an estimator, LVT or TRUE (default LVT)")
     p.add_argument("--fmax", type=float, default=1.0, help="F_max in N (default 1)")
     p.add_argument("--estimators", default=None,
                    help="active estimators: comma-separated names or 'all' (default: just the source)")
@@ -29,16 +31,18 @@ def register(sub):
 def _estimators(text, source):
     from studyapp import estimators
     from studyapp.errors import ParameterError
+    from studyapp.estimators import lvt
+    from studyapp.model.sources import PSEUDO_SOURCES, is_pseudo
 
     if text is None:
-        if source in ("LVT", "TRUE"):
+        if is_pseudo(source):
             return {}
         if source not in estimators.names():
-            raise ParameterError(f"source {source!r}: allowed are LVT, TRUE or an estimator "
-                                 f"({', '.join(n for n in estimators.names() if n != 'LVT')})")
+            raise ParameterError(f"source {source!r}: allowed are {', '.join(PSEUDO_SOURCES)} or an estimator "
+                                 f"({', '.join(n for n in estimators.names() if n != lvt.NAME)})")
         return {source: {}}
     if text.strip().lower() == "all":
-        return {n: {} for n in estimators.names() if n != "LVT"}
+        return {n: {} for n in estimators.names() if n != lvt.NAME}
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in estimators.names()]
     if unknown:
@@ -62,7 +66,10 @@ def run(args):
     from studyapp.engine.config import EngineConfig
     from studyapp.engine.engine import Engine
     from studyapp.errors import ParameterError
+    from studyapp.model.sources import LVT_SENSOR
 
+    if args.source is None:
+        args.source = LVT_SENSOR
     if args.seconds is not None and not args.seconds > 0:
         raise ParameterError(f"--seconds {args.seconds}: allowed is a positive number")
 
@@ -109,6 +116,7 @@ def run(args):
         "audio_underruns": summary.get("audio_underruns", 0),
         "faults": list(engine.faults),
         "midi_messages": summary.get("midi_messages", 0),
+        "events_dropped": engine.events_dropped,
         "seconds": summary.get("seconds", 0.0),
         "block": engine.info.get("block"),
         "load_max": summary.get("load_max", 0.0),
@@ -121,5 +129,6 @@ def run(args):
         print(json.dumps(result))
     else:
         say(f"live: done: {result['achieved_rate']:.0f} Hz achieved, {result['deadline_misses']} deadline misses, "
-            f"{result['audio_underruns']} underruns, {len(result['faults'])} faults")
+            f"{result['audio_underruns']} underruns, {len(result['faults'])} faults, "
+            f"{result['events_dropped']} events dropped")
     return 1 if engine.tripped else 0

@@ -13,7 +13,7 @@ def register(subparsers):
     p.add_argument("--fmax", type=float, default=1.0, help="peak friction force F_max in N (default 1)")
     p.add_argument("--rate", type=float, default=5000.0, help="sample rate in Hz, 1000..96000 (default 5000)")
     p.add_argument("--duration", type=float, default=7.0, help="seconds (default 7)")
-    p.add_argument("--source", default="LVT", help=SOURCES_HELP)
+    p.add_argument("--source", default=None, help=SOURCES_HELP)
     p.add_argument("--gesture", default="strokes", help="strokes, strokes-validation or hold (default strokes)")
     p.add_argument("--f0", type=float, default=None, help="string pitch in Hz (default: the model's)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -24,8 +24,9 @@ def register(subparsers):
 def check_source(name):
     from studyapp.errors import ParameterError
     from studyapp.estimators import names
+    from studyapp.model.sources import with_pseudo_sources
 
-    allowed = [n for n in names()] + ["TRUE"]
+    allowed = with_pseudo_sources(names())
     if name not in allowed:
         raise ParameterError(f"--source {name!r}: allowed are {', '.join(allowed)}")
 
@@ -45,7 +46,10 @@ def run(args):
     from studyapp.estimators.spec import validate_rate
     from studyapp.model import simulate
     from studyapp.model.loop import check_fmax
+    from studyapp.model.sources import LVT_SENSOR
 
+    if args.source is None:
+        args.source = LVT_SENSOR
     recording.check_path(args.output)
     validate_rate(args.rate)
     check_fmax(args.fmax)

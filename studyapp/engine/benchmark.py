@@ -32,6 +32,7 @@ import json
 import sys
 
 from studyapp import estimators
+from studyapp.estimators import lvt
 from studyapp.engine.config import BLOCK_PERIOD, block_samples
 
 LADDER = (5000.0, 10000.0, 20000.0, 40000.0, 48000.0, 96000.0)
@@ -41,7 +42,7 @@ CHECK_RATE = 48000.0
 
 
 def all_fourteen():
-    return {n: {} for n in estimators.names() if n != "LVT"}
+    return {n: {} for n in estimators.names() if n != lvt.NAME}
 
 
 def probe(rate, seconds, progress=print, block_period=BLOCK_PERIOD):

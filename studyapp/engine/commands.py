@@ -8,7 +8,7 @@ commands at block boundaries, in order.
 
 Kinds and values:
 
-    source        estimator name, "LVT" or "TRUE"
+    source        estimator name or a pseudo-source (model/sources.py: LVT_SENSOR, TRUE)
     fmax          N (clamped to the safety ceiling)
     hand_target   m (switches the gesture to "live")
     bowing        bool

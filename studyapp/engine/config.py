@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 from studyapp.engine.safety import SafetyLimits
 from studyapp.errors import ParameterError
+from studyapp.model.sources import LVT_SENSOR, with_pseudo_sources
 
 BLOCK_PERIOD = 0.002  # s: default block length; commands and MIDI act at block boundaries
 
@@ -22,7 +23,7 @@ def block_samples(rate, period=BLOCK_PERIOD):
 class EngineConfig:
     rate: float = 5000.0  # haptic rate, Hz
     estimators: dict = field(default_factory=dict)  # active set: name -> params ({} = Table 1 defaults)
-    source: str = "LVT"  # an active estimator, "LVT" or "TRUE"
+    source: str = LVT_SENSOR  # an active estimator or a pseudo-source (model/sources.py)
     fmax: float = 1.0  # N
     gesture: str = "strokes"
     f0: float | None = None  # Hz; None: the model's default
@@ -49,4 +50,4 @@ class EngineConfig:
     def sources(self):
         """The velocity sources a pad can select, in the scene's order."""
         names = list(self.estimators) if isinstance(self.estimators, dict) else list(self.estimators)
-        return names + [s for s in ("LVT", "TRUE") if s not in names]
+        return with_pseudo_sources(names)

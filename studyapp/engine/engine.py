@@ -21,7 +21,18 @@ Either way the fault is reported (``faults``, ``on_fault``), the
 at its next block and latches a fault) and ``force_output`` reads 0: the
 simulated device, which lives in the worker, stops with it. ``stop()`` asks
 the worker to finish, waits for it, kills it if it will not go, and unlinks
-the shared memory: no orphan process, no leaked segment.
+the shared memory: no orphan process, no leaked segment. It waits only while
+the worker shows signs of life: a running worker whose heartbeat is older than
+``STALL_GRACE`` (or its ``hang_timeout``, the longer), or a worker closing its
+devices that has said nothing for ``CLOSE_GRACE``, is stalled (stopped by
+SIGSTOP, hung in native code) and gets SIGKILL at once: a stopped process
+handles neither the stop command nor SIGTERM, and waiting out the polite
+timeout kept the parent 12 s behind a stalled worker.
+
+The worker's events (control events, notices, faults) pass through a ring of
+``event_ring.SLOTS`` slots; should the watchdog fall a whole ring behind, the
+events overwritten unread are counted in ``events_dropped`` (also in
+``status()``), never silently lost.
 """
 
 import contextlib
@@ -37,9 +48,12 @@ from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
 from studyapp.errors import ParameterError, UserError
+from studyapp.model.sources import with_pseudo_sources
 
 POLL = 0.01  # s between watchdog checks
 START_TIMEOUT = 120.0  # s for the worker to import, compile and prime
+STALL_GRACE = 0.5  # s: a running worker's heartbeat this old at stop() means it is stalled
+CLOSE_GRACE = 3.0  # s: a worker closing its devices may be this quiet (a device close gives up after 2 s)
 
 
 class EngineError(UserError):
@@ -66,6 +80,7 @@ class Engine:
         self._stop_watch = threading.Event()
         self._watchdog = None
         self._stopping = False
+        self.events_dropped = 0  # events the worker wrote that the ring overwrote before we read them
 
     # set-up ----------------------------------------------------------------
     def _validate(self):
@@ -78,7 +93,7 @@ class Engine:
         estimators = c.estimators if isinstance(c.estimators, dict) else {n: {} for n in c.estimators}
         names = Bank(c.rate, estimators).names
         c.estimators = dict(zip(names, estimators.values()))
-        allowed = list(names) + ["LVT", "TRUE"]
+        allowed = with_pseudo_sources(names)
         if c.source not in allowed:
             raise ParameterError(f"source {c.source!r}: allowed are {', '.join(allowed)}")
         fmax = float(c.fmax)
@@ -138,7 +153,7 @@ class Engine:
         self._commands.put(cmd.command(kind, value))
 
     def set_source(self, name):
-        allowed = list(self.names) + ["LVT", "TRUE"]
+        allowed = with_pseudo_sources(self.names)
         if name not in allowed:
             raise ParameterError(f"source {name!r}: allowed are {', '.join(allowed)}")
         self.send("source", name)
@@ -179,8 +194,11 @@ class Engine:
             raise EngineError("engine: not running")
 
     def status(self):
+        """The worker's status block (status.NUMBERS, status.TEXTS) and ``events_dropped`` (parent side)."""
         self._shared()
-        return self.status_block.read()
+        snap = self.status_block.read()
+        snap["events_dropped"] = self.events_dropped
+        return snap
 
     def telemetry(self, n=None, since=None):
         """Telemetry as ``{channel: array}`` plus ``"estimates": {name: array}``, ``"start"``, ``"end"``.
@@ -239,6 +257,8 @@ class Engine:
         while True:
             with self._event_lock:  # the watchdog and stop() may both be reading
                 event = self._events.get() if self._events is not None else None
+                if self._events is not None:
+                    self.events_dropped = self._events.lost
             if event is not None or time.monotonic() >= end:
                 return event
             time.sleep(min(POLL / 2, max(0.0, end - time.monotonic())))
@@ -300,15 +320,14 @@ class Engine:
             with contextlib.suppress(Exception):
                 self._commands.put(cmd.command("stop"))
             end = time.monotonic() + timeout
-            while self.process.is_alive() and time.monotonic() < end:
+            heard = time.monotonic()
+            while self.process.is_alive() and time.monotonic() < end and not self._stalled(heard):
                 event = self._next_event(0.05)
                 if event is not None:
                     self._handle(event)
+                    heard = time.monotonic()
             if self.process.is_alive():
-                self.process.terminate()
-                self.process.join(2.0)
-            if self.process.is_alive():
-                self.process.kill()
+                self.process.kill()  # SIGKILL: a stopped worker would never handle SIGTERM
         self.process.join(5.0)
         self._stop_watch.set()
         if self._watchdog is not None and self._watchdog is not threading.current_thread():
@@ -317,6 +336,14 @@ class Engine:
             self._handle(event)
         self._cleanup()
         return self.summary
+
+    def _stalled(self, heard):
+        """The worker has shown no sign of life for longer than it may (module docstring)."""
+        snap = self.status_block.read()
+        now = time.monotonic()
+        if snap["state"] == "running":
+            return now - max(snap["heartbeat"], heard) > max(STALL_GRACE, self.config.hang_timeout)
+        return now - max(snap["heartbeat"], heard) > CLOSE_GRACE
 
     def _cleanup(self):
         if self.process is not None and self.process.is_alive():

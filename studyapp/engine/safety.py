@@ -10,7 +10,13 @@ Three layers keep a fault from leaving the device pushing:
    its own fault the moment one appears and zeroes the force from that sample
    on), a clamp found violated, or the parent's watchdog clearing the
    ``force_enable`` word: the force scale goes to 0 and stays there until
-   ``clear()`` (an experimenter's decision, never automatic).
+   ``clear()`` (an experimenter's decision, never automatic). The word is read
+   twice per block: before the block runs (``before_block``), so a worker
+   that was stopped or starved while the watchdog tripped computes its next
+   block with zero force from the first sample; and after it ran, before its
+   force is written (``check``), so a block in flight across the trip has its
+   force withheld (set to 0) instead of written. After a trip not one sample
+   of non-zero force leaves the worker, SIGCONT or not.
 3. Runaway. A sample is *suspect* when the motor is saturated (|F| >=
    ``saturation`` x the device's sustained limit, 60 N for the TGR) or the
    handle moves faster than ``velocity_bound``. When suspect samples fill at
@@ -38,6 +44,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from studyapp.errors import ParameterError
+
+
+WATCHDOG = "watchdog: the parent disabled the force (worker not answering in time)"
 
 
 @dataclass(frozen=True)
@@ -98,11 +107,20 @@ class Safety:
         self.scale = 1.0
         self.loop.set_force_scale(1.0)
 
+    def before_block(self, force_enable):
+        """Just before a block runs: a cleared ``force_enable`` zeroes that block's force already."""
+        if not force_enable:
+            self.latch(WATCHDOG)
+
     def check(self, block, force_enable=True):
-        """Inspect one block just run; returns the fault text raised by it, or ``None``."""
+        """Inspect one block just run, before its force is written; returns the fault it raised, or ``None``.
+
+        With ``force_enable`` cleared the block's force is withheld: set to 0 in place.
+        """
         before = len(self.faults)
         if not force_enable:
-            self.latch("watchdog: the parent disabled the force (worker not answering in time)")
+            self.latch(WATCHDOG)
+            block["force"][:] = 0.0
         loop_fault = getattr(self.loop, "fault", None)
         if loop_fault:
             self.latch(f"loop fault: {loop_fault}")

@@ -45,7 +45,7 @@ import numpy as np
 from studyapp.engine import commands as cmd
 from studyapp.engine.audio import open_sink
 from studyapp.engine.event_ring import EventRing
-from studyapp.engine.midi import ControlMap, open_input
+from studyapp.engine.midi import ControlMap, coalesce, open_input
 from studyapp.engine.ring import Ring
 from studyapp.engine.safety import Safety
 from studyapp.engine.status import StatusBlock
@@ -211,8 +211,9 @@ class Worker:
             self.apply(command)
         if self.midi is None:
             return
-        for msg, arrived, block in self.midi.poll():
-            self.status.set(midi_messages=self.status.get("midi_messages") + 1)
+        received = self.midi.poll()
+        self.status.set(midi_messages=self.midi.received)
+        for msg, arrived, block in coalesce(received):
             learning = self.cmap.learning
             hit = self.cmap.lookup(msg)
             if hit is None:
@@ -242,6 +243,7 @@ class Worker:
     def step(self, started):
         """One block; returns (finished, wall-clock compute, CPU time of this thread)."""
         cpu_started = time.thread_time()
+        self.safety.before_block(self.status.force_enable)
         out = self.loop.run(self.block)
         self.safety.check(out, force_enable=self.status.force_enable)
         if self.sink.render:

@@ -24,6 +24,7 @@ import numpy as np
 from numba import njit
 
 from studyapp import estimators
+from studyapp.estimators import lvt
 from studyapp.estimators.dispatch import step_guarded
 from studyapp.estimators.registry import spec
 from studyapp.errors import ParameterError
@@ -73,7 +74,7 @@ def cost(name, rate, params=None, n=100_000, repeats=5, block=BLOCK):
 
 def bank_cost(rate, names=None, n=100_000, repeats=5, block=BLOCK):
     """Median ns/sample of a Bank of ``names`` (default: all but LVT) on blocks."""
-    names = names or [e for e in estimators.names() if e != "LVT"]
+    names = names or [e for e in estimators.names() if e != lvt.NAME]
     x, a, v = _signal(rate, n)
     bank = estimators.Bank(rate, names)
     return _median_ns(_blockwise(bank.process, x, a, v, block), n, repeats)
@@ -89,7 +90,7 @@ def run(rate, progress=True, n=100_000):
         if progress:
             print(f"bench estimators: {name} ...", file=sys.stderr, flush=True)
         result["estimators"][name] = cost(name, rate, n=n)
-    bank = [name for name in result["estimators"] if name != "LVT"]
+    bank = [name for name in result["estimators"] if name != lvt.NAME]
     result["bank"] = bank
     if progress:
         print(f"bench estimators: bank of {len(bank)} ...", file=sys.stderr, flush=True)

@@ -25,6 +25,15 @@ out-of-line calls halved the cost of a pass-through estimator (90 -> 45 ns
 wall-clock under load), and an out-of-line kernel in an untaken branch added
 ~20 ns per sample in an isolated test. A compiled loop that calls
 ``step_guarded`` (the closed loop) should use ``error_model="numpy"`` too.
+
+One registration. The two switches below are written out because numba
+inlines a kernel only when it is named in the source (it cannot type a global
+table of kernels to loop over), so they cannot be generated from
+``registry.REGISTRY``; they are checked against it instead:
+tests/estimators/test_estimators_dispatch.py runs every registered kind through
+both and compares with the registered kernel called directly, and a kind with
+no branch raises ``ValueError`` instead of returning 0.0 or leaving the output
+unwritten.
 """
 
 from numba import njit
@@ -68,7 +77,7 @@ def step_any(kind, s, p, x, a, v):
         return complementary.step(s, p, x, a, v)
     elif kind == kinds.LVT:
         return lvt.step(s, p, x, a, v)
-    return 0.0
+    raise ValueError("unknown estimator kind: not in the dispatch (estimators/registry.py)")
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -164,6 +173,8 @@ def run_block(kind, s, p, xs, acc, vel, out):
         guarded_loop(complementary.step, s, p, xs, acc, vel, out)
     elif kind == kinds.LVT:
         guarded_loop(lvt.step, s, p, xs, acc, vel, out)
+    else:
+        raise ValueError("unknown estimator kind: not in the dispatch (estimators/registry.py)")
 
 
 @njit(cache=True, error_model="numpy")

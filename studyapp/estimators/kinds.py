@@ -1,7 +1,10 @@
-"""Integer ids of the estimators, used by the compiled dispatch in ``dispatch.py``.
+"""Integer ids of the estimators, the compile-time constants of the compiled dispatch (``dispatch.py``).
 
-The order is the order of ``studyapp.estimators.names()`` (the issue's table,
-which follows the paper's Table 2 plus BDIFF and the LVT tachometer).
+The id of an estimator is its position in ``registry.REGISTRY`` (the order of
+``studyapp.estimators.names()``: the paper's Table 2 plus BDIFF and the LVT
+tachometer); the registry checks this at import, and
+tests/estimators/test_estimators_dispatch.py checks that the dispatch sends
+every id to its registered kernel.
 """
 
 BDIFF = 0
@@ -19,8 +22,3 @@ KALFOAWACC = 11
 COMP1 = 12
 COMP2 = 13
 LVT = 14
-
-NAMES = [
-    "BDIFF", "LOWPASS", "LEASTSQ", "FOAW", "LEVANT", "LEVANTLP", "KALPOS", "KALMAN",
-    "KALLEV", "KALLEVACC", "KALFOAW", "KALFOAWACC", "COMP1", "COMP2", "LVT",
-]

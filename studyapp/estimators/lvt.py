@@ -10,6 +10,8 @@ from numba import njit
 from studyapp.estimators import kinds
 from studyapp.estimators.spec import EstimatorSpec
 
+NAME = "LVT"  # the estimator; the sensor pseudo-source of the same text is model/sources.py's LVT_SENSOR
+
 
 def build(rate, params):
     import numpy as np
@@ -23,7 +25,7 @@ def step(s, p, x, a, v):
 
 
 SPEC = EstimatorSpec(
-    name="LVT",
+    name=NAME,
     kind=kinds.LVT,
     description="The measured tachometer velocity, passed through.",
     inputs=("velocity",),

@@ -6,8 +6,9 @@ streaming form (a switch on the estimator kind and the bad input guard at
 every sample); here the kernel itself is passed to a compiled loop,
 which numba specialises for that kernel. The output is the same: the kernel
 sees the same state and samples, and recordings with a bad sample (NaN, inf
-or beyond ``estimators.bounds``), or estimators this table does not know, take ``Estimator.process`` instead
-(tests check the equality for every estimator).
+or beyond ``estimators.bounds``), or estimators without a registered kernel,
+take ``Estimator.process`` instead (tests check the equality for every
+estimator).
 
 The loop is compiled once per process and kernel (numba cannot cache a
 function compiled for another compiled function as argument), so it pays
@@ -27,24 +28,11 @@ def run_kernel(step, s, p, xs, acc, vel, out):
         out[i] = step(s, p, xs[i], acc[i], vel[i])
 
 
-_KERNELS = None
-
-
 def kernels():
-    """Estimator name -> its compiled step (the same functions the dispatch calls)."""
-    global _KERNELS
-    if _KERNELS is None:
-        from studyapp.estimators import bdiff, complementary, foaw, hybrids, kalman, leastsq, levant, lowpass, lvt
+    """Estimator name -> its compiled step (the registry's, the same functions the dispatch calls)."""
+    from studyapp.estimators.registry import KERNELS
 
-        _KERNELS = {
-            "BDIFF": bdiff.step, "LOWPASS": lowpass.step, "LEASTSQ": leastsq.step, "FOAW": foaw.step,
-            "LEVANT": levant.step_levant, "LEVANTLP": levant.step_levantlp,
-            "KALPOS": kalman.step_kalpos, "KALMAN": kalman.step_kalman,
-            "KALLEV": hybrids.step_kallev, "KALLEVACC": hybrids.step_kallevacc,
-            "KALFOAW": hybrids.step_kalfoaw, "KALFOAWACC": hybrids.step_kalfoawacc,
-            "COMP1": complementary.step, "COMP2": complementary.step, "LVT": lvt.step,
-        }
-    return _KERNELS
+    return KERNELS
 
 
 def run(estimator, position, acceleration, velocity, finite=None):

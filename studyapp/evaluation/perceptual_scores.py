@@ -36,13 +36,14 @@ import numpy as np
 
 from studyapp.errors import ParameterError, UserError
 from studyapp.evaluation.perceptual import audio_distance, check_rate, frame_length
+from studyapp.model.sources import TRUE, is_pseudo
 
 DEFAULT_FMAX = (1.0, 2.2, 4.4, 7.7)
 DEFAULT_SEEDS = (0, 1)
 DEFAULT_DURATION = 2.0
 DEFAULT_RATE = 5000.0
 GESTURE = "strokes"
-REFERENCE_SOURCE = "TRUE"
+REFERENCE_SOURCE = TRUE
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,7 @@ class Cases:
     def simulate(self, source, fmax, seed, params=None):
         from studyapp.model import simulate
 
-        estimators = {} if source in ("LVT", REFERENCE_SOURCE) else {source: dict(params or {})}
+        estimators = {} if is_pseudo(source) else {source: dict(params or {})}
         return simulate(fmax, rate=self.rate, duration=self.duration, source=source, gesture=self.gesture,
                         seed=seed, estimators=estimators)
 
@@ -158,7 +159,7 @@ def warm_up(cases, names):
 
     short = frame_length(cases.rate) / cases.rate
     for name in (REFERENCE_SOURCE, *names):
-        estimators = {} if name in ("LVT", REFERENCE_SOURCE) else {name: {}}
+        estimators = {} if is_pseudo(name) else {name: {}}
         simulate(cases.fmax[0], rate=cases.rate, duration=short, source=name, gesture=cases.gesture,
                  seed=cases.seeds[0], estimators=estimators)
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from studyapp.errors import ParameterError, UserError
+from studyapp.estimators import lvt
 from studyapp.estimators.registry import spec as lookup
 from studyapp.estimators.spec import validate_rate
 
@@ -56,7 +57,7 @@ _FOAW_RANGES = {"window": (1, 64), "margin": (1e-7, 1e-2), "margin_vel": (1e-4, 
 SEARCH_RANGES = {name: dict(_FOAW_RANGES) for name in ("FOAW", "KALFOAW", "KALFOAWACC")}
 
 # The thirteen estimators of the paper's Table 2 (BDIFF and LVT are ours).
-PAPER_ESTIMATORS = [name for name in PAPER_TUNED if name not in ("BDIFF", "LVT")]
+PAPER_ESTIMATORS = [name for name in PAPER_TUNED if name not in ("BDIFF", lvt.NAME)]
 
 
 @dataclass(frozen=True)

@@ -6,15 +6,19 @@ One row per response, first the columns of the "Study results" contract:
 
 then ``study, step, value, knob, peak_fmax, duration, app_version``.
 
-- ``task`` is ``rating`` or ``adjustment``.
+- ``task`` names the task type; ``trial``, ``fmax``, ``time``, ``step`` and
+  ``duration`` come from the response event, the rest from the task type's
+  ``export_rows`` (``studyapp.experiment.tasks``):
 - Rating rows: ``rating`` is the noisiness normalised to [0, 1] per
   participant (0 = their best, least noisy condition, the highest knob; 1 =
-  their worst, the lowest knob; see ``rating_task``); ``fmax`` the rating
-  task's constant F_max (N); ``trial`` 1; ``value`` the raw knob position
-  (0..127) and ``knob`` the knob that played the condition.
+  their worst, the lowest knob), as the task logged it (``tasks/rating.py``);
+  ``fmax`` the rating task's constant F_max (N); ``trial`` 1; ``value`` the
+  raw knob position (0..127) and ``knob`` the knob that played the condition.
 - Adjustment rows: ``fmax`` the confirmed breakdown F_max (N); ``rating``
   empty; ``trial`` 1..6 (per condition); ``value`` the knob position;
   ``peak_fmax`` the highest F_max reached in the trial.
+- Listen rows: ``fmax`` the F_max played (N), ``duration`` how long; ``rating``
+  and ``value`` empty.
 - ``time`` is the ISO-8601 wall time of the response (the confirm).
 
 Incomplete sessions are exported too: every confirmed response is data. The
@@ -27,9 +31,9 @@ from pathlib import Path
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
-from studyapp.experiment.rating_task import normalise_ratings
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_log import read_events
+from studyapp.experiment.tasks import task_type
 
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
            "study", "step", "value", "knob", "peak_fmax", "duration", "app_version"]
@@ -54,14 +58,7 @@ def _session_rows(folder):
             continue
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
                 "time": event["wall"], "step": event["step"], "duration": event.get("duration")}
-        if event["task"] == "rating":
-            ratings = normalise_ratings({r["condition"]: r["value"] for r in event["responses"]})
-            for r in event["responses"]:
-                rows.append({**base, "condition": r["condition"], "rating": ratings[r["condition"]],
-                             "value": r["value"], "knob": r["knob"]})
-        else:
-            rows.append({**base, "condition": event["condition"], "value": event["value"],
-                         "peak_fmax": event.get("peak_fmax")})
+        rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
 
 
@@ -78,7 +75,7 @@ def export_responses(results_dir):
     frame["trial"] = frame["trial"].astype("int64")
     frame["step"] = frame["step"].astype("int64")
     frame["knob"] = frame["knob"].astype("Int64")
-    frame["value"] = frame["value"].astype("int64")
+    frame["value"] = frame["value"].astype("Int64")  # empty for a task without a knob answer
     return frame.reset_index(drop=True)
 
 

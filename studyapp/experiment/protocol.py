@@ -1,14 +1,18 @@
 """A study protocol: a TOML file, validated on load.
 
 A protocol says everything a session needs (paper Sec. 8): the haptic rate,
-the conditions of the rating task (its constant F_max, 1 N in the paper) and of
-the adjustment task (trials per condition, the knob's F_max ceiling and how
-many decades its logarithmic map spans), the estimator parameters (Table 1
-unless overridden), the study-wide seed of the Latin squares, and the
-instructions shown to the participant. ``docs/experiment.md`` lists every field.
+the estimator parameters (Table 1 unless overridden), the study-wide seed of
+the Latin squares, the tasks to run in order, and one table per task: its
+conditions, instructions and fields, which the task type reads and checks
+(``studyapp.experiment.tasks``; e.g. the rating task's constant F_max, 1 N in
+the paper, or the adjustment knob's F_max ceiling and how many decades its
+logarithmic map spans). ``docs/experiment.md`` lists every field.
 
-Nothing starts on an invalid protocol: ``load_protocol`` raises one
-``UserError`` whose single line names the file, the field and what is allowed.
+Nothing starts on an invalid protocol, and nothing is enrolled:
+``load_protocol`` raises one ``UserError`` whose single line names the file,
+the field and what is allowed. Every number has a finite range that the model
+accepts (F_max and the knob's ceiling at most the loop's ``FMAX_LIMIT`` of
+200 N); NaN and infinities are refused.
 The protocol's hash is the SHA-256 of the file's bytes, so two sessions ran the
 same study exactly when their hashes agree.
 """
@@ -21,32 +25,8 @@ from pathlib import Path
 
 from studyapp.errors import UserError
 
-TASKS = ("rating", "adjustment")
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
 NAME_ALLOWED = "1 to 32 letters, digits, '_' or '-'"
-
-
-@dataclass(frozen=True)
-class RatingSpec:
-    """The rating task: each condition on its own knob, rated at a constant F_max."""
-
-    conditions: tuple
-    fmax: float
-    confirm_pad: int
-    instructions: str
-
-
-@dataclass(frozen=True)
-class AdjustmentSpec:
-    """The adjustment task: one knob sets F_max from 0 up to ``ceiling`` over ``decades``."""
-
-    conditions: tuple
-    trials: int
-    ceiling: float
-    decades: float
-    knob: int
-    confirm_pad: int
-    instructions: str
 
 
 @dataclass(frozen=True)
@@ -63,11 +43,10 @@ class Protocol:
     pads: int
     gesture: str
     estimators: dict = field(default_factory=dict)
-    rating: RatingSpec | None = None
-    adjustment: AdjustmentSpec | None = None
+    specs: dict = field(default_factory=dict)  # task name -> its validated spec (the task type's parse)
 
     def task(self, name):
-        return getattr(self, name)
+        return self.specs[name]
 
     def estimator_params(self, name):
         """The parameter overrides for estimator ``name`` ({} = Table 1 defaults)."""
@@ -127,12 +106,14 @@ class _Fields:
         return value
 
     def number(self, key, low, high, unit="", default=..., low_open=False):
-        allowed = f"a number {'above' if low_open else 'from'} {low:g}{' to ' + format(high, 'g') if high is not None else ''} {unit}".strip()
+        """A finite number in [low, high] (``low_open``: above ``low``); NaN and infinities fail the test."""
+        lower = f"above {low:g} and up" if low_open else f"from {low:g}"
+        allowed = f"a number {lower} to {high:g} {unit}".strip()
         value = self.get(key, allowed, default)
         bad = isinstance(value, bool) or not isinstance(value, (int, float))
         if not bad:
             value = float(value)
-            bad = not (value > low if low_open else value >= low) or (high is not None and value > high)
+            bad = not ((low < value if low_open else low <= value) and value <= high)
         if bad:
             self.fail(key, f"= {value!r}", allowed)
         return value
@@ -171,13 +152,15 @@ def parse_protocol(text, source="<protocol>"):
     from studyapp import estimators
     from studyapp.estimators.registry import spec as estimator_spec
     from studyapp.estimators.spec import RATE_MAX, RATE_MIN
+    from studyapp.experiment.task_type import Bounds
+    from studyapp.experiment.tasks import task_names, task_type
     from studyapp.model.loop import GESTURES
 
     try:
         document = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise UserError(f"{source}: not valid TOML ({exc})") from None
-    known_tables = ("study", "apparatus", "estimators", *TASKS)
+    known_tables = ("study", "apparatus", "estimators", *task_names())
     for name in document:
         if name not in known_tables:
             raise UserError(f"{source}: [{name}] is not a known table: allowed are {', '.join(known_tables)}")
@@ -185,10 +168,10 @@ def parse_protocol(text, source="<protocol>"):
     study = _table(source, document, "study")
     name = study.string("name", NAME_ALLOWED, pattern=NAME_PATTERN)
     title = study.string("title", default=name)
-    tasks_allowed = "a list of the tasks to run, in order: 'rating', 'adjustment' or both"
+    tasks_allowed = "a list of the tasks to run, in order, from: " + ", ".join(repr(t) for t in task_names())
     tasks = study.get("tasks", tasks_allowed)
     if (not isinstance(tasks, list) or not tasks or len(set(tasks)) != len(tasks)
-            or any(t not in TASKS for t in tasks)):
+            or any(t not in task_names() for t in tasks)):
         study.fail("tasks", f"= {tasks!r}", tasks_allowed)
     seed = study.integer("seed", 0, 2**32 - 1)
     study.finish()
@@ -218,29 +201,12 @@ def parse_protocol(text, source="<protocol>"):
         overrides[est] = dict(params)
 
     specs = {}
+    bounds = Bounds(estimators=tuple(known), knobs=knobs, pads=pads)
     for task in tasks:
-        t = _table(source, document, task)
-        pad = t.integer("confirm_pad", 0, pads - 1, default=0)
-        instructions = t.string("instructions")
-        if task == "rating":
-            specs[task] = RatingSpec(
-                conditions=t.conditions("conditions", known, 2, knobs),
-                fmax=t.number("fmax", 0.0, None, "N", low_open=True),
-                confirm_pad=pad,
-                instructions=instructions,
-            )
-        else:
-            specs[task] = AdjustmentSpec(
-                conditions=t.conditions("conditions", known, 1, len(known)),
-                trials=t.integer("trials", 1, 100),
-                ceiling=t.number("ceiling", 0.0, None, "N", low_open=True),
-                decades=t.number("decades", 0.1, 12.0, "decades", default=3.0),
-                knob=t.integer("knob", 0, knobs - 1, default=0),
-                confirm_pad=pad,
-                instructions=instructions,
-            )
-        t.finish()
-    for task in TASKS:
+        table = _table(source, document, task)
+        specs[task] = task_type(task).parse(table, bounds)
+        table.finish()
+    for task in task_names():
         if task in document and task not in tasks:
             raise UserError(f"{source}: [{task}] is given but [study] tasks does not list it: "
                             f"allowed is to list it in tasks or remove the table")
@@ -258,7 +224,7 @@ def parse_protocol(text, source="<protocol>"):
         pads=pads,
         gesture=gesture,
         estimators=overrides,
-        **specs,
+        specs=specs,
     )
 
 

@@ -1,17 +1,21 @@
 """A participant's schedule: the trials of a session, in order.
 
 Each ``Trial`` has a ``step`` (its place in the session, from 0), its ``task``,
-and its ``trial`` number within its condition (from 1). The rating task is one
-trial over all its conditions; ``conditions`` is then the knob assignment
-(knob j plays ``conditions[j]``). An adjustment trial has one ``condition``.
-The order comes from the protocol's balanced Latin squares and the
-participant's enrolment index (see ``latin_square``); the schedule is stored in
-session.json, so a resumed session keeps it whatever the protocol file says.
+its ``trial`` number within its condition (from 1), ``conditions`` (the
+participant's row of the task's Latin square) and, for a trial of one
+condition, ``condition``. Each task type (``studyapp.experiment.tasks``) says
+how its conditions make trials: the rating task is one trial over all its
+conditions, ``conditions`` then being the knob assignment (knob j plays
+``conditions[j]``); an adjustment trial has one ``condition``. The order comes
+from the protocol's balanced Latin squares and the participant's enrolment
+index (see ``latin_square``); the schedule is stored in session.json, so a
+resumed session keeps it whatever the protocol file says.
 """
 
 from dataclasses import asdict, dataclass
 
-from studyapp.experiment.latin_square import balanced_latin_square, participant_row, task_seed
+from studyapp.experiment.latin_square import balanced_latin_square, task_seed
+from studyapp.experiment.tasks import task_type
 
 
 @dataclass(frozen=True)
@@ -33,9 +37,7 @@ class Trial:
                    conditions=tuple(d["conditions"]), condition=d.get("condition"))
 
     def describe(self):
-        if self.task == "rating":
-            return f"rating of {len(self.conditions)} conditions"
-        return f"adjustment {self.condition} trial {self.trial}"
+        return task_type(self.task).describe(self)
 
 
 def build_schedule(protocol, participant_index):
@@ -47,17 +49,10 @@ def build_schedule(protocol, participant_index):
     trials, squares = [], {}
     for task in protocol.tasks:
         spec = protocol.task(task)
-        square = balanced_latin_square(spec.conditions, task_seed(protocol.seed, task))
-        if task == "rating":
-            row = participant_row(square, participant_index)
-            trials.append(Trial(len(trials), "rating", 1, tuple(row)))
-            used = [participant_index % len(square)]
-        else:
-            used = []
-            for repetition in range(spec.trials):
-                row = participant_row(square, participant_index, repetition)
-                used.append((participant_index + repetition) % len(square))
-                for condition in row:
-                    trials.append(Trial(len(trials), "adjustment", repetition + 1, tuple(row), condition))
-        squares[task] = {"rows": len(square), "rows_used": used, "seed": task_seed(protocol.seed, task)}
+        seed = task_seed(protocol.seed, task)
+        square = balanced_latin_square(spec.conditions, seed)
+        planned, used = task_type(task).schedule(spec, square, participant_index)
+        for number, conditions, condition in planned:
+            trials.append(Trial(len(trials), task, number, tuple(conditions), condition))
+        squares[task] = {"rows": len(square), "rows_used": used, "seed": seed}
     return trials, squares

@@ -8,22 +8,24 @@ task) and ``finish``. Every record a task returns is appended to the session
 log with the trial's ``step`` and ``task``. The loop's faults and the stability
 monitor's changes of verdict are logged too.
 
-The loop is made per trial by ``make_loop(estimators, source, seed)`` (the
-rating trial gets all its conditions, an adjustment trial only its own), so
-every adjustment trial starts from a string at rest with F_max = 0. Headless,
+The current trial is the state machine its task type makes
+(``studyapp.experiment.tasks``). The loop is made per trial by
+``make_loop(estimators, source, seed)`` with the conditions the task type asks
+for (the rating trial gets all its conditions, an adjustment trial only its
+own), so every adjustment trial starts from a string at rest with F_max = 0. Headless,
 the default builds ``studyapp.model.ClosedLoop`` in-process; the GUI passes a
 factory for the real-time engine.
 
-On resume, the rating trial gets back the knob positions logged before the
-interruption. An interrupted adjustment trial starts again from F_max = 0 (a
+On resume, an interrupted trial gets back what its task type restores from
+the events logged before the interruption: the rating trial its knob
+positions; an adjustment trial nothing, so it starts again from F_max = 0 (a
 sudden return to a high F_max could be unsafe on a real device).
 """
 
 import numpy as np
 
 from studyapp import __version__
-from studyapp.experiment.adjustment_task import AdjustmentTask
-from studyapp.experiment.rating_task import RatingTask
+from studyapp.experiment.tasks import task_type
 
 
 def closed_loop_factory(protocol, audio=False):
@@ -74,22 +76,11 @@ class SessionRunner:
         if trial is None:
             return None
         p = self.protocol
-        if trial.task == "rating":
-            spec = p.rating
-            self.task = RatingTask(trial.conditions, spec.fmax, spec.confirm_pad, trial.trial)
-            conditions = trial.conditions
-        else:
-            spec = p.adjustment
-            self.task = AdjustmentTask(trial.condition, trial.trial, spec.ceiling, spec.decades,
-                                       spec.knob, spec.confirm_pad)
-            conditions = (trial.condition,)
+        kind = task_type(trial.task)
+        self.task = kind.start(p.task(trial.task), trial)
+        conditions = kind.loop_conditions(trial)
         earlier = [e for e in self.session.events() if e.get("step") == trial.step]
-        restored = 0
-        if trial.task == "rating":
-            for e in earlier:
-                if e.get("type") == "knob":
-                    self.task.knob(e["index"], e["value"])
-                    restored += 1
+        restored = self.task.restore(earlier)
         seed = int(np.random.SeedSequence([self.session.seed, trial.step]).generate_state(1)[0])
         estimators = {c: p.estimator_params(c) for c in conditions}
         self.loop = self.make_loop(estimators, self.task.source or conditions[0], seed)
@@ -131,9 +122,7 @@ class SessionRunner:
 
     @staticmethod
     def _summary(response):
-        if response["task"] == "rating":
-            return ", ".join(f"{r['condition']} {r['rating']:.2f}" for r in response["responses"])
-        return f"F_max = {response['fmax']:.3g} N"
+        return task_type(response["task"]).summary(response)
 
     def knob(self, index, value):
         return self._handle(self.task.knob(index, value))

@@ -62,7 +62,8 @@ class Console(QMainWindow):
         self.setup = SetupPanel()
         self.setup.protocol_chosen.connect(self.choose_protocol)
         self.start_button = QPushButton("Start session")
-        self.start_button.clicked.connect(self.start_session)
+        # not connected directly: ``clicked`` passes ``checked`` (False), which became the seed 0
+        self.start_button.clicked.connect(lambda: self.start_session())
         self.pause_button = QPushButton("Pause")
         self.pause_button.clicked.connect(self._pause_or_resume)
         self.abort_button = QPushButton("Abort")

@@ -3,9 +3,11 @@
 From the engine's shared status block (``studyapp.engine.status``): the
 achieved loop rate against the nominal one, the load (compute time over the
 block period; mean and worst over the last second), deadline misses, audio
-underruns, faults (with the latest fault's text while one is latched), plus
-telemetry samples the GUI lost (it fell more than the ring behind) and the
-scope's painted frame rate. Trouble shows in red.
+underruns, faults (with the latest fault's text while one is latched), the
+engine's events dropped (MIDI control events and notices its event ring
+overwrote before the console read them), plus telemetry samples the GUI lost
+(it fell more than the ring behind) and the scope's painted frame rate.
+Trouble shows in red.
 """
 
 from PySide6.QtWidgets import QLabel, QStatusBar
@@ -24,6 +26,7 @@ class StatusBar(QStatusBar):
             ("misses", "blocks finished after their deadline"),
             ("underruns", "audio device periods the engine did not fill in time"),
             ("faults", "safety faults raised (the force is held at zero while one is latched)"),
+            ("dropped", "engine events (MIDI controls, notices) overwritten before the console read them"),
             ("lost", "telemetry samples the GUI read too late to see"),
             ("fps", "scope frames painted per second"),
         ):
@@ -58,6 +61,9 @@ class StatusBar(QStatusBar):
             faults += f" — LATCHED: {s['fault'] or 'force disabled'}"
         self.labels["faults"].setText(faults)
         self.labels["faults"].setStyleSheet(RED if s["fault_latched"] else "")
+        dropped = s.get("events_dropped", 0)
+        self.labels["dropped"].setText(f"Events dropped {dropped}" if dropped else "")
+        self.labels["dropped"].setStyleSheet(RED if dropped else "")
         self.labels["lost"].setText(f"Lost {lost}" if lost else "")
 
     def show_frame_rate(self, fps):

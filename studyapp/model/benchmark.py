@@ -21,11 +21,12 @@ REPEATS = 5
 
 def measure(rate, block=BLOCK, seconds=SECONDS, repeats=REPEATS):
     """Samples per second (median over repeats) of the full closed loop at ``rate``."""
-    from studyapp.estimators import names
+    from studyapp.estimators import lvt, names
     from studyapp.model.loop import ClosedLoop, LoopConfig
+    from studyapp.model.sources import LVT_SENSOR
 
-    estimators = {name: {} for name in names() if name != "LVT"}
-    loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source="LVT", fmax=1.0, gesture="strokes"))
+    estimators = {name: {} for name in names() if name != lvt.NAME}
+    loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=LVT_SENSOR, fmax=1.0, gesture="strokes"))
     loop.run(block)
     n = max(block, int(round(seconds * loop.rate)))
     rates = []

@@ -32,6 +32,7 @@ import numpy as np
 
 from studyapp.errors import ParameterError
 from studyapp.model.calibration import F0
+from studyapp.model.sources import is_pseudo, with_pseudo_sources
 
 SETTLE = 0.25  # s before the monitor's verdict counts (its window)
 BLOCK = 0.05  # s
@@ -44,10 +45,10 @@ KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min",
 
 
 def sources():
-    """Every velocity source the loop can run: each estimator name (LVT, the tachometer, among them) and TRUE."""
+    """Every velocity source the loop can run: each estimator name, then the pseudo-sources (model/sources.py)."""
     from studyapp.estimators import names
 
-    return names() + ["TRUE"]
+    return with_pseudo_sources(names())
 
 
 def check_source(name, label="source"):
@@ -85,7 +86,7 @@ def is_broken(source, fmax, rate=5000.0, gesture="hold", duration=4.0, seed=0, e
     from studyapp.model.loop import ClosedLoop, LoopConfig
 
     estimators = dict(estimators or {})
-    if source not in ("LVT", "TRUE") and source not in estimators:
+    if not is_pseudo(source) and source not in estimators:
         estimators[source] = {}
     loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
                                  f0=F0 if f0 is None else f0, seed=seed, audio=False))

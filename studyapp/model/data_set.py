@@ -13,6 +13,7 @@ from pathlib import Path
 from studyapp.atomic import atomic_open
 from studyapp.estimators.spec import validate_rate
 from studyapp.model.simulate import simulate
+from studyapp.model.sources import LVT_SENSOR
 from studyapp.recording import save
 
 PAPER_FMAX = [0, 0.3, 0.5, 0.8, 1.1, 1.4, 1.6, 1.9, 2.2, 3.3, 4.4, 5.5, 7.7, 9.9, 12.1]
@@ -34,14 +35,14 @@ def write_set(directory, validation=False, rate=5000.0, duration=7.0, progress=N
         name = file_name(fmax)
         if progress is not None:
             progress(i + 1, len(PAPER_FMAX), name)
-        rec = simulate(fmax, rate=rate, duration=duration, source="LVT", gesture=settings["gesture"],
+        rec = simulate(fmax, rate=rate, duration=duration, source=LVT_SENSOR, gesture=settings["gesture"],
                        seed=settings["seed"] * 1000 + i)
         save(rec, directory / name)
         files.append({"file": name, "fmax": fmax, "seed": rec.meta["seed"], "broken": rec.meta["broken"],
                       "fault": rec.meta["fault"]})
     index = {
         "set": "validation" if validation else "training",
-        "rate": rate, "duration": duration, "source": "LVT", "gesture": settings["gesture"],
+        "rate": rate, "duration": duration, "source": LVT_SENSOR, "gesture": settings["gesture"],
         "fmax": PAPER_FMAX, "files": files,
     }
     with atomic_open(directory / "index.json", "w") as f:

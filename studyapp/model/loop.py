@@ -59,10 +59,9 @@ from studyapp.estimators.spec import validate_rate
 from studyapp.model import body, bow_table, bowed_string, calibration, contact_mic, hand, sensors, stability
 from studyapp.model import device as mechanics
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
+from studyapp.model.sources import LVT_SENSOR, LVT_SENSOR_INDEX, TRUE, TRUE_INDEX, with_pseudo_sources
 from studyapp.model.stability import StabilityMonitor
 
-SOURCE_TRUE = -1
-SOURCE_LVT = -2
 FMAX_LIMIT = 200.0  # N: nothing above the motors' impulsive limit makes sense
 F0_RANGE = (20.0, 2000.0)
 
@@ -83,7 +82,6 @@ OUTPUTS = (
 )
 
 GESTURES = ("strokes", "strokes-validation", "hold", "live", "playback")
-SOURCES_EXTRA = ("LVT", "TRUE")
 
 
 @dataclass
@@ -92,7 +90,7 @@ class LoopConfig:
 
     rate: float = 5000.0
     estimators: dict = field(default_factory=dict)
-    source: str = "LVT"
+    source: str = LVT_SENSOR
     fmax: float = 1.0
     gesture: str = "strokes"
     f0: float | None = calibration.F0  # None: the default
@@ -220,7 +218,7 @@ def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bri
         if src >= 0:
             v_src = step_guarded(kinds[src], est_s[src], est_p[src], x_m, a_m, v_m)
             est_out[src, k] = v_src
-        elif src == SOURCE_TRUE:
+        elif src == TRUE_INDEX:
             v_src = v
         else:
             v_src = v_m
@@ -350,16 +348,16 @@ class ClosedLoop:
 
     # settings -------------------------------------------------------------
     def set_source(self, name):
-        if name == "TRUE":
+        if name == TRUE:
             if not self.simulated:
-                raise ParameterError("source 'TRUE' needs the simulated device (a real one has no true velocity)")
-            index = SOURCE_TRUE
-        elif name == "LVT":
-            index = SOURCE_LVT
+                raise ParameterError(f"source {TRUE!r} needs the simulated device (a real one has no true velocity)")
+            index = TRUE_INDEX
+        elif name == LVT_SENSOR:
+            index = LVT_SENSOR_INDEX
         elif name in self.names:
             index = self.names.index(name)
         else:
-            allowed = ", ".join(list(self.names) + list(SOURCES_EXTRA))
+            allowed = ", ".join(with_pseudo_sources(self.names))
             if name in SPECS:
                 raise ParameterError(f"source {name!r} is not an active estimator: allowed are {allowed}")
             raise ParameterError(f"unknown source {name!r}: allowed are {allowed}")

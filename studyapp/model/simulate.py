@@ -14,13 +14,14 @@ import numpy as np
 from studyapp.errors import ParameterError
 from studyapp.model import calibration
 from studyapp.model.loop import ClosedLoop, LoopConfig
+from studyapp.model.sources import LVT_SENSOR, is_pseudo
 from studyapp.recording import COLUMNS, Recording
 
 BLOCK = 4096
 DURATION_MAX = 3600.0
 
 
-def simulate(fmax, rate=5000.0, duration=7.0, source="LVT", gesture="strokes", f0=None, seed=0,
+def simulate(fmax, rate=5000.0, duration=7.0, source=LVT_SENSOR, gesture="strokes", f0=None, seed=0,
              estimators=None, progress=None):
     """A ``Recording`` of ``duration`` s of bowing at ``fmax`` N with ``source`` in the loop.
 
@@ -39,7 +40,7 @@ def simulate(fmax, rate=5000.0, duration=7.0, source="LVT", gesture="strokes", f
         estimators = {name: {} for name in estimators}
     else:
         estimators = dict(estimators)
-    if source not in ("LVT", "TRUE") and source not in estimators:
+    if not is_pseudo(source) and source not in estimators:
         estimators[source] = {}
     f0 = calibration.F0 if f0 is None else f0
     config = LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,

@@ -78,7 +78,10 @@ def test_one_real_probe_reports_what_it_ran():
     result = benchmark.probe(5000.0, 1.0, progress=lines.append, block_period=0.01)
     assert result["rate"] == 5000.0 and result["block"] == 50
     assert result["seconds"] == pytest.approx(1.0, abs=0.5)
-    assert result["faults"] == [] and result["overruns"] >= 0 and result["stalls"] >= 0
+    assert result["faults"] == []
+    # Overruns and stalls are kinds of deadline miss, counted at most once each.
+    assert result["overruns"] + result["stalls"] <= result["deadline_misses"]
+    assert f"overruns {result['overruns']}, stalls {result['stalls']}," in lines[0]
     assert 0.0 < result["load_mean"] <= result["load_p99"] <= result["load_max"]
     assert result["passed"] == (result["deadline_misses"] == 0
                                 and abs(result["achieved_rate"] - 5000.0) <= 50.0)

@@ -30,6 +30,7 @@ def test_live_runs_for_the_given_time_and_prints_one_json_object(tmp_path):
     result = json.loads(out)
     assert list(result)[:len(KEYS)] == KEYS
     assert result["rate"] == 8000.0 and result["faults"] == [] and result["midi_messages"] == 0
+    assert result["events_dropped"] == 0
     assert result["achieved_rate"] == pytest.approx(8000, rel=0.1)
     assert result["audio_underruns"] == 0
     assert result["seconds"] == pytest.approx(2.5, abs=0.5)

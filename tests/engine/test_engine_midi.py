@@ -8,7 +8,7 @@ import mido
 import pytest
 
 from studyapp.engine import commands
-from studyapp.engine.midi import ControlMap, MidiInput, open_input
+from studyapp.engine.midi import ControlMap, MidiInput, coalesce, open_input
 from studyapp.errors import ParameterError
 from studyapp.model.fmax_knob import LIVE_RANGE, fmax_from_knob
 
@@ -99,14 +99,14 @@ def test_default_actions_drive_the_engine_commands():
     assert "pad4" not in actions
 
 
-def test_the_callback_only_queues_and_the_engine_drains_in_order():
+def test_the_callback_only_queues_raw_bytes_and_the_engine_drains_in_order():
     midi = MidiInput("fake", "UNIX_JACK")
-    sent = [mido.Message("control_change", control=1, value=v) for v in range(100)]
+    sent = [[0xB0, 1, v] for v in range(100)]
 
-    def rtmidi_thread():
+    def rtmidi_thread():  # python-rtmidi calls back with ([bytes], delta time) and the user data
         for i, m in enumerate(sent):
             midi.block = i // 10
-            midi._callback(m)
+            midi._callback((m, 0.001), None)
 
     thread = threading.Thread(target=rtmidi_thread)
     thread.start()
@@ -117,6 +117,27 @@ def test_the_callback_only_queues_and_the_engine_drains_in_order():
     times = [t for _, t, _ in got]
     assert times == sorted(times)
     assert midi.received == 100 and midi.poll() == []
+
+
+def test_a_block_keeps_only_the_last_value_of_each_controller_and_every_note():
+    cc = lambda channel, number, value: [0xB0 | channel, number, value]  # noqa: E731
+    note_on = lambda note: [0x90, note, 100]  # noqa: E731
+    received = [
+        (cc(0, 1, 10), 1.0, 7), (cc(0, 2, 5), 1.1, 7), (note_on(36), 1.2, 7), (cc(0, 1, 20), 1.3, 7),
+        (cc(1, 1, 99), 1.4, 7),  # the same number on channel 2 is another controller
+        (note_on(36), 1.5, 8), (cc(0, 2, 6), 1.6, 8), (cc(0, 1, 30), 1.7, 8), ([0xF8], 1.8, 8), ([0xB0], 1.9, 8),
+    ]
+    got = coalesce(received)
+    expected = [
+        (mido.Message("control_change", channel=0, control=1, value=30), 1.7, 8),  # where knob 1 first moved
+        (mido.Message("control_change", channel=0, control=2, value=6), 1.6, 8),
+        (mido.Message("note_on", channel=0, note=36, velocity=100), 1.2, 7),
+        (mido.Message("control_change", channel=1, control=1, value=99), 1.4, 7),
+        (mido.Message("note_on", channel=0, note=36, velocity=100), 1.5, 8),  # both presses kept
+        (mido.Message("clock"), 1.8, 8),
+    ]  # the torn [0xB0] is left out
+    assert got == expected
+    assert coalesce([]) == []
 
 
 def test_without_a_backend_one_line_says_so_and_nothing_leaks_to_stderr(capfd, monkeypatch):

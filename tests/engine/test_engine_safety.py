@@ -92,6 +92,26 @@ def test_the_watchdog_word_latches_a_fault():
     assert loop.force_scale == 0.0
 
 
+def test_a_watchdog_trip_before_a_block_zeroes_that_block_from_its_first_sample():
+    loop = ClosedLoop(LoopConfig(rate=RATE, source="TRUE", fmax=2.0))
+    safety = Safety(loop)
+    block = loop.run(int(0.5 * RATE))  # the scripted strokes: the bow pushes back
+    safety.before_block(True)
+    assert safety.check(block) is None and np.max(np.abs(block["force"])) > 1.0
+    safety.before_block(False)  # the parent cleared the word while the worker was stopped
+    assert "watchdog" in safety.latched
+    assert np.all(loop.run(LOOP_BLOCK)["force"] == 0.0)
+
+
+def test_a_block_in_flight_across_a_watchdog_trip_has_its_force_withheld():
+    loop = FakeLoop()
+    safety = Safety(loop, motor_limits=(200.0, 60.0))
+    block = _block(0.9)
+    assert "watchdog" in safety.check(block, force_enable=False)
+    assert np.all(block["force"] == 0.0)
+    assert np.all(block["velocity_true"] == 0.0) and block["position"].shape == (BLOCK,)  # only the force
+
+
 def test_fmax_is_clamped_to_the_ceiling():
     safety = Safety(FakeLoop(), SafetyLimits(fmax_ceiling=20.0), motor_limits=(200.0, 60.0))
     assert safety.clamp_fmax(5.0) == 5.0

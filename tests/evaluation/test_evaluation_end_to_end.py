@@ -110,7 +110,19 @@ def test_evaluate_writes_every_output(recordings, optimised, tmp_path, capsys):
     tests = _csv(out / "wilcoxon.csv")
     pairs = len(ESTIMATORS) * (len(ESTIMATORS) - 1) // 2
     assert len(tests) == 2 * 3 * pairs  # groups a and b, three measures
-    assert all(0.0 <= float(t["p"]) <= 1.0 for t in tests)
+    # Every test against scipy's rank-sum on the per-recording values of evaluation.json (group a: all three).
+    from scipy import stats
+
+    for t in (t for t in tests if t["group"] == "a" and t["measure"] == "error_pct_lowpass"):
+        a, b = (written["estimators"][n]["error_pct_lowpass"] for n in (t["a"], t["b"]))
+        if np.ptp(a + b) == 0:
+            assert (float(t["statistic"]), float(t["p"])) == (0.0, 1.0)
+            continue
+        assert float(t["p"]) == pytest.approx(stats.mannwhitneyu(a, b, use_continuity=False).pvalue, rel=1e-9)
+        # z, tie-corrected: |z| from the asymptotic p, its sign from U - n_a n_b / 2.
+        asymptotic = stats.mannwhitneyu(a, b, method="asymptotic", use_continuity=False)
+        z = np.sign(asymptotic.statistic - len(a) * len(b) / 2) * stats.norm.isf(asymptotic.pvalue / 2)
+        assert float(t["statistic"]) == pytest.approx(z, rel=1e-6)
     assert {t["group"] for t in tests} == {"a", "b"}
 
     import matplotlib.image
@@ -123,10 +135,25 @@ def test_evaluate_writes_every_output(recordings, optimised, tmp_path, capsys):
 
     summary = json.loads((out / "validation.json").read_text())
     assert summary["matched_recordings"] == len(FMAX)
-    assert summary["error_difference_pct_mean"] >= 0 and summary["delay_difference_mean"] >= 0
     assert set(summary["estimators"]) == set(ESTIMATORS)
     assert written["validation"] == summary
-    assert len(_csv(out / "validation.csv")) == len(ESTIMATORS) * len(FMAX)
+    rows = _csv(out / "validation.csv")
+    assert len(rows) == len(ESTIMATORS) * len(FMAX)
+    # Sec. 7.3's differences from the raw E and D of each pair (closed forms), and one pair's raw
+    # values from the metric run on the two recordings directly.
+    e_train = np.array([float(r["error"]) for r in rows])
+    e_valid = np.array([float(r["error_validation"]) for r in rows])
+    d_train = np.array([int(r["delay"]) for r in rows])
+    d_valid = np.array([int(r["delay_validation"]) for r in rows])
+    assert summary["error_difference_pct_mean"] == pytest.approx(np.mean(100 * np.abs(e_valid - e_train) / e_train))
+    assert summary["delay_difference_mean"] == pytest.approx(np.mean(np.abs(d_valid - d_train)))
+    rec_v = load(recordings / "validation" / "fmax_2.2.npz")
+    est_v = create("KALMAN", rec_v.rate, **params).process(rec_v["position"], rec_v["acceleration"],
+                                                            rec_v["velocity_lvt"])
+    d_v, e_v = delay_and_error(rec_v["velocity_lvt"], est_v, 100)
+    (kalman,) = [r for r in rows if r["estimator"] == "KALMAN" and float(r["fmax"]) == 2.2]
+    assert float(kalman["error"]) == pytest.approx(e) and float(kalman["error_validation"]) == pytest.approx(e_v)
+    assert int(kalman["delay_difference"]) == abs(d_v - d)
 
 
 def test_tradeoff_writes_table_and_plots(optimised, tmp_path):

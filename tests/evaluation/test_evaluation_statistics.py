@@ -12,19 +12,22 @@ from studyapp.evaluation.significance import not_different_from_best, pairwise, 
 from tests.evaluation.conftest import stick_slip
 
 
-def test_rank_sum_exact_p_for_separated_samples():
-    # 5 vs 5, completely separated: exact two-sided p = 2 / C(10, 5) = 2 / 252.
-    u, p = rank_sum([1, 2, 3, 4, 5], [6, 7, 8, 9, 10])
-    assert p == pytest.approx(2 / 252)
-    assert u == 0.0
+def test_rank_sum_of_recordings_drops_non_finite_values():
+    # The finite values 1, 2, 3 against 4, 5, 6: exact p = 2 / C(6, 3), z = -4.5 / sqrt(21 / 4).
+    z, p = rank_sum([1, np.nan, 2, 3], [4, 5, np.inf, 6])
+    assert p == pytest.approx(0.1, rel=1e-12)
+    assert z == pytest.approx(stats.ranksums([1, 2, 3], [4, 5, 6]).statistic, rel=1e-12)
+    z, p = rank_sum([1.0, np.nan], [2.0, 3.0])
+    assert np.isnan(z) and p == 1.0
+    assert rank_sum([2.0, 2.0, 2.0], [2.0, 2.0]) == (0.0, 1.0)
 
 
-def test_rank_sum_with_ties_agrees_with_the_normal_approximation():
+def test_rank_sum_with_ties_is_the_tie_corrected_normal_approximation():
     rng = np.random.default_rng(0)
     a, b = rng.integers(0, 5, 30), rng.integers(1, 6, 30)
     _, p = rank_sum(a, b)
-    z = stats.ranksums(a, b).pvalue  # no tie correction: close, not equal
-    assert p == pytest.approx(z, rel=0.1)
+    assert p == pytest.approx(stats.mannwhitneyu(a, b, method="asymptotic", use_continuity=False).pvalue, rel=1e-10)
+    assert p < stats.ranksums(a, b).pvalue  # ranksums has no tie correction: larger variance, larger p
 
 
 def test_pairwise_and_best_group():
@@ -64,8 +67,16 @@ def test_report_matches_the_metric_and_lowpass_is_100_percent():
     assert np.allclose(result.error_pct("LOWPASS"), 100.0)
     assert np.allclose(result.delay_pct("LOWPASS"), 100.0)
     assert np.allclose(result.error_pct("BDIFF"), 100 * result.errors["BDIFF"] / result.errors["LOWPASS"])
-    # Each recording's E and D are normalised to [0, 1] across the three estimators: 0 <= F_g <= 2n.
-    assert all(0.0 <= result.objective[n] <= 6.0 for n in params)
+    # Eqs. 29-32: each recording's E and |D| are scaled to [0, 1] across the three estimators (min -> 0,
+    # max -> 1; all equal -> 0); F_g (eq. 27) is their sum over the recordings.
+    def scaled(m):
+        spread = m.max(axis=0) - m.min(axis=0)
+        return np.where(spread > 0, (m - m.min(axis=0)) / np.where(spread > 0, spread, 1.0), 0.0)
+
+    errors = np.array([result.errors[n] for n in params])
+    delays = np.abs(np.array([result.delays[n] for n in params], dtype=float))
+    expected = (scaled(errors) + scaled(delays)).sum(axis=1)
+    assert [result.objective[n] for n in params] == pytest.approx(expected, rel=1e-12)
     assert result.ranking == sorted(params, key=result.objective.get)
     doc = result.to_json()
     assert set(doc) >= {"estimators", "ranking"}

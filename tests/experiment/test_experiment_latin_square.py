@@ -52,13 +52,13 @@ def test_schedule_of_the_paper_study():
     assert len(trials) == 1 + 9 * 6
     assert [t.step for t in trials] == list(range(len(trials)))
     rating = trials[0]
-    assert rating.task == "rating" and sorted(rating.conditions) == sorted(protocol.rating.conditions)
+    assert rating.task == "rating" and sorted(rating.conditions) == sorted(protocol.task("rating").conditions)
     adjustment = trials[1:]
     counts = collections.Counter((t.condition, t.trial) for t in adjustment)
     assert set(counts.values()) == {1} and len(counts) == 54
     for r in range(6):
         block = [t.condition for t in adjustment[9 * r: 9 * r + 9]]
-        assert sorted(block) == sorted(protocol.adjustment.conditions) and all(t.trial == r + 1 for t in adjustment[9 * r: 9 * r + 9])
+        assert sorted(block) == sorted(protocol.task("adjustment").conditions) and all(t.trial == r + 1 for t in adjustment[9 * r: 9 * r + 9])
     assert squares["rating"]["rows"] == 8 and squares["adjustment"]["rows"] == 18
     assert squares["adjustment"]["rows_used"] == [4, 5, 6, 7, 8, 9]
     other, _ = build_schedule(protocol, participant_index=5)

@@ -79,21 +79,21 @@ def test_shipped_protocols_load(name):
 
 def test_sinclair2014_is_the_paper_study():
     p = load_protocol(SHIPPED / "sinclair2014.toml")
-    assert set(p.rating.conditions) == {"LOWPASS", "LEASTSQ", "FOAW", "LEVANT", "LEVANTLP", "KALPOS", "KALLEV", "LVT"}
-    assert set(p.adjustment.conditions) == set(p.rating.conditions) | {"KALFOAW"}
-    assert p.rating.fmax == 1.0 and p.adjustment.trials == 6 and p.knobs == 8
+    assert set(p.task("rating").conditions) == {"LOWPASS", "LEASTSQ", "FOAW", "LEVANT", "LEVANTLP", "KALPOS", "KALLEV", "LVT"}
+    assert set(p.task("adjustment").conditions) == set(p.task("rating").conditions) | {"KALFOAW"}
+    assert p.task("rating").fmax == 1.0 and p.task("adjustment").trials == 6 and p.knobs == 8
     assert p.estimator_params("LEVANT") == {"c": 19.7}
     assert p.estimator_params("KALLEV")["q"] == 6.38e4
 
 
 def test_demo_is_short():
     p = load_protocol(SHIPPED / "demo.toml")
-    assert len(p.rating.conditions) == 3 and len(p.adjustment.conditions) == 3 and p.adjustment.trials == 1
+    assert len(p.task("rating").conditions) == 3 and len(p.task("adjustment").conditions) == 3 and p.task("adjustment").trials == 1
 
 
 def test_a_complete_protocol_loads(tmp_path):
     p = load_protocol(write(tmp_path, BASE))
-    assert p.study == "pilot" and p.adjustment.confirm_pad == 1 and p.adjustment.decades == 2.0
+    assert p.study == "pilot" and p.task("adjustment").confirm_pad == 1 and p.task("adjustment").decades == 2.0
     assert p.estimator_params("LOWPASS") == {"cutoff_hz": 300.0} and p.estimator_params("LVT") == {}
     assert p.settings()["rating"]["conditions"] == ["LOWPASS", "LEVANT", "LVT"]
 

@@ -91,9 +91,7 @@ def run_simulated(session, made=None, trials=None):
         participant.play(runner)
     else:
         for _ in range(trials):
-            trial = runner.start_trial()
-            rng = __import__("numpy").random.default_rng([session.seed, trial.step])
-            (participant.rate if trial.task == "rating" else participant.adjust)(runner, rng)
+            participant.play_trial(runner, runner.start_trial())
     return runner
 
 
@@ -113,7 +111,7 @@ def test_simulated_participant_rates_by_noise_and_finds_breakdown(tmp_path, prot
     for response in responses[1:]:
         threshold = THRESHOLD[response["condition"]]
         # Confirmed within a few knob steps of the breakdown level.
-        knob = protocol.adjustment.ceiling, protocol.adjustment.decades
+        knob = protocol.task("adjustment").ceiling, protocol.task("adjustment").decades
         assert fmax_from_knob(response["value"] - 8, *knob) < threshold < fmax_from_knob(response["value"] + 8, *knob)
         assert response["peak_fmax"] > threshold
     # Every knob event of the rating trial drove the loop: selection and F_max.

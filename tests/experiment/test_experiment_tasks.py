@@ -1,10 +1,13 @@
 """Task logic: scripted event sequences give the expected logged responses."""
 
+import json
+
 import numpy as np
 import pytest
 
-from studyapp.experiment.adjustment_task import AdjustmentTask
-from studyapp.experiment.rating_task import RatingTask, normalise_ratings
+from studyapp.experiment.tasks import task_type
+from studyapp.experiment.tasks.adjustment import AdjustmentTrial
+from studyapp.experiment.tasks.rating import RatingTrial, normalise_ratings
 from studyapp.model.fmax_knob import fmax_from_knob, knob_from_fmax
 
 CONDITIONS = ("LOWPASS", "LEVANT", "KALLEV", "LVT")
@@ -19,7 +22,7 @@ def play(task, script):
 
 
 def test_rating_knob_selects_and_rates():
-    task = RatingTask(CONDITIONS, fmax=1.0)
+    task = RatingTrial(CONDITIONS, fmax=1.0)
     assert task.source is None and task.fmax == 0.0
     records = play(task, [("knob", 2, 50), ("tick", 0.5), ("knob", 0, 10), ("tick", 0.25)])
     assert records == [
@@ -31,7 +34,7 @@ def test_rating_knob_selects_and_rates():
 
 
 def test_rating_full_sequence_gives_the_normalised_response():
-    task = RatingTask(CONDITIONS, fmax=1.0, confirm_pad=3)
+    task = RatingTrial(CONDITIONS, fmax=1.0, confirm_pad=3)
     script = [
         ("knob", 3, 127), ("tick", 1.0),  # best first: LVT at the top
         ("knob", 1, 0), ("tick", 1.0),    # worst: LEVANT at the bottom
@@ -64,7 +67,7 @@ def test_rating_normalises_within_the_participants_range():
 
 
 def test_rating_confirm_is_refused_until_complete():
-    task = RatingTask(CONDITIONS, fmax=1.0)
+    task = RatingTrial(CONDITIONS, fmax=1.0)
     records = play(task, [("knob", 0, 127), ("knob", 1, 0), ("pad", 0)])
     assert records[-1]["accepted"] is False and "KALLEV, LVT" in records[-1]["reason"]
     records = play(task, [("knob", 0, 30), ("knob", 1, 30), ("knob", 2, 30), ("knob", 3, 30), ("pad", 0)])
@@ -73,7 +76,7 @@ def test_rating_confirm_is_refused_until_complete():
 
 
 def test_rating_ignores_unassigned_knobs_and_rejects_bad_values():
-    task = RatingTask(CONDITIONS, fmax=1.0)
+    task = RatingTrial(CONDITIONS, fmax=1.0)
     assert task.knob(7, 10) == [] and task.source is None
     for bad in (-1, 128, 1.5, True):
         with pytest.raises(ValueError, match="knob value"):
@@ -81,7 +84,7 @@ def test_rating_ignores_unassigned_knobs_and_rejects_bad_values():
 
 
 def test_adjustment_sequence_with_overshoot():
-    task = AdjustmentTask("LOWPASS", trial=2, ceiling=40.0, decades=3.0, knob=0, confirm_pad=1)
+    task = AdjustmentTrial("LOWPASS", trial=2, ceiling=40.0, decades=3.0, knob=0, confirm_pad=1)
     assert task.fmax == 0.0 and task.source == "LOWPASS"
     script = [("pad", 1), ("knob", 1, 99), ("knob", 0, 60), ("tick", 0.5), ("knob", 0, 100),
               ("tick", 0.5), ("knob", 0, 96), ("pad", 0), ("pad", 1)]
@@ -109,3 +112,15 @@ def test_fmax_knob_map_is_logarithmic_from_zero_to_the_ceiling():
     for k in range(128):
         assert knob_from_fmax(fmax_from_knob(k, 12.0, 2.0), 12.0, 2.0) == k
     assert knob_from_fmax(1e-9, 12.0, 2.0) == 1 and knob_from_fmax(1e9, 12.0, 2.0) == 127
+
+
+def test_ratings_are_normalised_once_and_exported_as_logged():
+    task = RatingTrial(CONDITIONS, fmax=1.0)
+    records = play(task, [("knob", 0, 90), ("knob", 1, 10), ("knob", 2, 127), ("knob", 3, 37), ("pad", 0)])
+    response = records[-1]
+    rows = task_type("rating").export_rows(json.loads(json.dumps(response)))  # as read back from events.jsonl
+    # Closed form: noisiness = (max - k) / (max - min) over this participant's knob positions.
+    expected = {"LOWPASS": 37 / 117, "LEVANT": 1.0, "KALLEV": 0.0, "LVT": 90 / 117}
+    assert {r["condition"]: r["rating"] for r in rows} == pytest.approx(expected)
+    assert [r["rating"] for r in rows] == [r["rating"] for r in response["responses"]]
+    assert [(r["knob"], r["value"]) for r in rows] == [(0, 90), (1, 10), (2, 127), (3, 37)]

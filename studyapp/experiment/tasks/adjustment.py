@@ -1,0 +1,185 @@
+"""The adjustment task (paper Sec. 8.1-8.2): one knob raises F_max until the string breaks down.
+
+Each condition is played in ``trials`` repetitions; repetition r follows row
+r of the task's balanced Latin square from the participant's row on. A trial
+starts at F_max = 0. The adjustment knob sets F_max through the one knob law
+(``studyapp.model.fmax_knob``: 0 at the bottom, then logarithmically from
+``ceiling`` * 10^-``decades`` to the protocol's ``ceiling``); the participant
+turns it up until the string "breaks down" (the margin of stability), turns
+back if they overshot, and confirms with the pad. The response is the F_max
+at the confirm; the highest F_max reached during the trial is kept too, as a
+record of the overshoot. A confirm at F_max = 0 is refused (no friction
+cannot break down: it is a slip of the hand). Other knobs are ignored.
+
+An interrupted trial starts again from F_max = 0 (a sudden return to a high
+F_max could be unsafe on a real device): nothing is restored.
+
+The simulated participant (Sec. 8.2): it rests the bow on the string and holds
+the handle (gesture ``adjust_gesture``, ``hold``: the model's oscillation
+shows when the bow rests or moves slowly, while regular strokes mask it; see
+studyapp.model.stability), then from F_max = 0 raises the knob in steps of 3
+to 5 positions (drawn per trial), listening ``probe_time`` seconds after each,
+until the loop's stability monitor flags breakdown (it reacts within
+``reaction_time``) or the loop faults. The oscillation, once started,
+outlives a small turn back (hysteresis, as the paper's participants found),
+so it then works down in a staircase: lift the bow until the string is calm
+(at most ``rest_time``), turn back 2 or 3 positions, bow again and listen,
+until the string holds. It confirms there, moved by its personal criterion (a
+bias of ``criterion_spread`` knob positions drawn once per session:
+participants judge "breakdown" differently, Sec. 9.1) and a per-trial jitter
+of ``hand_jitter`` positions. If the string never breaks down it confirms at
+the top of the knob.
+
+Each F_max step is probed for ``probe_time`` = 1.2 s, longer than the
+stability monitor needs to call a breakdown (about 1 s after the oscillation
+starts, studyapp.model.stability): with shorter probes the participant kept
+raising F_max past breakdown before hearing it, and confirmed two to three
+times above the F_max that model.breakdown.breakdown_fmax finds.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from studyapp.experiment.latin_square import participant_row
+from studyapp.experiment.task_type import Measure
+from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
+from studyapp.model.fmax_knob import KNOB_MAX, fmax_from_knob
+from studyapp.model.loop import FMAX_LIMIT
+
+
+@dataclass(frozen=True)
+class AdjustmentSpec:
+    conditions: tuple
+    trials: int
+    ceiling: float
+    decades: float
+    knob: int
+    confirm_pad: int
+    instructions: str
+
+
+class AdjustmentTrial(ConfirmPadTrial):
+    task = "adjustment"
+
+    def __init__(self, condition, trial, ceiling, decades, knob=0, confirm_pad=0):
+        super().__init__(trial, confirm_pad)
+        self.condition = condition
+        self.ceiling = float(ceiling)
+        self.decades = float(decades)
+        self.knob_index = knob
+        self.value = 0
+        self.peak_value = 0
+
+    @property
+    def source(self):
+        return self.condition
+
+    @property
+    def fmax(self):
+        return fmax_from_knob(self.value, self.ceiling, self.decades)
+
+    def knob(self, index, value):
+        check_knob_value(value)
+        if self.done or index != self.knob_index:
+            return []
+        self.value = value
+        self.peak_value = max(self.peak_value, value)
+        return [{"type": "knob", "index": index, "value": value, "fmax": self.fmax}]
+
+    def refusal(self):
+        return "F_max is 0: turn the knob up first" if self.value == 0 else None
+
+    def answer(self):
+        return {
+            "condition": self.condition,
+            "trial": self.trial,
+            "fmax": self.fmax,
+            "value": self.value,
+            "peak_fmax": fmax_from_knob(self.peak_value, self.ceiling, self.decades),
+            "duration": self.elapsed,
+        }
+
+    def knob_positions(self):
+        return {self.knob_index: self.value}
+
+
+class Adjustment:
+    name = "adjustment"
+    measure = Measure(column="fmax", low=0.0, high=math.inf, allowed="a finite F_max >= 0 N",
+                      higher_is_better=True, label="max F_max")
+
+    def parse(self, table, bounds):
+        pad = read_confirm_pad(table, bounds)
+        instructions = table.string("instructions")
+        return AdjustmentSpec(
+            conditions=table.conditions("conditions", bounds.estimators, 1, len(bounds.estimators)),
+            trials=table.integer("trials", 1, 100),
+            ceiling=table.number("ceiling", 0.0, FMAX_LIMIT, "N", low_open=True),
+            decades=table.number("decades", 0.1, 12.0, "decades", default=3.0),
+            knob=table.integer("knob", 0, bounds.knobs - 1, default=0),
+            confirm_pad=pad,
+            instructions=instructions,
+        )
+
+    def schedule(self, spec, square, participant_index):
+        trials, used = [], []
+        for repetition in range(spec.trials):
+            row = participant_row(square, participant_index, repetition)
+            used.append((participant_index + repetition) % len(square))
+            trials += [(repetition + 1, row, condition) for condition in row]
+        return trials, used
+
+    def loop_conditions(self, trial):
+        return (trial.condition,)
+
+    def start(self, spec, trial):
+        return AdjustmentTrial(trial.condition, trial.trial, spec.ceiling, spec.decades, spec.knob, spec.confirm_pad)
+
+    def describe(self, trial):
+        return f"adjustment {trial.condition} trial {trial.trial}"
+
+    def heading(self, trial):
+        return f"adjustment, repetition {trial.trial}"
+
+    def knob_captions(self, trial, state, knobs, hidden):
+        return ["F_max" if i == state.knob_index else "" for i in range(knobs)]
+
+    def response_text(self, response):
+        return f"Response recorded: F_max = {response['fmax']:.3g} N."
+
+    def summary(self, response):
+        return f"F_max = {response['fmax']:.3g} N"
+
+    def export_rows(self, event):
+        return [{"condition": event["condition"], "value": event["value"], "peak_fmax": event.get("peak_fmax")}]
+
+    def simulate(self, participant, runner, rng):
+        knob = runner.task.knob_index
+        step = int(rng.integers(3, 6))
+        participant.knob_values[knob] = 0
+        runner.set_gesture(participant.adjust_gesture)
+        runner.set_bowing(True)
+        runner.advance(participant.reaction_time)
+        value, broken = 0, False
+        while value < KNOB_MAX and not broken:
+            value = min(KNOB_MAX, value + step)
+            participant.turn(runner, knob, value, rng)
+            broken = participant.listen_for_breakdown(runner, participant.probe_time)
+        if broken and runner.loop.fault is not None:
+            value -= step
+        elif broken:
+            for _ in range(participant.retries):
+                value = max(1, value - int(rng.integers(2, 4)))
+                participant.rest(runner)
+                participant.turn(runner, knob, value, rng)
+                if not participant.listen_for_breakdown(runner, participant.probe_time) or value == 1:
+                    break
+        if broken:
+            value = round(value + participant.criterion + rng.normal(0.0, participant.hand_jitter))
+        participant.turn(runner, knob, int(np.clip(value, 1, KNOB_MAX)), rng)
+        runner.pad(runner.task.confirm_pad)
+
+
+TASK_TYPE = Adjustment()
