@@ -112,8 +112,10 @@ def load(path):
     """Read a recording written by ``save`` (or any CSV with the ``COLUMNS`` header)."""
     path = Path(path)
     suffix = _suffix(path)
-    if not path.is_file():
+    if not path.exists():
         raise InputDataError(f"{path}: no such file")
+    if not path.is_file():
+        raise InputDataError(f"{path}: not a regular file: allowed is a recording file")
     try:
         if suffix == ".npz":
             columns, meta = _load_npz(path)
@@ -138,7 +140,8 @@ def load(path):
         raise InputDataError(f"{path}: {exc}") from None
 
 
-def _parse_meta(text, path):
+def parse_meta(text, path):
+    """The metadata JSON ``text`` as a dict; ``InputDataError`` naming ``path`` otherwise."""
     try:
         meta = json.loads(text)
     except json.JSONDecodeError:
@@ -150,7 +153,7 @@ def _parse_meta(text, path):
 
 def _load_npz(path):
     with np.load(path, allow_pickle=False) as data:
-        meta = _parse_meta(str(data["__meta__"]), path) if "__meta__" in data.files else {}
+        meta = parse_meta(str(data["__meta__"]), path) if "__meta__" in data.files else {}
         columns = {k: np.asarray(data[k], dtype=np.float64) for k in data.files if k != "__meta__"}
     return columns, meta
 
@@ -160,17 +163,17 @@ def _load_h5(path):
 
     with h5py.File(path, "r") as f:
         raw = f.attrs.get("meta", "{}")
-        meta = _parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), path)
+        meta = parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), path)
         columns = {k: np.asarray(f[k][()], dtype=np.float64) for k in f.keys()}
     return columns, meta
 
 
 def _load_csv(path):
     meta = {}
-    with open(path, encoding="utf-8") as f:
+    with open(path, encoding="utf-8-sig") as f:  # -sig: a byte order mark (Excel's CSV UTF-8) is accepted
         first = f.readline()
         if first.startswith("#"):
-            meta = _parse_meta(first[1:].strip(), path)
+            meta = parse_meta(first[1:].strip(), path)
             header = f.readline()
         else:
             header = first

@@ -1,68 +1,115 @@
-"""CSV tables of samples: one header row, one row per sample, SI units.
+"""CSV tables of samples, read a block of rows at a time: one header row, one row per sample, SI units.
 
-Reading checks everything before anything is computed, so a bad file stops
-with one line that names the file, the line and the column, and nothing is
-written. Cells keep their original text, so a table can be written back out
-with an added column without reformatting the user's numbers.
+``SampleTable(path)`` opens the file and checks its header; ``blocks(size,
+names)`` then yields ``(rows, columns)`` for each run of ``size`` samples:
+``rows`` the cells' original text (so a table is written back out with an
+added column without reformatting the user's numbers) and ``columns`` the
+named columns as float64. Memory stays that of one block whatever the file's
+length. A UTF-8 byte order mark (Excel's "CSV UTF-8") is accepted.
+
+A bad file stops with one ``InputDataError`` that names the file, the line and
+the column. The header, the first row and the file's kind (a regular file: a
+device such as ``/dev/zero`` never ends) are checked on opening; a bad cell
+further down is found when its block is read, so a caller writing as it reads
+writes atomically (``studyapp.atomic``).
 """
 
 import csv
-from dataclasses import dataclass
+import os
+import stat
 
 import numpy as np
 
 from studyapp.errors import InputDataError
 
 
-@dataclass
 class SampleTable:
-    path: str
-    header: list
-    rows: list  # list of lists of cell text
+    """An open CSV file of samples; use as a context manager, or call ``close``."""
 
-    def column(self, name):
-        """The column ``name`` as float64; a non-numeric cell raises InputDataError."""
-        j = self.header.index(name)
-        out = np.empty(len(self.rows))
-        for i, row in enumerate(self.rows):
-            cell = row[j].strip()
+    def __init__(self, path, required=("position",)):
+        self.path = str(path)
+        try:
+            self._file = open(path, newline="", encoding="utf-8-sig")
+        except FileNotFoundError:
+            raise InputDataError(f"{path}: no such file") from None
+        except IsADirectoryError:
+            raise InputDataError(f"{path}: is a folder: allowed is a CSV file") from None
+        except OSError as exc:
+            raise InputDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
+        try:
+            if not stat.S_ISREG(os.fstat(self._file.fileno()).st_mode):
+                raise InputDataError(f"{path}: not a regular file: allowed is a CSV file")
+            self._reader = csv.reader(self._file)
+            header = self._next_row()
+            if not header:
+                raise InputDataError(f"{path}: empty file; expected a header row with a 'position' column")
+            self.header = [h.strip() for h in header]
+            for name in required:
+                if name not in self.header:
+                    raise InputDataError(f"{path}: column {name!r} missing; the header has {', '.join(self.header)}")
+            self._first = self._next_row()
+            if self._first is None:
+                raise InputDataError(f"{path}: no samples below the header")
+        except BaseException:
+            self._file.close()
+            raise
+
+    def _next_row(self):
+        """The next non-blank row (a trailing blank line is not a sample), checked for its length; None at the end."""
+        try:
+            for row in self._reader:
+                if not row:
+                    continue
+                if hasattr(self, "header") and len(row) != len(self.header):
+                    raise InputDataError(f"{self.path}: line {self._reader.line_num} has {len(row)} cells, "
+                                         f"the header has {len(self.header)}")
+                return row
+        except (UnicodeDecodeError, csv.Error) as exc:
+            raise InputDataError(f"{self.path}: not a readable CSV file ({exc})") from None
+        return None
+
+    def blocks(self, size, names):
+        """Yield ``(rows, {name: float64 array})`` for runs of up to ``size`` rows; ``names`` must be in the header."""
+        indices = {name: self.header.index(name) for name in names}
+        row = self._first
+        while row is not None:
+            rows, lines = [], []
+            while row is not None and len(rows) < size:
+                rows.append(row)
+                lines.append(self._reader.line_num)
+                row = self._next_row()
+            yield rows, {name: self._floats(rows, lines, j, name) for name, j in indices.items()}
+
+    def _floats(self, rows, lines, j, name):
+        try:
+            return np.array([row[j] for row in rows], dtype=np.float64)  # float() per cell, in C
+        except ValueError:
+            pass
+        out = np.empty(len(rows))
+        for i, row in enumerate(rows):  # find the cell to name
             try:
-                out[i] = float(cell)
+                out[i] = float(row[j])
             except ValueError:
                 raise InputDataError(
-                    f"{self.path}: line {i + 2}, column {name!r}: {cell!r} is not a number"
+                    f"{self.path}: line {lines[i]}, column {name!r}: {row[j].strip()!r} is not a number"
                 ) from None
         return out
 
+    def close(self):
+        self._file.close()
 
-def read_csv(path, required=("position",)):
-    try:
-        with open(path, newline="") as f:
-            reader = csv.reader(f)
-            header = next(reader, None)
-            rows = list(reader)
-    except FileNotFoundError:
-        raise InputDataError(f"{path}: no such file") from None
-    except (UnicodeDecodeError, csv.Error) as exc:
-        raise InputDataError(f"{path}: not a readable CSV file ({exc})") from None
-    if not header:
-        raise InputDataError(f"{path}: empty file; expected a header row with a 'position' column")
-    header = [h.strip() for h in header]
-    for name in required:
-        if name not in header:
-            raise InputDataError(f"{path}: column {name!r} missing; the header has {', '.join(header)}")
-    rows = [r for r in rows if r]  # a trailing blank line is not a sample
-    for i, row in enumerate(rows):
-        if len(row) != len(header):
-            raise InputDataError(f"{path}: line {i + 2} has {len(row)} cells, the header has {len(header)}")
-    if not rows:
-        raise InputDataError(f"{path}: no samples below the header")
-    return SampleTable(str(path), header, rows)
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
 
-def write_csv(f, header, rows, extra_name, extra_values):
-    """Write ``rows`` with one more column ``extra_name`` (values as shortest round-trip text)."""
-    writer = csv.writer(f, lineterminator="\n")
-    writer.writerow(list(header) + [extra_name])
-    for row, value in zip(rows, extra_values):
-        writer.writerow(list(row) + [repr(float(value))])
+def write_header(f, header, extra_name):
+    csv.writer(f, lineterminator="\n").writerow(list(header) + [extra_name])
+
+
+def write_rows(f, rows, extra_values):
+    """Write ``rows`` (lists of cells) each with one more cell, ``extra_values`` as shortest round-trip text."""
+    # csv writes a float as repr() does: the shortest text that reads back to the same number
+    csv.writer(f, lineterminator="\n").writerows(list(r) + [v] for r, v in zip(rows, extra_values.tolist()))

@@ -4,7 +4,10 @@ Each sub-command lives in its own module of this package with two functions:
 ``register(subparsers)`` adds its parser (argparse only, so start-up stays fast)
 and sets ``func``; the function imports what it needs and returns an exit code.
 A ``UserError`` becomes one line on stderr and exit code 2; so does a
-malformed command line (argparse's own usage dump is several lines).
+malformed command line (argparse's own usage dump is several lines), a
+number option that is not finite, a negative ``--seed`` (``number_options``),
+and a file that cannot be written (an ``OSError``: a full disk, a read-only
+folder), which names the file.
 """
 
 import argparse
@@ -12,6 +15,7 @@ import importlib
 import sys
 
 from studyapp import __version__
+from studyapp.cli import number_options
 from studyapp.errors import UserError
 
 # Module names under studyapp.cli, in the order shown by --help. A module that
@@ -61,6 +65,7 @@ def build_parser():
                 continue
             raise
         module.register(sub)
+    number_options.checked(parser)
     return parser
 
 
@@ -87,3 +92,8 @@ def main(argv=None):
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    except OSError as exc:
+        # the outputs are atomic (studyapp.atomic): a failed write leaves no partial file to mention
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"studyapp: error: {where}{exc.strerror or exc}: nothing written", file=sys.stderr)
+        return 2

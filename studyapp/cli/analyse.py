@@ -36,6 +36,7 @@ def run(args):
     from studyapp.analysis.report_folder import write_report_folder
     from studyapp.analysis.responses import load_responses
     from studyapp.analysis.study import analyse
+    from studyapp.cli import output_paths
     from studyapp.errors import ParameterError
 
     if not 0.0 < args.alpha < 1.0:
@@ -46,9 +47,11 @@ def run(args):
     def say(message):
         print(f"studyapp analyse: {message}", file=sys.stderr, flush=True)
 
-    say(f"reading {args.results}")
+    output_paths.check_folder(args.output)
+    # read before saying anything: bad input is then the one line on stderr
     responses, label = load_responses(args.results)
     evaluation = load_evaluation(args.evaluation) if args.evaluation else None
+    say(f"read {args.results}")
     expected = {"adjustment": args.trials} if args.trials else None
     study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected)
     say(f"{len(study.participants)} participants, {len(responses)} responses")

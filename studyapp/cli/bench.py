@@ -1,4 +1,4 @@
-"""``studyapp bench estimators|loop|live|midi``: speed, measured (medians), never asserted in tests."""
+"""``studyapp bench estimators|loop|live|midi|memory``: speed and memory, measured, never asserted in tests."""
 
 
 def register(sub):
@@ -30,6 +30,14 @@ def register(sub):
     p.add_argument("--runs", type=int, default=3, help="runs; the figures are their medians (default 3)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.midi_flood"))
+
+    p = kinds.add_parser("memory", help="peak memory of 'studyapp estimate' on a generated CSV and .npz")
+    p.add_argument("--rows", type=int, default=10_000_000, metavar="N", help="samples per input (default 10^7)")
+    p.add_argument("--block", type=int, default=1 << 16, metavar="N",
+                   help="estimate's --block (default 65536, its own default)")
+    p.add_argument("--dir", metavar="DIR", help="where the temporary inputs go (default: the system's temp folder)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.cli.memory_benchmark"))
 
 
 def _run(module):

@@ -37,21 +37,14 @@ def register(subparsers):
 
 def check_output(path):
     """Raise ``UserError`` unless ``path`` can be written (call before the search)."""
-    import os
     from pathlib import Path
 
+    from studyapp.cli import output_paths
     from studyapp.errors import UserError
 
-    path = Path(path)
-    if path.suffix.lower() not in SUFFIXES:
+    if Path(path).suffix.lower() not in SUFFIXES:
         raise UserError(f"-o {path}: allowed suffixes are {', '.join(SUFFIXES)}")
-    if path.is_dir():
-        raise UserError(f"-o {path}: is a directory; give a file name")
-    parent = path.parent
-    while not parent.exists():
-        parent = parent.parent
-    if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
-        raise UserError(f"-o {path}: cannot create a file in {parent}")
+    output_paths.check_file(path)
 
 
 def command_line(args):

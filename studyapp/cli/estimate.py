@@ -1,18 +1,32 @@
-"""``studyapp estimate INPUT --estimator NAME --rate HZ [--set key=value ...] [-o OUTPUT.csv]``.
+"""``studyapp estimate INPUT --estimator NAME [--rate HZ] [--set key=value ...] [--block N] [-o OUTPUT.csv]``.
 
 INPUT is a CSV with a ``position`` column and optionally ``acceleration`` and
-``velocity`` (SI units, one row per sample), or a recording (``.npz``/``.h5``/
-``.csv`` from ``studyapp simulate``, whose tachometer column is
-``velocity_lvt``). OUTPUT is the input plus a ``velocity_estimate`` column.
+``velocity`` (SI units, one row per sample; ``--rate`` is then required), or a
+recording (``.npz``/``.h5`` from ``studyapp simulate``, whose tachometer
+column is ``velocity_lvt``), which carries its own rate: ``--rate`` may be
+left out, and a different one is refused. OUTPUT is the input plus a
+``velocity_estimate`` column.
+
+The input is read, estimated and written ``--block`` samples at a time
+(``sample_table``, ``recording_blocks``): the estimators keep their state
+across blocks, so the output equals one pass over the whole input exactly,
+and memory stays that of one block. OUTPUT is written atomically (a failure
+leaves no partial file); to stdout, lines already written before a bad cell
+further down stay written.
 """
+
+DEFAULT_BLOCK = 1 << 16  # samples: about 5 MB of a 9-column recording as text
 
 
 def register(sub):
     parser = sub.add_parser("estimate", help="apply one estimator to a file of samples")
     parser.add_argument("input", metavar="INPUT", help="CSV with a position column, or a recording (.npz/.h5)")
     parser.add_argument("--estimator", required=True, metavar="NAME", help="estimator name (see 'studyapp estimators')")
-    parser.add_argument("--rate", required=True, type=str, metavar="HZ", help="sample rate in Hz")
+    parser.add_argument("--rate", type=str, metavar="HZ",
+                        help="sample rate in Hz (required for a CSV; a recording's own rate otherwise)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a parameter")
+    parser.add_argument("--block", type=int, default=DEFAULT_BLOCK, metavar="N",
+                        help=f"samples read and written at a time (default {DEFAULT_BLOCK})")
     parser.add_argument("-o", "--output", metavar="OUTPUT.csv", help="output file (default: stdout)")
     parser.set_defaults(func=run)
 
@@ -29,53 +43,97 @@ def parse_settings(items):
     return params
 
 
-def _columns(path, reads):
-    """Header, rows of cell text, and float columns for position/acceleration/velocity."""
-    from pathlib import Path
+def _recording_rate(path, recorded, given):
+    """The recording's rate; ``--rate``, if given, must agree with it."""
+    import math
 
-    from studyapp import sample_table
-    from studyapp.errors import InputDataError
+    from studyapp.errors import ParameterError
 
-    suffix = Path(path).suffix.lower()
-    if suffix in (".npz", ".h5", ".hdf5"):
-        from studyapp import recording
+    if given is None:
+        return recorded
+    try:
+        value = float(given)
+    except ValueError:
+        value = math.nan
+    if not math.isclose(value, recorded, rel_tol=1e-6):
+        raise ParameterError(f"--rate {given}: {path} was recorded at {recorded:g} Hz: allowed is to leave out "
+                             f"--rate or give {recorded:g}")
+    return recorded
 
-        rec = recording.load(path)
-        header = list(rec.columns)
-        n = len(rec.columns["position"])
-        rows = [[repr(float(rec.columns[h][i])) for h in header] for i in range(n)]
-        cols = {"position": rec.columns["position"], "acceleration": rec.columns.get("acceleration"),
-                "velocity": rec.columns.get("velocity", rec.columns.get("velocity_lvt"))}
-        return header, rows, cols
-    table = sample_table.read_csv(path)
-    velocity_name = "velocity" if "velocity" in table.header else "velocity_lvt"
-    names = {"position": "position", "acceleration": "acceleration", "velocity": velocity_name}
-    cols = {}
-    for key, name in names.items():
-        if name in table.header:
-            cols[key] = table.column(name)
-        elif key in reads:
-            raise InputDataError(f"{path}: column {name!r} missing; this estimator reads {', '.join(reads)}")
+
+class _Input:
+    """The input file as blocks of (header cells, float columns by estimator input)."""
+
+    def __init__(self, path, rate):
+        from pathlib import Path
+
+        from studyapp import recording_blocks, sample_table
+        from studyapp.errors import ParameterError
+
+        self.path = path
+        if Path(path).suffix.lower() in recording_blocks.SUFFIXES:
+            self.source = recording_blocks.RecordingBlocks(path)
+            self.rate = _recording_rate(path, self.source.rate, rate)
+            self.header = list(self.source.names)
+            self.is_table = False
         else:
-            cols[key] = None
-    return table.header, table.rows, cols
+            if rate is None:
+                raise ParameterError(f"--rate: required for {path} (a CSV carries no sample rate): allowed is "
+                                     "a number of Hz from 1000 to 96000")
+            self.source = sample_table.SampleTable(path)
+            self.rate = rate
+            self.header = self.source.header
+            self.is_table = True
+        velocity = "velocity" if "velocity" in self.header else "velocity_lvt"
+        self.columns = {"position": "position", "acceleration": "acceleration", "velocity": velocity}
+
+    def check(self, reads):
+        from studyapp.errors import InputDataError
+
+        for key in ("position", *reads):
+            name = self.columns[key]
+            if name not in self.header:
+                raise InputDataError(f"{self.path}: column {name!r} missing; this estimator reads {', '.join(reads)}")
+
+    def blocks(self, size):
+        """Yield (rows, {position, acceleration, velocity}: array or None) per block."""
+        present = [name for name in self.columns.values() if name in self.header]
+        if self.is_table:
+            for rows, cols in self.source.blocks(size, present):
+                yield rows, {k: cols.get(name) for k, name in self.columns.items()}
+            return
+        for cols in self.source.blocks(size):
+            rows = list(zip(*(cols[name].tolist() for name in self.header)))
+            yield rows, {k: cols.get(name) for k, name in self.columns.items()}
+
+    def close(self):
+        self.source.close()
 
 
 def run(args):
+    import contextlib
     import sys
 
     from studyapp import estimators
     from studyapp.atomic import atomic_open
-    from studyapp.sample_table import write_csv
+    from studyapp.cli import output_paths
+    from studyapp.errors import ParameterError
+    from studyapp.sample_table import write_header, write_rows
 
-    est = estimators.create(args.estimator, args.rate, **parse_settings(args.set))
-    header, rows, cols = _columns(args.input, est.spec.inputs)
-    estimate = est.process(cols["position"], cols["acceleration"], cols["velocity"])
+    if args.block < 1:
+        raise ParameterError(f"--block {args.block}: allowed is an integer of at least 1")
+    settings = parse_settings(args.set)
     if args.output:
-        with atomic_open(args.output, "w", newline="") as f:
-            write_csv(f, header, rows, "velocity_estimate", estimate)
-    else:
-        write_csv(sys.stdout, header, rows, "velocity_estimate", estimate)
+        output_paths.check_file(args.output, inputs=[args.input])
+    source = _Input(args.input, args.rate)
+    with contextlib.closing(source):
+        est = estimators.create(args.estimator, source.rate, **settings)
+        source.check(est.spec.inputs)
+        with (atomic_open(args.output, "w", newline="") if args.output else contextlib.nullcontext(sys.stdout)) as f:
+            write_header(f, source.header, "velocity_estimate")
+            for rows, cols in source.blocks(args.block):
+                estimate = est.process(cols["position"], cols["acceleration"], cols["velocity"])
+                write_rows(f, rows, estimate)
     if est.bad_samples:
         print(f"note: {est.bad_samples} bad input samples (NaN, inf or beyond the physical bounds) "
               "were replaced by the last good one", file=sys.stderr)

@@ -10,7 +10,7 @@ it in the loop against TRUE's, paper Sec. 10; cli/perceptual_options.py); with
 (``evaluation/paper_comparison.py``).
 """
 
-from studyapp.cli import delay_option, perceptual_options
+from studyapp.cli import delay_option, output_paths, perceptual_options
 
 
 def register(sub):
@@ -53,8 +53,8 @@ def run(args):
     if args.max_lag <= 0:
         raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
     output = Path(args.output) if args.output else None
-    if output is not None and output.exists() and not output.is_dir():
-        raise UserError(f"-o {output}: exists and is not a directory")
+    if output is not None:
+        output_paths.check_folder(output)
     if args.compare_paper and output is None:
         raise UserError("--compare-paper: needs -o DIR, the folder its two tables are written to")
     takes = load_takes(expand_paths(args.recordings), args.reference)

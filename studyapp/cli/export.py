@@ -18,8 +18,10 @@ def register(sub):
 def run(args):
     import sys
 
+    from studyapp.cli import output_paths
     from studyapp.experiment.export import write_responses
 
+    output_paths.check_file(args.output)
     frame = write_responses(args.results, args.output)
     sessions = frame.groupby(["study", "participant", "session"]).ngroups
     print(f"studyapp export: {len(frame)} responses from {sessions} sessions -> {args.output}", file=sys.stderr)

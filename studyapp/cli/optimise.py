@@ -11,7 +11,7 @@ the closed loop on the perceptual cases (cli/perceptual_options.py), so no
 recordings are read; the default patience is then ``PERCEPTUAL_PATIENCE``.
 """
 
-from studyapp.cli import delay_option, perceptual_options
+from studyapp.cli import delay_option, output_paths, perceptual_options
 
 PAPER_PATIENCE = 1000  # the paper's stopping rule
 # Each set costs a closed-loop simulation per case (eight by default): at a tenth of the paper's rule a run
@@ -78,6 +78,7 @@ def run(args):
     output = Path(args.output)
     if output.suffix.lower() != ".toml":
         raise UserError(f"-o {output}: expected a .toml file")
+    output_paths.check_file(output)
     if args.max_lag <= 0:
         raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
     if args.patience < 1:

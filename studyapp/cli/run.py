@@ -29,6 +29,7 @@ def register(sub):
 def run(args):
     import sys
 
+    from studyapp.cli import output_paths
     from studyapp.errors import UserError
     from studyapp.experiment.protocol import load_protocol
     from studyapp.experiment.session import check_participant
@@ -39,6 +40,7 @@ def run(args):
     if args.headless and not args.simulated_participant:
         raise UserError("--headless: allowed only with --simulated-participant (a person takes part through the GUI)")
     protocol = load_protocol(args.protocol)
+    output_paths.check_folder(args.results, "--results")
     if not args.headless:
         return _run_in_gui(args)
 

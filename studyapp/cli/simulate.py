@@ -43,6 +43,7 @@ def run(args):
     import sys
 
     from studyapp import recording
+    from studyapp.cli import output_paths
     from studyapp.estimators.spec import validate_rate
     from studyapp.model import simulate
     from studyapp.model.loop import check_fmax
@@ -51,6 +52,7 @@ def run(args):
     if args.source is None:
         args.source = LVT_SENSOR
     recording.check_path(args.output)
+    output_paths.check_file(args.output)
     validate_rate(args.rate)
     check_fmax(args.fmax)
     check_source(args.source)

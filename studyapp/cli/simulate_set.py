@@ -18,7 +18,18 @@ def register(subparsers):
 def run(args):
     import sys
 
+    from studyapp.cli import output_paths
+    from studyapp.errors import ParameterError
+    from studyapp.estimators.spec import validate_rate
     from studyapp.model.data_set import write_set
+    from studyapp.model.simulate import DURATION_MAX
+
+    # checked before write_set makes the folder, so a bad value leaves nothing behind
+    validate_rate(args.rate)
+    if not 0 < args.duration <= DURATION_MAX:
+        raise ParameterError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
+                             f"{DURATION_MAX:g}")
+    output_paths.check_folder(args.output)
 
     def progress(i, total, name):
         print(f"\rsimulate-set: {i}/{total} {name}   ", end="", file=sys.stderr, flush=True)

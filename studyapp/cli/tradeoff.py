@@ -53,8 +53,10 @@ def run(args):
     import time
     from pathlib import Path
 
+    from studyapp.cli import output_paths
     from studyapp.errors import UserError
     from studyapp.estimators.spec import RATE_MAX, validate_rate
+    from studyapp.model.simulate import DURATION_MAX
     from studyapp.evaluation.dataset import file_sha256, warm_up
     from studyapp.evaluation.executors import make_executor
     from studyapp.evaluation.parameter_sets import parameter_sets
@@ -64,8 +66,10 @@ def run(args):
 
     started = time.monotonic()
     output = Path(args.output)
-    if output.exists() and not output.is_dir():
-        raise UserError(f"-o {output}: exists and is not a directory")
+    output_paths.check_folder(output)
+    if not 0 < args.duration <= DURATION_MAX:
+        raise UserError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
+                        f"{DURATION_MAX:g}")
     rates = [validate_rate(r) for r in (args.rates or DEFAULT_RATES)]
     fmax = list(args.fmax or DEFAULT_FMAX)
     for f in fmax:

@@ -21,17 +21,18 @@ The file is flat TOML, one table per estimator plus two tables of metadata:
 
 Every other table must be named after an estimator, and its keys are that
 estimator's parameters (``studyapp estimators`` lists them). ``read`` uses the
-standard library's ``tomllib``; ``write`` writes the flat structure by hand
+standard library's ``tomllib`` (through ``studyapp.small_files``: a regular
+file of at most 1 MB); ``write`` writes the flat structure by hand
 (strings, numbers, booleans and flat lists of them), atomically.
 """
 
 import json
 import math
-import tomllib
 from pathlib import Path
 
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
+from studyapp.small_files import read_toml
 
 META_TABLES = ("provenance", "objective")
 
@@ -41,18 +42,12 @@ def read(path):
     from studyapp.estimators.registry import SPECS
 
     path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such parameter file") from None
-    except IsADirectoryError:
-        raise UserError(f"{path}: is a directory, expected a PARAMS.toml file") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise UserError(f"{path}: invalid TOML ({exc})") from None
+    _, data = read_toml(path, "parameter (PARAMS.toml)")
     params = {}
     for key, value in data.items():
         if key in META_TABLES:
+            if not isinstance(value, dict):
+                raise UserError(f"{path}: {key} = {value!r}: allowed is a table [{key}]")
             continue
         if key not in SPECS:
             raise UserError(f"{path}: table [{key}] is not an estimator: allowed are {', '.join(SPECS)}, "
@@ -63,6 +58,9 @@ def read(path):
             if isinstance(v, (dict, list)):
                 raise UserError(f"{path}: [{key}] {name} must be a number or a string")
         params[key] = dict(value)
+    if not params:
+        raise UserError(f"{path}: no estimator table: allowed is a file of [NAME] tables, as studyapp optimise "
+                        "writes")
     return params, dict(data.get("provenance", {}))
 
 

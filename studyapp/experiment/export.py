@@ -31,6 +31,7 @@ from pathlib import Path
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.experiment import response_event
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_log import read_events
 from studyapp.experiment.tasks import task_type
@@ -54,8 +55,12 @@ def _session_rows(folder):
         raise InputDataError(f"{path}: not a readable session file ({exc})") from None
     rows = []
     for event in read_events(folder / EVENTS_FILE):
-        if event.get("type") != "response":
+        if isinstance(event, dict) and event.get("type") != "response":
             continue
+        wrong = response_event.problem(event)
+        if wrong is not None:
+            seq = event.get("seq") if isinstance(event, dict) else "?"
+            raise InputDataError(f"{folder / EVENTS_FILE}: response event seq {seq}: {wrong}")
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
                 "time": event["wall"], "step": event["step"], "duration": event.get("duration")}
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]

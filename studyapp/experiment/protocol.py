@@ -19,11 +19,11 @@ same study exactly when their hashes agree.
 
 import hashlib
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from studyapp.errors import UserError
+from studyapp.small_files import parse_toml, read_bytes
 
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
 NAME_ALLOWED = "1 to 32 letters, digits, '_' or '-'"
@@ -121,7 +121,8 @@ class _Fields:
     def conditions(self, key, known, at_least, at_most):
         allowed = (f"a list of {at_least} to {at_most} different estimator names from: {', '.join(known)}")
         value = self.get(key, allowed)
-        if not isinstance(value, list) or not at_least <= len(value) <= at_most:
+        if (not isinstance(value, list) or not at_least <= len(value) <= at_most
+                or not all(isinstance(name, str) for name in value)):
             self.fail(key, f"= {value!r}", allowed)
         for name in value:
             if name not in known:
@@ -156,10 +157,7 @@ def parse_protocol(text, source="<protocol>"):
     from studyapp.experiment.tasks import task_names, task_type
     from studyapp.model.loop import GESTURES
 
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{source}: not valid TOML ({exc})") from None
+    document = parse_toml(text, source)
     known_tables = ("study", "apparatus", "estimators", *task_names())
     for name in document:
         if name not in known_tables:
@@ -170,8 +168,8 @@ def parse_protocol(text, source="<protocol>"):
     title = study.string("title", default=name)
     tasks_allowed = "a list of the tasks to run, in order, from: " + ", ".join(repr(t) for t in task_names())
     tasks = study.get("tasks", tasks_allowed)
-    if (not isinstance(tasks, list) or not tasks or len(set(tasks)) != len(tasks)
-            or any(t not in task_names() for t in tasks)):
+    if (not isinstance(tasks, list) or not tasks or not all(isinstance(t, str) for t in tasks)
+            or len(set(tasks)) != len(tasks) or any(t not in task_names() for t in tasks)):
         study.fail("tasks", f"= {tasks!r}", tasks_allowed)
     seed = study.integer("seed", 0, 2**32 - 1)
     study.finish()
@@ -231,10 +229,7 @@ def parse_protocol(text, source="<protocol>"):
 def load_protocol(path):
     """Read and validate the protocol file at ``path``; its hash is the SHA-256 of its bytes."""
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise UserError(f"{path}: cannot read the protocol ({exc.strerror or exc})") from None
+    data = read_bytes(path, "protocol")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:

@@ -17,7 +17,8 @@ registered by name in ``studyapp.experiment.tasks``:
 - **captions**: ``heading``, ``knob_captions``, ``response_text`` are the text
   the console and the participant window show (never a condition name under
   blinding unless the task shows it on purpose);
-- **export**: ``export_rows`` turns a logged response into rows of the
+- **export**: ``response_problem`` checks a logged response's own fields
+  (``studyapp.experiment.response_event`` checks the common ones), ``export_rows`` turns a logged response into rows of the
   responses table (``studyapp.experiment.export``);
 - **analysis**: ``measure`` says which column of those rows is the task's
   outcome, its valid range and which way is better (None: not analysed);
@@ -114,6 +115,9 @@ class TaskType(Protocol):
 
     def summary(self, response: dict) -> str:
         """One line for the experimenter's progress."""
+
+    def response_problem(self, event: dict) -> str | None:
+        """None if a logged response has the task's own fields, else ``field = value: allowed ...``."""
 
     def export_rows(self, event: dict) -> list:
         """Rows (dicts of ``export.COLUMNS`` beyond the common ones) for a logged response."""

@@ -163,7 +163,7 @@ def test_unknown_table_and_bad_toml(tmp_path):
     assert "[extras] is not a known table" in error(write(tmp_path, doc))
     bad = tmp_path / "bad.toml"
     bad.write_text("[study\nname = 1\n")
-    with pytest.raises(UserError, match="bad.toml: not valid TOML"):
+    with pytest.raises(UserError, match="bad.toml: invalid TOML"):
         load_protocol(bad)
     with pytest.raises(UserError, match="missing.toml: cannot read"):
         load_protocol(tmp_path / "missing.toml")

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from studyapp.experiment.event_fields import integer, text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
@@ -151,6 +152,13 @@ class Adjustment:
 
     def summary(self, response):
         return f"F_max = {response['fmax']:.3g} N"
+
+    def response_problem(self, event):
+        if not text(event.get("condition")):
+            return f"condition = {event.get('condition')!r}: allowed is an estimator name"
+        if not integer(event.get("value"), 0):
+            return f"value = {event.get('value')!r}: allowed is a knob position, an integer >= 0"
+        return None
 
     def export_rows(self, event):
         return [{"condition": event["condition"], "value": event["value"], "peak_fmax": event.get("peak_fmax")}]

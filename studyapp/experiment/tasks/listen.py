@@ -15,6 +15,7 @@ The simulated participant bows through the whole trial.
 
 from dataclasses import dataclass
 
+from studyapp.experiment.event_fields import text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.tasks.confirm_pad import check_knob_value
 from studyapp.model.loop import FMAX_LIMIT
@@ -117,6 +118,11 @@ class Listen:
 
     def summary(self, response):
         return f"listened {response['duration']:.3g} s"
+
+    def response_problem(self, event):
+        if not text(event.get("condition")):
+            return f"condition = {event.get('condition')!r}: allowed is an estimator name"
+        return None
 
     def export_rows(self, event):
         return [{"condition": event["condition"]}]

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from studyapp.experiment.event_fields import integer, number, text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
@@ -162,6 +163,17 @@ class Rating:
 
     def summary(self, response):
         return ", ".join(f"{r['condition']} {r['rating']:.2f}" for r in response["responses"])
+
+    def response_problem(self, event):
+        responses = event.get("responses")
+        allowed = "a list of {condition, knob, value, rating} objects"
+        if not isinstance(responses, list) or not responses or not all(isinstance(r, dict) for r in responses):
+            return f"responses = {responses!r}: allowed is {allowed}"
+        for r in responses:
+            if not (text(r.get("condition")) and integer(r.get("knob"), 0) and integer(r.get("value"), 0)
+                    and number(r.get("rating"))):
+                return f"responses item {r!r}: allowed is {allowed}"
+        return None
 
     def export_rows(self, event):
         return [{"condition": r["condition"], "rating": r["rating"], "value": r["value"], "knob": r["knob"]}

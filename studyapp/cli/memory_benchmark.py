@@ -1,0 +1,108 @@
+"""``studyapp bench memory [--rows N] [--block N] [--json]``: peak memory of ``studyapp estimate`` (issue 14, item 8).
+
+Writes a CSV of ``--rows`` samples (position, acceleration, velocity) and a
+recording ``.npz`` of as many samples (the nine columns of ``studyapp
+simulate``) into a temporary folder, runs ``studyapp estimate --estimator
+KALLEV`` on each in a child process, and reports the child's peak resident
+memory (``ru_maxrss`` from ``os.wait4``, the kernel's own accounting) beside
+the input file's size. The target: at most twice the input and at most 500 MB
+for a CSV of 10^7 rows. Measured, never asserted in a test.
+"""
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from studyapp.errors import ParameterError
+
+COLUMNS = ("t", "position", "velocity_lvt", "acceleration", "velocity_true", "acceleration_true", "force",
+           "string_velocity", "audio")
+WRITE_BLOCK = 1 << 18
+
+
+def _signal(start, n, rate):
+    """A smooth stroke with a 110 Hz ripple: values of every column (not physics, just realistic digits)."""
+    t = (start + np.arange(n)) / rate
+    x = 0.01 * np.sin(2 * np.pi * 0.5 * t) + 1e-5 * np.sin(2 * np.pi * 110 * t)
+    v = np.gradient(x, 1 / rate) if n > 1 else np.zeros(n)
+    return {"t": t, "position": x, "velocity_lvt": v, "acceleration": -x * 40.0, "velocity_true": v,
+            "acceleration_true": -x * 40.0, "force": 0.5 * np.tanh(v), "string_velocity": v, "audio": np.sin(t)}
+
+
+def write_csv(path, rows, rate):
+    with open(path, "w") as f:
+        f.write("position,acceleration,velocity\n")
+        for start in range(0, rows, WRITE_BLOCK):
+            s = _signal(start, min(WRITE_BLOCK, rows - start), rate)
+            np.savetxt(f, np.column_stack([s["position"], s["acceleration"], s["velocity_lvt"]]), fmt="%.17g",
+                       delimiter=",")
+
+
+def write_npz(path, rows, rate):
+    """An uncompressed .npz like ``recording.save`` writes, built a block at a time (np.savez would need it all)."""
+    import zipfile
+
+    from numpy.lib import format as npy
+
+    meta = json.dumps({"rate": rate, "format": 1, "source": "bench memory"})
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
+        with z.open("__meta__.npy", "w") as f:
+            npy.write_array(f, np.array(meta))
+        for name in COLUMNS:
+            with z.open(f"{name}.npy", "w", force_zip64=True) as f:
+                npy.write_array_header_1_0(f, {"descr": "<f8", "fortran_order": False, "shape": (rows,)})
+                for start in range(0, rows, WRITE_BLOCK):
+                    f.write(_signal(start, min(WRITE_BLOCK, rows - start), rate)[name].astype("<f8").tobytes())
+
+
+def measure(input_path, output_path, block, rate):
+    argv = [sys.executable, "-m", "studyapp", "estimate", str(input_path), "--estimator", "KALLEV",
+            "--block", str(block), "-o", str(output_path)]
+    if Path(input_path).suffix == ".csv":
+        argv += ["--rate", f"{rate:g}"]
+    started = time.monotonic()
+    proc = subprocess.Popen(argv, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    seconds = time.monotonic() - started
+    err = proc.stderr.read().decode(errors="replace").strip()
+    proc.stderr.close()
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        raise RuntimeError(f"estimate failed ({proc.returncode}): {err}")
+    size = Path(input_path).stat().st_size
+    peak = usage.ru_maxrss * 1024  # kilobytes on Linux
+    return {"input": Path(input_path).suffix[1:], "input_bytes": size, "peak_rss_bytes": peak,
+            "peak_over_input": round(peak / size, 3), "seconds": round(seconds, 2)}
+
+
+def run_cli(args):
+    if args.rows < 1:
+        raise ParameterError(f"--rows {args.rows}: allowed is an integer of at least 1")
+    if args.block < 1:
+        raise ParameterError(f"--block {args.block}: allowed is an integer of at least 1")
+    rate = 5000.0
+    results = []
+    with tempfile.TemporaryDirectory(prefix="studyapp-bench-memory-", dir=args.dir) as folder:
+        for suffix, write in ((".csv", write_csv), (".npz", write_npz)):
+            path = Path(folder) / f"input{suffix}"
+            if not args.json:
+                print(f"bench memory: writing {args.rows} rows to {path.name}", file=sys.stderr, flush=True)
+            write(path, args.rows, rate)
+            results.append(measure(path, Path(folder) / "output.csv", args.block, rate))
+            path.unlink()
+            (Path(folder) / "output.csv").unlink()
+    if args.json:
+        print(json.dumps({"rows": args.rows, "block": args.block, "results": results}))
+        return 0
+    print(f"studyapp estimate --estimator KALLEV, {args.rows} rows, --block {args.block}")
+    print(f"{'input':<6}{'input MB':>10}{'peak RSS MB':>13}{'peak/input':>12}{'seconds':>9}")
+    for r in results:
+        print(f"{r['input']:<6}{r['input_bytes'] / 1e6:>10.1f}{r['peak_rss_bytes'] / 1e6:>13.1f}"
+              f"{r['peak_over_input']:>12.2f}{r['seconds']:>9.1f}")
+    return 0

@@ -1,0 +1,45 @@
+"""Numbers on the command line: finite floats and non-negative seeds, for every command at once.
+
+argparse's ``float`` takes ``nan`` and ``inf``, and ``int`` takes ``-1``; no
+option of ours means anything by them (an open-ended option is left out
+instead), so ``checked`` replaces those types on every sub-command's options.
+The error then goes through argparse, naming the option:
+``argument --max-lag: 'nan' is not a finite number``.
+"""
+
+import argparse
+import math
+
+SEED_MAX = 2**63 - 1  # numpy's generators take any non-negative integer; run stores seeds as int64
+
+
+def finite_float(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid float value: {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+def seed(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+    if not 0 <= value <= SEED_MAX:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed is an integer from 0 to 2**63 - 1")
+    return value
+
+
+def checked(parser):
+    """Give every ``type=float`` option ``finite_float`` and every integer ``--seed`` ``seed``, recursively."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                checked(sub)
+        elif action.type is float:
+            action.type = finite_float
+        elif action.type is int and action.dest == "seed":
+            action.type = seed

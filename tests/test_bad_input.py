@@ -1,0 +1,321 @@
+"""Every command against a table of bad inputs: one line on stderr, exit 2, nothing written (issue 14, item 7).
+
+Each case runs ``studyapp ARGV`` in this process (``studyapp.cli.main``, so a
+traceback fails the test with its exception) in a fresh output folder, next to
+a folder of prepared inputs. Both folders must be as they were afterwards: no
+output file, no folder, no temporary file. A few cases (``/dev/zero``, the
+real entry point) run as a child process under a memory and time limit.
+
+Not covered: ``gui`` (needs a display; its options are those of ``run``) and
+``estimators`` (takes no input but ``--json``). ``live`` runs with
+``--audio null --midi none``, so it needs no hardware; each of its cases is
+refused before the engine starts.
+"""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from studyapp.cli import main
+
+REPO = Path(__file__).resolve().parents[1]
+UNWRITABLE = "/sys/studyapp-bad-input"  # not writable even by root
+RATE = 5000.0
+
+
+def _recording(path, drop=()):
+    from studyapp.recording import Recording, save
+    from studyapp.synthetic import stick_slip
+
+    sig = stick_slip(RATE, 0.1, seed=1)
+    save(Recording(RATE, {k: v for k, v in sig.items() if k not in drop}, {"fmax": 1.0}), path)
+
+
+def _results(folder, event=None, raw_line=None):
+    """A results folder with one session holding one good adjustment response and ``event`` or ``raw_line``."""
+    from studyapp.experiment.protocol import load_protocol
+    from studyapp.experiment.session import Session
+
+    session = Session.create(load_protocol(REPO / "protocols" / "demo.toml"), "p1", folder)
+    good = {"type": "response", "step": 3, "task": "adjustment", "condition": "LVT", "trial": 1, "fmax": 2.5,
+            "value": 60, "peak_fmax": 3.0, "duration": 4.0}
+    session.log.append(good)
+    if event is not None:
+        session.log.append({**good, "step": 4, **event})
+    session.close()
+    if raw_line is not None:
+        with open(session.folder / "events.jsonl", "ab") as f:
+            f.write(raw_line)
+    return folder
+
+
+MALFORMED_EVENTS = {
+    "no_fmax": {"fmax": None},
+    "fmax_text": {"fmax": "lots"},
+    "trial_text": {"trial": "first"},
+    "unknown_task": {"task": "dance"},
+    "rating_responses_5": {"task": "rating", "responses": 5},
+    "rating_response_no_condition": {"task": "rating", "responses": [{"value": 3, "knob": 0}]},
+    "no_condition": {"condition": None},
+    "step_text": {"step": "x"},
+}
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("inputs")
+    rng = np.random.default_rng(14)
+    (d / "good.csv").write_text("position,acceleration,velocity\n" + "".join(
+        f"{0.001 * i!r},0.0,0.0\n" for i in range(50)))
+    (d / "wrong.csv").write_text("speed,force\n1,2\n3,4\n")
+    (d / "responses_wrong.csv").write_text("a,b\n1,2\n")
+    _recording(d / "rec.npz")
+    _recording(d / "nopos.npz", drop=("position",))
+    for name in ("empty.csv", "empty.npz", "empty.toml"):
+        (d / name).write_bytes(b"")
+    for name in ("binary.csv", "binary.npz", "binary.toml"):
+        (d / name).write_bytes(rng.integers(0, 256, 4096, dtype=np.uint8).tobytes())
+    (d / "nested.toml").write_text("x = " + "[" * 5000 + "]" * 5000 + "\n")
+    (d / "nested_table.toml").write_text("x = " + "{a = " * 5000 + "1" + "}" * 5000 + "\n")
+    with open(d / "huge.toml", "w") as f:  # 2 MB of valid TOML
+        f.write("[provenance]\n")
+        f.writelines(f"k{i} = {i}\n" for i in range(180_000))
+    (d / "prov5.toml").write_text("provenance = 5\n")
+    (d / "objective_list.toml").write_text("objective = [1, 2]\n")
+    (d / "adir").mkdir()
+    (d / "adir.npz").mkdir()
+    (d / "adir.csv").mkdir()
+    (d / "adir.toml").mkdir()
+    _results(d / "results_good")
+    for name, event in MALFORMED_EVENTS.items():
+        _results(d / f"results_{name}", event=event)
+    _results(d / f"results_not_object", raw_line=b"[1, 2]\n")
+    os.chmod(d, 0o555)  # a command that writes into the inputs folder fails loudly (unless root)
+    yield d
+    os.chmod(d, 0o755)
+
+
+ESTIMATE = ["--estimator", "LOWPASS", "--rate", "5000", "-o", "{out}/e.csv"]
+SIMULATE = ["simulate", "--duration", "0.05"]
+SET = ["simulate-set", "--duration", "0.05"]
+BREAKDOWN = ["breakdown", "--source", "LVT", "--seeds", "1", "--duration", "0.5"]
+OPTIMISE = ["optimise", "--max-sets", "1", "--workers", "1", "--estimators", "LOWPASS", "--quiet"]
+TRADEOFF = ["tradeoff", "--rates", "5000", "--fmax", "1", "--duration", "0.2", "--estimators", "LOWPASS"]
+RUN = ["run", "--participant", "p1", "--simulated-participant", "--headless"]
+PROTOCOL = str(REPO / "protocols" / "demo.toml")
+LIVE = ["live", "--audio", "null", "--midi", "none", "--seconds", "0.2"]
+
+CASES = {
+    # estimate: inputs
+    "estimate-missing": ["estimate", "{in}/none.csv", *ESTIMATE],
+    "estimate-dir": ["estimate", "{in}/adir", *ESTIMATE],
+    "estimate-dir-csv": ["estimate", "{in}/adir.csv", *ESTIMATE],
+    "estimate-dir-npz": ["estimate", "{in}/adir.npz", *ESTIMATE],
+    "estimate-empty-csv": ["estimate", "{in}/empty.csv", *ESTIMATE],
+    "estimate-empty-npz": ["estimate", "{in}/empty.npz", *ESTIMATE],
+    "estimate-binary-csv": ["estimate", "{in}/binary.csv", *ESTIMATE],
+    "estimate-binary-npz": ["estimate", "{in}/binary.npz", *ESTIMATE],
+    "estimate-wrong-columns": ["estimate", "{in}/wrong.csv", *ESTIMATE],
+    "estimate-no-position": ["estimate", "{in}/nopos.npz", "--estimator", "LOWPASS", "-o", "{out}/e.csv"],
+    "estimate-rate-differs": ["estimate", "{in}/rec.npz", *ESTIMATE[:2], "--rate", "10000", "-o", "{out}/e.csv"],
+    "estimate-csv-without-rate": ["estimate", "{in}/good.csv", "--estimator", "LOWPASS", "-o", "{out}/e.csv"],
+    # estimate: numbers and outputs
+    "estimate-rate-nan": ["estimate", "{in}/good.csv", *ESTIMATE[:2], "--rate", "nan", "-o", "{out}/e.csv"],
+    "estimate-rate-negative": ["estimate", "{in}/good.csv", *ESTIMATE[:2], "--rate", "-1", "-o", "{out}/e.csv"],
+    "estimate-set-nan": ["estimate", "{in}/good.csv", *ESTIMATE, "--set", "cutoff_hz=nan"],
+    "estimate-block-zero": ["estimate", "{in}/good.csv", *ESTIMATE, "--block", "0"],
+    "estimate-out-dir": ["estimate", "{in}/good.csv", *ESTIMATE[:4], "-o", "{in}/adir"],
+    "estimate-out-dir-csv": ["estimate", "{in}/good.csv", *ESTIMATE[:4], "-o", "{in}/adir.csv"],
+    "estimate-out-unwritable": ["estimate", "{in}/good.csv", *ESTIMATE[:4], "-o", UNWRITABLE + "/e.csv"],
+    "estimate-out-under-file": ["estimate", "{in}/good.csv", *ESTIMATE[:4], "-o", "{in}/good.csv/e.csv"],
+    "estimate-out-is-input": ["estimate", "{in}/good.csv", *ESTIMATE[:4], "-o", "{in}/good.csv"],
+    # simulate
+    "simulate-seed-negative": [*SIMULATE, "--seed", "-1", "-o", "{out}/s.npz"],
+    "simulate-duration-nan": [*SIMULATE, "--duration", "nan", "-o", "{out}/s.npz"],
+    "simulate-duration-negative": [*SIMULATE, "--duration", "-1", "-o", "{out}/s.npz"],
+    "simulate-duration-inf": [*SIMULATE, "--duration", "inf", "-o", "{out}/s.npz"],
+    "simulate-fmax-nan": [*SIMULATE, "--fmax", "nan", "-o", "{out}/s.npz"],
+    "simulate-rate-nan": [*SIMULATE, "--rate", "nan", "-o", "{out}/s.npz"],
+    "simulate-f0-nan": [*SIMULATE, "--f0", "nan", "-o", "{out}/s.npz"],
+    "simulate-f0-negative": [*SIMULATE, "--f0", "-5", "-o", "{out}/s.npz"],
+    "simulate-out-dir": [*SIMULATE, "-o", "{in}/adir.npz"],
+    "simulate-out-unwritable": [*SIMULATE, "-o", UNWRITABLE + "/s.npz"],
+    "simulate-out-under-file": [*SIMULATE, "-o", "{in}/good.csv/s.npz"],
+    # simulate-set
+    "simulate-set-out-file": [*SET, "-o", "{in}/good.csv"],
+    "simulate-set-out-unwritable": [*SET, "-o", UNWRITABLE],
+    "simulate-set-out-under-file": [*SET, "-o", "{in}/good.csv/set"],
+    "simulate-set-rate-nan": [*SET, "--rate", "nan", "-o", "{out}/set"],
+    "simulate-set-duration-negative": [*SET, "--duration", "-1", "-o", "{out}/set"],
+    "simulate-set-duration-nan": [*SET, "--duration", "nan", "-o", "{out}/set"],
+    # breakdown
+    "breakdown-seeds-negative": [*BREAKDOWN, "--seeds", "-1"],
+    "breakdown-rate-nan": [*BREAKDOWN, "--rate", "nan"],
+    "breakdown-duration-nan": [*BREAKDOWN, "--duration", "nan"],
+    "breakdown-out-dir": [*BREAKDOWN, "-o", "{in}/adir.csv"],
+    "breakdown-out-unwritable": [*BREAKDOWN, "-o", UNWRITABLE + "/b.csv"],
+    "breakdown-out-under-file": [*BREAKDOWN, "-o", "{in}/good.csv/b.csv"],
+    # evaluate
+    "evaluate-missing": ["evaluate", "{in}/none.npz"],
+    "evaluate-empty-dir": ["evaluate", "{in}/adir"],
+    "evaluate-empty": ["evaluate", "{in}/empty.npz"],
+    "evaluate-binary": ["evaluate", "{in}/binary.npz"],
+    "evaluate-binary-csv": ["evaluate", "{in}/binary.csv"],
+    "evaluate-no-position": ["evaluate", "{in}/nopos.npz"],
+    "evaluate-wrong-columns": ["evaluate", "{in}/wrong.csv"],
+    "evaluate-max-lag-nan": ["evaluate", "{in}/rec.npz", "--max-lag", "nan"],
+    "evaluate-max-lag-negative": ["evaluate", "{in}/rec.npz", "--max-lag", "-1"],
+    "evaluate-params-provenance-5": ["evaluate", "{in}/rec.npz", "--params", "{in}/prov5.toml"],
+    "evaluate-params-objective-list": ["evaluate", "{in}/rec.npz", "--params", "{in}/objective_list.toml"],
+    "evaluate-params-nested": ["evaluate", "{in}/rec.npz", "--params", "{in}/nested.toml"],
+    "evaluate-params-nested-table": ["evaluate", "{in}/rec.npz", "--params", "{in}/nested_table.toml"],
+    "evaluate-params-huge": ["evaluate", "{in}/rec.npz", "--params", "{in}/huge.toml"],
+    "evaluate-params-empty": ["evaluate", "{in}/rec.npz", "--params", "{in}/empty.toml"],
+    "evaluate-params-binary": ["evaluate", "{in}/rec.npz", "--params", "{in}/binary.toml"],
+    "evaluate-params-dir": ["evaluate", "{in}/rec.npz", "--params", "{in}/adir.toml"],
+    "evaluate-out-file": ["evaluate", "{in}/rec.npz", "-o", "{in}/good.csv"],
+    "evaluate-out-unwritable": ["evaluate", "{in}/rec.npz", "-o", UNWRITABLE],
+    "evaluate-out-under-file": ["evaluate", "{in}/rec.npz", "-o", "{in}/good.csv/ev"],
+    # optimise
+    "optimise-seed-negative": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--seed", "-1"],
+    "optimise-max-lag-nan": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--max-lag", "nan"],
+    "optimise-binary": [*OPTIMISE, "{in}/binary.npz", "-o", "{out}/p.toml"],
+    "optimise-no-position": [*OPTIMISE, "{in}/nopos.npz", "-o", "{out}/p.toml"],
+    "optimise-out-dir": [*OPTIMISE, "{in}/rec.npz", "-o", "{in}/adir.toml"],
+    "optimise-out-unwritable": [*OPTIMISE, "{in}/rec.npz", "-o", UNWRITABLE + "/p.toml"],
+    "optimise-out-under-file": [*OPTIMISE, "{in}/rec.npz", "-o", "{in}/good.csv/p.toml"],
+    "optimise-range-nan": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--range", "LOWPASS.cutoff_hz=nan:300"],
+    # demo
+    "demo-seed-negative": ["demo", "--seconds", "0.2", "--seed", "-1"],
+    "demo-rate-nan": ["demo", "--seconds", "0.2", "--rate", "nan"],
+    "demo-seconds-nan": ["demo", "--seconds", "nan"],
+    # tradeoff
+    "tradeoff-rates-nan": [*TRADEOFF, "-o", "{out}/t", "--rates", "nan"],
+    "tradeoff-fmax-nan": [*TRADEOFF, "-o", "{out}/t", "--fmax", "nan"],
+    "tradeoff-duration-nan": [*TRADEOFF, "-o", "{out}/t", "--duration", "nan"],
+    "tradeoff-duration-negative": [*TRADEOFF, "-o", "{out}/t", "--duration", "-1"],
+    "tradeoff-seed-negative": [*TRADEOFF, "-o", "{out}/t", "--seed", "-1"],
+    "tradeoff-params-provenance-5": [*TRADEOFF, "-o", "{out}/t", "--params", "{in}/prov5.toml"],
+    "tradeoff-params-nested": [*TRADEOFF, "-o", "{out}/t", "--params", "{in}/nested.toml"],
+    "tradeoff-out-file": [*TRADEOFF, "-o", "{in}/good.csv"],
+    "tradeoff-out-unwritable": [*TRADEOFF, "-o", UNWRITABLE],
+    "tradeoff-out-under-file": [*TRADEOFF, "-o", "{in}/good.csv/t"],
+    # run
+    "run-protocol-missing": [*RUN, "--results", "{out}/r", "--protocol", "{in}/none.toml"],
+    "run-protocol-dir": [*RUN, "--results", "{out}/r", "--protocol", "{in}/adir.toml"],
+    "run-protocol-empty": [*RUN, "--results", "{out}/r", "--protocol", "{in}/empty.toml"],
+    "run-protocol-binary": [*RUN, "--results", "{out}/r", "--protocol", "{in}/binary.toml"],
+    "run-protocol-nested": [*RUN, "--results", "{out}/r", "--protocol", "{in}/nested.toml"],
+    "run-protocol-nested-table": [*RUN, "--results", "{out}/r", "--protocol", "{in}/nested_table.toml"],
+    "run-protocol-huge": [*RUN, "--results", "{out}/r", "--protocol", "{in}/huge.toml"],
+    "run-seed-negative": [*RUN, "--results", "{out}/r", "--protocol", PROTOCOL, "--seed", "-1"],
+    "run-results-file": [*RUN, "--results", "{in}/good.csv", "--protocol", PROTOCOL],
+    "run-results-unwritable": [*RUN, "--results", UNWRITABLE, "--protocol", PROTOCOL],
+    "run-results-under-file": [*RUN, "--results", "{in}/good.csv/r", "--protocol", PROTOCOL],
+    # export
+    "export-missing": ["export", "{in}/none", "-o", "{out}/x.csv"],
+    "export-file": ["export", "{in}/good.csv", "-o", "{out}/x.csv"],
+    "export-out-dir": ["export", "{in}/results_good", "-o", "{in}/adir.csv"],
+    "export-out-unwritable": ["export", "{in}/results_good", "-o", UNWRITABLE + "/x.csv"],
+    "export-out-under-file": ["export", "{in}/results_good", "-o", "{in}/good.csv/x.csv"],
+    **{f"export-event-{name}": ["export", f"{{in}}/results_{name}", "-o", "{out}/x.csv"]
+       for name in [*MALFORMED_EVENTS, "not_object"]},
+    # analyse
+    "analyse-missing": ["analyse", "{in}/none", "-o", "{out}/rep"],
+    "analyse-wrong-columns": ["analyse", "{in}/responses_wrong.csv", "-o", "{out}/rep"],
+    "analyse-empty": ["analyse", "{in}/empty.csv", "-o", "{out}/rep"],
+    "analyse-binary": ["analyse", "{in}/binary.csv", "-o", "{out}/rep"],
+    "analyse-dir-csv": ["analyse", "{in}/adir.csv", "-o", "{out}/rep"],
+    "analyse-alpha-nan": ["analyse", "{in}/results_good", "-o", "{out}/rep", "--alpha", "nan"],
+    "analyse-evaluation-missing": ["analyse", "{in}/results_good", "-o", "{out}/rep", "--evaluation", "{in}/none"],
+    "analyse-evaluation-binary": ["analyse", "{in}/results_good", "-o", "{out}/rep", "--evaluation",
+                                  "{in}/binary.csv"],
+    "analyse-out-file": ["analyse", "{in}/results_good", "-o", "{in}/good.csv"],
+    "analyse-out-unwritable": ["analyse", "{in}/results_good", "-o", UNWRITABLE],
+    "analyse-out-under-file": ["analyse", "{in}/results_good", "-o", "{in}/good.csv/rep"],
+    **{f"analyse-event-{name}": ["analyse", f"{{in}}/results_{name}", "-o", "{out}/rep"]
+       for name in [*MALFORMED_EVENTS, "not_object"]},
+    # bench
+    "bench-estimators-rate-nan": ["bench", "estimators", "--rate", "nan"],
+    "bench-estimators-samples-negative": ["bench", "estimators", "--samples", "-1"],
+    "bench-loop-rate-nan": ["bench", "loop", "--rate", "nan"],
+    "bench-live-seconds-nan": ["bench", "live", "--seconds", "nan"],
+    "bench-live-block-negative": ["bench", "live", "--block-ms", "-1"],
+    "bench-memory-rows-negative": ["bench", "memory", "--rows", "-1"],
+    "bench-memory-block-zero": ["bench", "memory", "--rows", "1000", "--block", "0"],
+    # live
+    "live-rate-nan": [*LIVE, "--rate", "nan"],
+    "live-fmax-nan": [*LIVE, "--fmax", "nan"],
+    "live-fmax-negative": [*LIVE, "--fmax", "-1"],
+    "live-seconds-nan": [*LIVE, "--seconds", "nan"],
+    "live-seed-negative": [*LIVE, "--seed", "-1"],
+    "live-block-negative": [*LIVE, "--block", "-1"],
+}
+
+
+def _tree(folder):
+    return sorted(str(p.relative_to(folder)) for p in Path(folder).rglob("*"))
+
+
+def _argv(template, inputs, out):
+    return [a.replace("{in}", str(inputs)).replace("{out}", str(out)) for a in template]
+
+
+def assert_refused(code, err, before, after):
+    lines = err.strip().splitlines()
+    assert "Traceback" not in err, err
+    assert code == 2 and len(lines) == 1 and lines[0].startswith("studyapp: error: "), (code, err)
+    assert after == before, "left behind: " + ", ".join(sorted(set(after[1]) - set(before[1])))
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_input_is_refused_in_one_line(case, inputs, tmp_path, capsys, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    monkeypatch.chdir(out)
+    before = (_tree(inputs), _tree(out))
+    code = main(_argv(CASES[case], inputs, out))
+    err = capsys.readouterr().err
+    assert_refused(code, err, before, (_tree(inputs), _tree(out)))
+
+
+SUBPROCESS_CASES = {
+    "estimate-dev-zero": ["estimate", "/dev/zero", *ESTIMATE],
+    "estimate-dev-zero-csv-link": ["estimate", "{out}/zero.csv", *ESTIMATE],
+    "evaluate-params-dev-zero": ["evaluate", "{in}/rec.npz", "--params", "/dev/zero"],
+    "run-protocol-dev-zero": [*RUN, "--results", "{out}/r", "--protocol", "/dev/zero"],
+}
+
+
+def _limit_memory():
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+
+@pytest.mark.parametrize("case", list(SUBPROCESS_CASES))
+def test_bad_input_is_refused_by_the_command(case, inputs, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "zero.csv").symlink_to("/dev/zero")
+    before = (_tree(inputs), _tree(out))
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    proc = subprocess.run([sys.executable, "-m", "studyapp", *_argv(SUBPROCESS_CASES[case], inputs, out)],
+                          capture_output=True, text=True, timeout=120, env=env, cwd=out,
+                          preexec_fn=_limit_memory)
+    assert_refused(proc.returncode, proc.stderr, before, (_tree(inputs), _tree(out)))
+
+
+def test_a_recording_csv_with_a_byte_order_mark_is_accepted(tmp_path):
+    from studyapp.recording import COLUMNS, Recording, load, save
+
+    rec = Recording(1000.0, {name: np.arange(5.0) * (i + 1) / 1000 for i, name in enumerate(COLUMNS)})
+    save(rec, tmp_path / "plain.csv")
+    (tmp_path / "excel.csv").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "plain.csv").read_bytes())
+    loaded = load(tmp_path / "excel.csv")
+    assert loaded.rate == 1000.0 and list(loaded.columns) == list(COLUMNS)
+    np.testing.assert_array_equal(loaded["position"], rec["position"])
