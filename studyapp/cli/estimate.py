@@ -135,6 +135,6 @@ def run(args):
                 estimate = est.process(cols["position"], cols["acceleration"], cols["velocity"])
                 write_rows(f, rows, estimate)
     if est.bad_samples:
-        print(f"note: {est.bad_samples} non-finite input samples were replaced by the last good one",
-              file=sys.stderr)
+        print(f"note: {est.bad_samples} bad input samples (NaN, inf or beyond the physical bounds) "
+              "were replaced by the last good one", file=sys.stderr)
     return 0

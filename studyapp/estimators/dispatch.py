@@ -5,8 +5,9 @@ state (float64, starts as zeros, changed in place), ``p`` its parameters
 (float64, read only), and ``x``, ``a``, ``v`` the position, acceleration and
 tachometer velocity samples (0.0 when not measured).
 
-Bad input policy (one policy for every estimator). A non-finite sample (NaN or
-inf) in any input is replaced by the last finite sample of that input (0.0
+Bad input policy (one policy for every estimator). A bad sample in any input
+-- NaN, inf, or beyond that input's physical bound (``bounds.py``: 1 m,
+1e5 m/s^2, 100 m/s) -- is replaced by the last good sample of that input (0.0
 before the first one) and counted; the kernel never sees it, so a bad sample
 can never poison later output. The first ``GUARD`` slots of every state vector
 hold ``[last_x, last_a, last_v, bad_count]``; the kernel's own state follows.
@@ -35,12 +36,12 @@ no branch raises ``ValueError`` instead of returning 0.0 or leaving the output
 unwritten.
 """
 
-import numpy as np
 from numba import njit
 
 from studyapp.estimators import (
     bdiff, complementary, foaw, hybrids, kalman, kinds, leastsq, levant, lowpass, lvt,
 )
+from studyapp.estimators.bounds import ACCELERATION_BOUND, POSITION_BOUND, VELOCITY_BOUND, good
 
 GUARD = 4
 
@@ -83,17 +84,17 @@ def step_any(kind, s, p, x, a, v):
 def step_guarded(kind, s, p, x, a, v):
     """One step with the bad-input policy applied (the streaming form)."""
     bad = False
-    if np.isfinite(x):
+    if good(x, POSITION_BOUND):
         s[0] = x
     else:
         x = s[0]
         bad = True
-    if np.isfinite(a):
+    if good(a, ACCELERATION_BOUND):
         s[1] = a
     else:
         a = s[1]
         bad = True
-    if np.isfinite(v):
+    if good(v, VELOCITY_BOUND):
         s[2] = v
     else:
         v = s[2]
@@ -107,7 +108,7 @@ def step_guarded(kind, s, p, x, a, v):
 def guarded_loop(kernel, s, p, xs, acc, vel, out):
     """``out[i] = step_guarded(kind of kernel, s, p, ...)`` for every sample, with the kernel known at compile time.
 
-    numba compiles this once per kernel. The guard's last finite samples and
+    numba compiles this once per kernel. The guard's last good samples and
     bad count stay in locals for the block and are written back at its end.
     Both choices are for speed and leave the output unchanged, bit for bit:
     with the guard slots written every sample and the kernel chosen per
@@ -123,13 +124,13 @@ def guarded_loop(kernel, s, p, xs, acc, vel, out):
         x = xs[i]
         a = acc[i]
         v = vel[i]
-        if not (np.isfinite(x) and np.isfinite(a) and np.isfinite(v)):
+        if not (good(x, POSITION_BOUND) and good(a, ACCELERATION_BOUND) and good(v, VELOCITY_BOUND)):
             bad += 1.0
-            if not np.isfinite(x):
+            if not good(x, POSITION_BOUND):
                 x = last_x
-            if not np.isfinite(a):
+            if not good(a, ACCELERATION_BOUND):
                 a = last_a
-            if not np.isfinite(v):
+            if not good(v, VELOCITY_BOUND):
                 v = last_v
         last_x = x
         last_a = a

@@ -39,8 +39,9 @@ class Estimator:
 
     ``process(position, acceleration=None, velocity=None)`` returns the
     velocity estimate for a block and continues from its state across calls;
-    ``reset()`` returns it to its start. ``bad_samples`` counts the non-finite
-    input samples that were replaced by the last good one.
+    ``reset()`` returns it to its start. ``bad_samples`` counts the bad input
+    samples (NaN, inf, or beyond the physical bounds of ``bounds.py``) that
+    were replaced by the last good one.
     """
 
     def __init__(self, name, rate, **params):

@@ -42,9 +42,9 @@ residual equals the margin to within rounding.
 chain it twice, F(F(x)), the second time on velocity with a margin in m/s: the
 margin is in the units of x and the output in units of x per second.
 
-Bad input: handled centrally by ``dispatch.step_guarded`` (a non-finite sample
-is replaced by the last finite one and counted), so the kernel only ever sees
-finite input.
+Bad input: handled centrally by ``dispatch.step_guarded`` (a NaN, inf or
+out-of-bounds sample, ``bounds.py``, is replaced by the last good one and
+counted), so the kernel only ever sees finite input within the bounds.
 
 State (``foaw_state_size(N)`` = 3 + 4 (N + 1) slots):
 ``[started, head, chosen n, ring of N+1 samples stored twice, 1/j table, 6/(n(n+1)(n+2)) table]``
@@ -65,6 +65,7 @@ import numpy as np
 from numba import njit
 
 from studyapp.estimators import kinds
+from studyapp.estimators.bounds import POSITION_BOUND, good
 from studyapp.estimators.spec import EstimatorSpec, Param
 
 CHOSEN = 2  # state slot holding the window n chosen at the last step
@@ -137,10 +138,10 @@ def foaw_core(s, at, window, margin, rate, x):
 @njit(cache=True, error_model="numpy")
 def _window_loop(xs, window, margin, out):
     s = np.zeros(foaw_state_size(window))
-    last = 0.0  # the guard's rule (dispatch.step_guarded): a non-finite sample repeats the last finite one
+    last = 0.0  # the guard's rule (dispatch.step_guarded): a bad sample repeats the last good one
     for i in range(xs.shape[0]):
         x = xs[i]
-        if np.isfinite(x):
+        if good(x, POSITION_BOUND):
             last = x
         else:
             x = last

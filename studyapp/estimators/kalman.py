@@ -54,6 +54,12 @@ Because R is diagonal the two measurements of KALMAN are applied one after
 the other (position, then acceleration), which gives the joint update's
 posterior. The arithmetic is unrolled (no np.linalg, no allocation).
 
+Bad input is held and counted by the guard (``dispatch.step_guarded``,
+``bounds.py``), so the filter only sees positions within 1 m and
+accelerations within 1e5 m/s^2. The bound matters: a residual of 1e300 m
+overflows the update to inf, then inf - inf = NaN, and NaN never leaves the
+state (before the bounds, one such sample made every later output NaN).
+
 Start. At the first sample the filter is set to x = x_0, v = a = 0 and
 P_0 = diag(r_pos, (1 m/s)^2, (100 m/s^2)^2) (unscaled; [r_pos, (1 m/s)^2]
 for KALPOS), and outputs 0; from the second sample on it predicts and

@@ -34,9 +34,13 @@ output="sos")``, zero initial state, run as in ``biquad.py``).
 ``[started, w, u1]`` (``LEVANT_STATE``); the hybrids KALLEV and KALLEVACC
 chain it twice, L(L(x)).
 
-Bad input: handled centrally by ``dispatch.step_guarded`` (a non-finite sample
-is replaced by the last finite one and counted), so these kernels only ever
-see finite input.
+Bad input: handled centrally by ``dispatch.step_guarded`` (a NaN, inf or
+out-of-bounds sample, ``bounds.py``, is replaced by the last good one and
+counted), so these kernels only ever see finite input within the bounds. The
+bound matters here: the observer closes an error e at a rate of about
+lambda sqrt(|e|), so after one 1e30 m sample (before the bounds) LEVANT still
+read 4e6 m/s two seconds later; after a 1 m sample it is back within 0.1 s
+(tests/estimators/test_estimators_extremes.py).
 
 LEVANT state: ``[started, w, u1]``; parameters ``[alpha, lambda, T]``.
 LEVANTLP state: ``[started, w, u1, z1, z2]``; parameters ``[alpha, lambda, T, section(5)]``.

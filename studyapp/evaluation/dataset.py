@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.estimators.bounds import all_good
 from studyapp.evaluation import kernels
 from studyapp.evaluation.metric import DEFAULT_METHOD, Reference, check_method
 from studyapp.evaluation.normalisation import raw_objectives
@@ -44,7 +45,8 @@ class Take:
     sha256: str | None = None
 
     def __post_init__(self):
-        self.finite = all(np.isfinite(a).all() for a in (self.position, self.acceleration, self.velocity))
+        # every sample good for the estimators' input guard (finite and within its physical bound)
+        self.finite = all_good(self.position, self.acceleration, self.velocity)
 
 
 def reference_column(reference):

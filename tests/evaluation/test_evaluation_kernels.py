@@ -27,3 +27,15 @@ def test_non_finite_input_takes_the_guarded_path(signals):
     out = kernels.run(create("LOWPASS", 5000.0), x, a, v)
     assert np.all(np.isfinite(out))
     assert np.array_equal(out, create("LOWPASS", 5000.0).process(x, a, v))
+
+
+@pytest.mark.parametrize("name, column, value", [("KALMAN", 0, 1e30), ("KALMAN", 1, -2e5), ("LVT", 2, 150.0)])
+def test_absurd_finite_input_takes_the_guarded_path(signals, name, column, value):
+    """Beyond an input's physical bound (1 m, 1e5 m/s^2, 100 m/s) a finite sample is bad too."""
+    cols = [s.copy() for s in signals]
+    cols[column][10] = value
+    out = kernels.run(create(name, 5000.0), *cols)
+    assert np.array_equal(out, create(name, 5000.0).process(*cols))
+    held = [s.copy() for s in cols]
+    held[column][10] = held[column][9]
+    assert np.array_equal(out, create(name, 5000.0).process(*held))
