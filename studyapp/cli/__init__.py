@@ -4,7 +4,9 @@ Each sub-command lives in its own module of this package with two functions:
 ``register(subparsers)`` adds its parser (argparse only, so start-up stays fast)
 and sets ``func``; the function imports what it needs and returns an exit code.
 A ``UserError`` becomes one line on stderr and exit code 2; so does a
-malformed command line (argparse's own usage dump is several lines).
+malformed command line (argparse's own usage dump is several lines). An
+``EngineError`` (the real-time engine failed, not the user) is one line and
+exit code 1.
 """
 
 import argparse
@@ -12,7 +14,7 @@ import importlib
 import sys
 
 from studyapp import __version__
-from studyapp.errors import UserError
+from studyapp.errors import EngineError, UserError
 
 # Module names under studyapp.cli, in the order shown by --help. A module that
 # does not exist yet is skipped, so layers can land one at a time.
@@ -78,6 +80,9 @@ def main(argv=None):
     except UserError as exc:
         print(f"studyapp: error: {exc}", file=sys.stderr)
         return 2
+    except EngineError as exc:
+        print(f"studyapp: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("studyapp: interrupted", file=sys.stderr)
         return 130
