@@ -22,6 +22,7 @@ FORBIDDEN = {
     "analysis": ("studyapp.engine", "studyapp.gui", "studyapp.cli"),
     "experiment": ("studyapp.gui", "studyapp.cli"),
     "engine": ("studyapp.gui", "studyapp.cli", "studyapp.experiment", "studyapp.analysis"),
+    "session": ("studyapp.gui", "studyapp.cli", "studyapp.analysis"),
 }
 
 

@@ -26,7 +26,7 @@ from studyapp.model.fmax_knob import KNOB_MAX, LIVE_RANGE, fmax_from_knob
 
 @dataclass(frozen=True)
 class Command:
-    sent: float = field(default_factory=time.monotonic, kw_only=True)
+    sent: float = field(default_factory=time.monotonic, kw_only=True, compare=False)  # equal commands: same content
 
 
 @dataclass(frozen=True)
@@ -114,18 +114,19 @@ def default_actions(sources, fmax_range=LIVE_RANGE):
 
 
 _ACTIONS = {
-    "fmax_log": lambda a, v, s: SetFmax(fmax_from_knob(v * KNOB_MAX, a[1], a[2]), sent=s),
-    "fmax_linear": lambda a, v, s: SetFmax(a[1] + v * (a[2] - a[1]), sent=s),
-    "volume": lambda a, v, s: SetVolume(v, sent=s),
-    "source": lambda a, v, s: SetSource(a[1], sent=s) if v > 0 else None,  # a pad: pressed, not released
-    "select": lambda a, v, s: SetSource(a[1], sent=s),  # a knob: any movement selects
-    "bowing": lambda a, v, s: SetBowing(v > 0, sent=s),
-    "hand_target": lambda a, v, s: SetHandTarget(a[1] + v * (a[2] - a[1]), sent=s),
+    "fmax_log": lambda a, v, s: (SetFmax(fmax_from_knob(v * KNOB_MAX, a[1], a[2]), sent=s),),
+    "fmax_linear": lambda a, v, s: (SetFmax(a[1] + v * (a[2] - a[1]), sent=s),),
+    "volume": lambda a, v, s: (SetVolume(v, sent=s),),
+    "source": lambda a, v, s: (SetSource(a[1], sent=s),) if v > 0 else (),  # a pad: pressed, not released
+    # a rating knob: any movement selects its condition, at the task's F_max when one is given
+    "select": lambda a, v, s: (SetSource(a[1], sent=s),) + tuple(SetFmax(f, sent=s) for f in a[2:3]),
+    "bowing": lambda a, v, s: (SetBowing(v > 0, sent=s),),
+    "hand_target": lambda a, v, s: (SetHandTarget(a[1] + v * (a[2] - a[1]), sent=s),),
 }
 
 
-def action_command(action, value, sent):
-    """The command an action makes from a control value in [0, 1], or ``None`` (e.g. a pad released)."""
+def action_commands(action, value, sent):
+    """The commands an action makes from a control value in [0, 1] (none, e.g. for a pad released)."""
     make = _ACTIONS.get(action[0])
     if make is None:
         raise ParameterError(f"MIDI action {action[0]!r}: allowed are {', '.join(_ACTIONS)}")

@@ -49,7 +49,8 @@ class Applied:
     ``arrived``: the message's arrival (``time.monotonic()``); ``latency``: from
     then to the start of the block that applied the action (None without an
     action); ``blocks_late``: block boundaries it waited for; ``block``: that
-    block's number; ``trial``: the mapping's tag (``InstallActions.trial``).
+    block's number; ``trial``: the mapping's tag (``InstallActions.trial``);
+    ``commands``: what the action did; ``origin``: ``midi`` or ``screen``.
     """
 
     control: str
@@ -59,6 +60,8 @@ class Applied:
     blocks_late: int
     block: int
     trial: int
+    commands: tuple = ()
+    origin: str = "midi"
     level: str = "info"
 
 

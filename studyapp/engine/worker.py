@@ -210,7 +210,7 @@ class Worker:
         cmd.Stall: lambda self, c: time.sleep(float(c.seconds)),
         cmd.Stop: _stop,
         cmd.InstallActions: _install,
-        cmd.Control: lambda self, c: self.control(c.control, c.value, c.sent, self.k),
+        cmd.Control: lambda self, c: self.control(c.control, c.value, c.sent, self.k, "screen"),
     }
 
     def apply(self, command):
@@ -227,12 +227,15 @@ class Worker:
                         command_latency_max=max(self.status.get("command_latency_max"), latency))
         return latency
 
-    def control(self, control, value, arrived, block):
+    def control(self, control, value, arrived, block, origin="midi"):
         """A control moved (MIDI, or on screen): apply its action, tell the parent."""
         action = self.actions.get(control)
-        command = cmd.action_command(action, value, arrived) if action else None
-        latency = self.apply(command) if command else None
-        self.events.put(ev.Applied(control, value, arrived, latency, self.k - block, self.k, self.trial))
+        commands = cmd.action_commands(action, value, arrived) if action else ()
+        latency = None
+        for command in commands:
+            latency = self.apply(command)
+        self.events.put(ev.Applied(control, value, arrived, latency, self.k - block, self.k, self.trial,
+                                   commands, origin))
 
     def drain(self):
         while True:

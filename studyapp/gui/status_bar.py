@@ -4,8 +4,10 @@ From the engine's shared status block (``studyapp.engine.status``): the
 achieved loop rate against the nominal one, the load (compute time over the
 block period; mean and worst over the last second), deadline misses, audio
 underruns, faults (with the latest fault's text while one is latched), plus
-telemetry samples the GUI lost (it fell more than the ring behind) and the
-scope's painted frame rate. Trouble shows in red.
+telemetry samples the GUI lost (it fell more than the ring behind), the
+knob-to-effect latency (a control's arrival to the first block run with its
+effect, measured by the worker: the last and the largest) and the scope's
+painted frame rate. Trouble shows in red.
 """
 
 from PySide6.QtWidgets import QLabel, QStatusBar
@@ -25,6 +27,7 @@ class StatusBar(QStatusBar):
             ("underruns", "audio device periods the engine did not fill in time"),
             ("faults", "safety faults raised (the force is held at zero while one is latched)"),
             ("lost", "telemetry samples the GUI read too late to see"),
+            ("knob", "knob to effect: from a control's arrival to the first block run with it (last, largest)"),
             ("fps", "scope frames painted per second"),
         ):
             label = QLabel("")
@@ -44,7 +47,7 @@ class StatusBar(QStatusBar):
             for key in ("rate", "load", "misses", "underruns"):
                 self.labels[key].setText("")
 
-    def show_status(self, status, lost=0):
+    def show_status(self, status, lost=0, knob_latency=(None, None)):
         s = status
         self.labels["rate"].setText(f"Loop {s['achieved_rate']:,.0f} / {s['rate']:,.0f} Hz")
         self.labels["load"].setText(f"Load {100 * s['load_mean']:.0f}% ({100 * s['load_max']:.0f}%)")
@@ -59,6 +62,9 @@ class StatusBar(QStatusBar):
         self.labels["faults"].setText(faults)
         self.labels["faults"].setStyleSheet(RED if s["fault_latched"] else "")
         self.labels["lost"].setText(f"Lost {lost}" if lost else "")
+        last, largest = knob_latency
+        if last is not None:
+            self.labels["knob"].setText(f"Knob → effect {1e3 * last:.1f} ms (max {1e3 * largest:.1f})")
 
     def show_frame_rate(self, fps):
         self.labels["fps"].setText(f"Scope {fps:.0f} fps" if fps else "")

@@ -56,14 +56,17 @@ def worker():
 def test_a_control_takes_the_installed_mapping_and_reports_its_trial(worker):
     worker.apply(cmd.Control("knob1", 30 / 127, sent=1.0))  # no mapping yet: nothing happens
     assert worker.loop.fmax == 0.0 and worker.events[-1].latency is None
-    worker.apply(cmd.InstallActions({"knob1": ("fmax_log", 40.0, 2.0), "knob2": ("select", "KALLEV")}, trial=3))
+    worker.apply(cmd.InstallActions({"knob1": ("fmax_log", 40.0, 2.0), "knob2": ("select", "KALLEV", 1.0)},
+                                    trial=3))
     worker.apply(cmd.Control("knob1", 30 / 127, sent=1.0))
     assert worker.loop.fmax == pytest.approx(fmax_from_knob(30, 40.0, 2.0))
     applied = worker.events[-1]
     assert isinstance(applied, ev.Applied) and (applied.control, applied.trial, applied.block) == ("knob1", 3, 7)
-    assert applied.latency > 0
+    assert applied.latency > 0 and applied.origin == "screen"
+    assert applied.commands == (cmd.SetFmax(pytest.approx(fmax_from_knob(30, 40.0, 2.0)), sent=1.0),)
     worker.apply(cmd.Control("knob2", 0.0, sent=1.0))
-    assert worker.loop.source == "KALLEV"
+    assert (worker.loop.source, worker.loop.fmax) == ("KALLEV", 1.0)
+    worker.apply(cmd.Control("knob1", 30 / 127, sent=1.0))
     worker.apply(cmd.InstallActions({}, trial=3))  # a pause: the knob is reported but acts on nothing
     worker.apply(cmd.Control("knob1", 1.0, sent=1.0))
     assert worker.loop.fmax == pytest.approx(fmax_from_knob(30, 40.0, 2.0))

@@ -152,7 +152,7 @@ def test_emergency_stop_zeroes_force(idle_console, qapp):
     assert console.pause_button.text() == "Resume" and not console.start_button.isEnabled()
     # the experimenter clears it: force may flow again (still F_max 0 until someone turns it up)
     console.pause_button.click()
-    wait_until(qapp, lambda: not c.clearing, 5)
+    wait_until(qapp, lambda: c.state in ("idle", "finished", "aborted"), 5)
     assert not engine.status()["fault_latched"] and engine.status_block.force_enable
     bow_preview(console, qapp)
     assert np.max(np.abs(telemetry_after(console, qapp, 0.3)["force"])) > 0.3
@@ -170,6 +170,6 @@ def test_escape_is_the_emergency_stop_in_every_window(idle_console, qapp, qtbot)
         qtbot.keyClick(window, Qt.Key.Key_Escape)
         assert c.emergency
         assert c.engine.status_block.force_enable is False
-        c.resume()
-        wait_until(qapp, lambda: not c.clearing, 5)
+        c.clear_emergency()
+        wait_until(qapp, lambda: c.state in ("idle", "finished", "aborted"), 5)
     console.participant_window.hide()
