@@ -53,8 +53,8 @@ import traceback
 import numpy as np
 
 from studyapp.engine import commands as cmd
-from studyapp.engine.audio import open_sink
 from studyapp.engine import events as ev
+from studyapp.engine.audio import open_sink
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, open_input
 from studyapp.engine.ring import Ring
