@@ -66,6 +66,11 @@ CHANNELS = (
     "t", "position", "velocity_lvt", "velocity_true", "source_velocity", "string_velocity",
     "force", "fmax", "force_scale", "friction", "broken", "stability_score", "trial", "trial_clock",
 )
+# rows with one value per block, and the rest, copied from the loop's output
+_FMAX, _FORCE_SCALE, _BROKEN, _SCORE, _TRIAL, _CLOCK = (
+    CHANNELS.index(c) for c in ("fmax", "force_scale", "broken", "stability_score", "trial", "trial_clock"))
+_SAMPLED = tuple((i, c) for i, c in enumerate(CHANNELS)
+                 if i not in (_FMAX, _FORCE_SCALE, _BROKEN, _SCORE, _TRIAL, _CLOCK))
 REALTIME_PRIORITY = 5  # below JACK's own threads (10 and 9 by default)
 RESYNC = 0.1  # s behind the timer after which the schedule restarts from now
 
@@ -282,16 +287,15 @@ class Worker:
         if self.sink.render:
             self.sink.push(out["audio"])
         rows = self._rows
+        for i, name in _SAMPLED:
+            rows[i] = out[name]
         monitor = self.loop.monitor
-        per_block = {"fmax": self.loop.fmax, "force_scale": self.loop.force_scale, "broken": float(monitor.broken),
-                     "stability_score": monitor.score, "trial": self.trial}
-        for i, name in enumerate(CHANNELS):
-            if name in per_block:
-                rows[i] = per_block[name]
-            elif name == "trial_clock":
-                rows[i] = out["t"] - self.trial_start
-            else:
-                rows[i] = out[name]
+        rows[_FMAX] = self.loop.fmax
+        rows[_FORCE_SCALE] = self.loop.force_scale
+        rows[_BROKEN] = monitor.broken
+        rows[_SCORE] = monitor.score
+        rows[_TRIAL] = self.trial
+        np.subtract(out["t"], self.trial_start, out=rows[_CLOCK])
         rows[len(CHANNELS):] = out["estimates"]
         self.ring.write(rows)
         finished = time.monotonic()

@@ -77,6 +77,11 @@ def test_status_bar_shows_the_loop(idle_console, qapp):
     for key, word in (("load", "Load"), ("misses", "Deadline misses"), ("underruns", "Audio underruns"),
                       ("faults", "Faults")):
         assert console.status.labels[key].text().startswith(word)
+    # a knob turned on screen: the worker applies it and measures its knob-to-effect latency
+    console.turn_knob(1, 90)
+    wait_until(qapp, lambda: console.status.labels["knob"].text().startswith("Knob → effect"), 5)
+    last = console.controller.latency.last
+    assert 0 < last < 1.0 and f"{1e3 * last:.1f} ms" in console.status.labels["knob"].text()
 
 
 def test_scope_receives_data_and_draws_it(idle_console, qapp, tmp_path):
