@@ -3,11 +3,10 @@
 DESIGN.md: dependencies point down only, and only studyapp.gui imports Qt. The
 contracts live in .importlinter at the repository root:
 
-- ``layers``: cli > gui > analysis > (session) > engine | evaluation | experiment > model > estimators,
+- ``layers``: cli > gui > analysis > session > engine | evaluation | experiment > model > estimators,
   indirect imports included (import-linter's default), so no module reaches a
   higher layer through any chain; engine, evaluation and experiment are
-  independent; experiment, below analysis, never imports it; studyapp.session
-  is optional (checked once it exists);
+  independent; experiment, below analysis, never imports it;
 - ``qt``: PySide6 and pyqtgraph are imported only by studyapp.gui.
 
 import-linter resolves ``from studyapp import gui`` to the module studyapp.gui
@@ -60,9 +59,8 @@ VIOLATIONS = {
     "indirect, through an unlayered module": ({"estimators/_bad.py": "import studyapp._bridge\n",
                                                "_bridge.py": "import studyapp.engine.ring\n"},
                                               LAYERS, "studyapp.estimators is not allowed to import studyapp.engine"),
-    "the optional session layer, once it exists": ({"session/__init__.py": "",
-                                                    "session/_bad.py": "import studyapp.gui.app\n"},
-                                                   LAYERS, "studyapp.session is not allowed to import studyapp.gui"),
+    "session imports gui": ({"session/_bad.py": "import studyapp.gui.app\n"},
+                            LAYERS, "studyapp.session is not allowed to import studyapp.gui"),
     "core imports Qt": ({"engine/_bad.py": "import PySide6.QtCore\n"},
                         "Qt only in studyapp.gui", "studyapp.engine._bad -> PySide6"),
 }

@@ -7,7 +7,8 @@ A ``UserError`` becomes one line on stderr and exit code 2; so does a
 malformed command line (argparse's own usage dump is several lines), a
 number option that is not finite, a negative ``--seed`` (``number_options``),
 and a file that cannot be written (an ``OSError``: a full disk, a read-only
-folder), which names the file.
+folder), which names the file. An ``EngineError`` (the real-time engine
+failed, not the user) is one line and exit code 1.
 """
 
 import argparse
@@ -16,7 +17,7 @@ import sys
 
 from studyapp import __version__
 from studyapp.cli import number_options
-from studyapp.errors import UserError
+from studyapp.errors import EngineError, UserError
 
 # Module names under studyapp.cli, in the order shown by --help. A module that
 # does not exist yet is skipped, so layers can land one at a time.
@@ -83,6 +84,9 @@ def main(argv=None):
     except UserError as exc:
         print(f"studyapp: error: {exc}", file=sys.stderr)
         return 2
+    except EngineError as exc:
+        print(f"studyapp: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("studyapp: interrupted", file=sys.stderr)
         return 130

@@ -81,7 +81,8 @@ def run(args):
         fmax=args.fmax, gesture=args.gesture, seed=args.seed, block=args.block, audio=args.audio,
         midi=args.midi,
     )
-    engine = Engine(config, say=say, on_fault=lambda text: say(f"live: fault: {text}"))
+    engine = Engine(config, on_notice=lambda notice: say(notice.text),
+                    on_fault=lambda text: say(f"live: fault: {text}"))
 
     def terminate(signum, frame):
         raise KeyboardInterrupt

@@ -1,48 +1,108 @@
 """Commands to the worker, and what MIDI controls do.
 
-A command is a tuple ``(kind, value, sent)``: ``sent`` is ``time.monotonic()``
-when it was made (CLOCK_MONOTONIC is one clock for every process on Linux, so
-the worker can measure the command-to-effect latency: from ``sent`` to the
-start of the first block run with the new setting). The worker applies
-commands at block boundaries, in order.
+A command is a small frozen dataclass; every one carries ``sent``, the
+``time.monotonic()`` when it was made (CLOCK_MONOTONIC is one clock for every
+process on Linux, so the worker can measure the command-to-effect latency:
+from ``sent`` to the start of the first block run with the new setting). The
+worker applies commands at block boundaries, in order, through a handler table
+(``worker.Worker.HANDLERS``: one method per command type).
 
-Kinds and values:
-
-    source        estimator name or a pseudo-source (model/sources.py: LVT_SENSOR, TRUE)
-    fmax          N (clamped to the safety ceiling)
-    hand_target   m (switches the gesture to "live")
-    bowing        bool
-    gesture       gesture name
-    reset_string  None
-    volume        linear gain 0..4
-    mute          bool
-    learn         control name: bind it to the next MIDI control that moves
-    clear_fault   None: unlatch a safety fault (the experimenter's decision)
-    stall         seconds: a drill that stops the worker answering, to test the watchdog
-    stop          None
-
-MIDI actions map a control (see midi.ControlMap) to a command. The default
-for live use (``default_actions``): knob 1 sets F_max through the app's one
-knob law (model/fmax_knob.py, the paper's logarithmic map of Sec. 8.2) over
-``LIVE_RANGE``, knob 2 the volume, and pad i selects the i-th velocity source
-of the scene.
+MIDI actions map a control (see midi.ControlMap) to a command. The worker
+applies them itself, in and out of a session, through the mapping in force:
+``default_actions`` outside a session (knob 1 sets F_max through the app's one
+knob law, model/fmax_knob.py, the paper's logarithmic map of Sec. 8.2, over
+``LIVE_RANGE``; knob 2 the volume; pad i selects the i-th velocity source of
+the scene), the trial's mapping during one (``InstallActions``). An on-screen
+knob reaches the same mapping as a ``Control`` command, so a knob takes one
+route whatever the hand turned.
 """
 
 import time
+from dataclasses import dataclass, field
 
 from studyapp.errors import ParameterError
 from studyapp.model.fmax_knob import KNOB_MAX, LIVE_RANGE, fmax_from_knob
 
-KINDS = (
-    "source", "fmax", "hand_target", "bowing", "gesture", "reset_string", "volume", "mute",
-    "learn", "clear_fault", "stall", "stop",
-)
+
+@dataclass(frozen=True)
+class Command:
+    sent: float = field(default_factory=time.monotonic, kw_only=True, compare=False)  # equal commands: same content
 
 
-def command(kind, value=None, sent=None):
-    if kind not in KINDS:
-        raise ParameterError(f"command {kind!r}: allowed are {', '.join(KINDS)}")
-    return (kind, value, time.monotonic() if sent is None else sent)
+@dataclass(frozen=True)
+class SetSource(Command):
+    name: str  # an active estimator or a pseudo-source (model/sources.py: LVT_SENSOR, TRUE)
+
+
+@dataclass(frozen=True)
+class SetFmax(Command):
+    newtons: float  # clamped to the safety ceiling
+
+
+@dataclass(frozen=True)
+class SetHandTarget(Command):
+    metres: float  # switches the gesture to "live"
+
+
+@dataclass(frozen=True)
+class SetBowing(Command):
+    on: bool
+
+
+@dataclass(frozen=True)
+class SetGesture(Command):
+    name: str
+
+
+@dataclass(frozen=True)
+class ResetString(Command):
+    """The string at rest, the stability monitor afresh, the trial clock at 0."""
+
+
+@dataclass(frozen=True)
+class SetVolume(Command):
+    gain: float  # linear, 0..4
+
+
+@dataclass(frozen=True)
+class SetMute(Command):
+    on: bool
+
+
+@dataclass(frozen=True)
+class Learn(Command):
+    control: str  # bind it to the next MIDI control that moves
+
+
+@dataclass(frozen=True)
+class ClearFault(Command):
+    """Unlatch a safety fault (the experimenter's decision)."""
+
+
+@dataclass(frozen=True)
+class Stall(Command):
+    seconds: float  # a drill that stops the worker answering, to test the watchdog
+
+
+@dataclass(frozen=True)
+class Stop(Command):
+    pass
+
+
+@dataclass(frozen=True)
+class InstallActions(Command):
+    """The ``{control: action}`` mapping from now on; ``trial`` tags the controls it applies."""
+
+    actions: dict
+    trial: int = 0
+
+
+@dataclass(frozen=True)
+class Control(Command):
+    """An on-screen control moved to ``value`` in [0, 1]: applied as if it came from MIDI."""
+
+    control: str
+    value: float
 
 
 def default_actions(sources, fmax_range=LIVE_RANGE):
@@ -53,19 +113,21 @@ def default_actions(sources, fmax_range=LIVE_RANGE):
     return actions
 
 
-def action_command(action, value, sent):
-    """The command an action makes from a control value in [0, 1], or ``None`` (e.g. a pad released)."""
-    kind = action[0]
-    if kind == "fmax_log":
-        return command("fmax", fmax_from_knob(value * KNOB_MAX, action[1], action[2]), sent)
-    if kind == "fmax_linear":
-        return command("fmax", action[1] + value * (action[2] - action[1]), sent)
-    if kind == "volume":
-        return command("volume", value, sent)
-    if kind == "source":
-        return command("source", action[1], sent) if value > 0 else None
-    if kind == "bowing":
-        return command("bowing", value > 0, sent)
-    if kind == "hand_target":
-        return command("hand_target", action[1] + value * (action[2] - action[1]), sent)
-    raise ParameterError(f"MIDI action {kind!r}: allowed are fmax_log, fmax_linear, volume, source, bowing, hand_target")
+_ACTIONS = {
+    "fmax_log": lambda a, v, s: (SetFmax(fmax_from_knob(v * KNOB_MAX, a[1], a[2]), sent=s),),
+    "fmax_linear": lambda a, v, s: (SetFmax(a[1] + v * (a[2] - a[1]), sent=s),),
+    "volume": lambda a, v, s: (SetVolume(v, sent=s),),
+    "source": lambda a, v, s: (SetSource(a[1], sent=s),) if v > 0 else (),  # a pad: pressed, not released
+    # a rating knob: any movement selects its condition, at the task's F_max when one is given
+    "select": lambda a, v, s: (SetSource(a[1], sent=s),) + tuple(SetFmax(f, sent=s) for f in a[2:3]),
+    "bowing": lambda a, v, s: (SetBowing(v > 0, sent=s),),
+    "hand_target": lambda a, v, s: (SetHandTarget(a[1] + v * (a[2] - a[1]), sent=s),),
+}
+
+
+def action_commands(action, value, sent):
+    """The commands an action makes from a control value in [0, 1] (none, e.g. for a pad released)."""
+    make = _ACTIONS.get(action[0])
+    if make is None:
+        raise ParameterError(f"MIDI action {action[0]!r}: allowed are {', '.join(_ACTIONS)}")
+    return make(action, value, sent)

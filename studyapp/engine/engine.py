@@ -1,10 +1,10 @@
 """The parent's handle on the real-time engine: start, command, watch, stop.
 
     with Engine(EngineConfig(rate=5000, estimators={"KALLEV": {}}, source="KALLEV")) as engine:
-        engine.set_fmax(2.0)
+        engine.send(SetFmax(2.0))  # a command (engine/commands.py), applied at the next block
         engine.status()            # the shared status block (status.NUMBERS, status.TEXTS)
         engine.telemetry(5000)     # newest samples of every channel, from the shared rings
-        engine.controls()          # MIDI control events since the last call
+        engine.controls()          # controls the worker applied since the last call (events.Applied)
 
 The parent creates the shared memory (a ring for the telemetry, the status
 block, a ring of events from the worker), spawns the worker (``worker.main``) and, once it reports ready, runs a
@@ -42,13 +42,16 @@ import time
 from multiprocessing.connection import wait as wait_for
 
 from studyapp.engine import commands as cmd
+from studyapp.engine import events as ev
 from studyapp.engine.audio import parse as parse_audio
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
-from studyapp.errors import ParameterError, UserError
+from studyapp.errors import EngineError, ParameterError
 from studyapp.model.sources import with_pseudo_sources
+
+__all__ = ["Engine", "EngineError"]
 
 POLL = 0.01  # s between watchdog checks
 START_TIMEOUT = 120.0  # s for the worker to import, compile and prime
@@ -56,15 +59,11 @@ STALL_GRACE = 0.5  # s: a running worker's heartbeat this old at stop() means it
 CLOSE_GRACE = 3.0  # s: a worker closing its devices may be this quiet (a device close gives up after 2 s)
 
 
-class EngineError(UserError):
-    """The worker could not start, or stopped with an error (one line)."""
-
-
 class Engine:
-    def __init__(self, config=None, on_fault=None, say=None):
+    def __init__(self, config=None, on_fault=None, on_notice=None):
         self.config = config or EngineConfig()
         self.on_fault = on_fault
-        self.say = say or (lambda text: None)
+        self.on_notice = on_notice or (lambda notice: None)
         self.names = self._validate()
         self.faults = []
         self.fault_time = None  # time.monotonic() when the watchdog or the worker reported the first fault
@@ -122,12 +121,12 @@ class Engine:
         while True:
             event = self._next_event(min(0.05, max(0.0, deadline - time.monotonic())))
             if event is not None:
-                if event[0] == "ready":
-                    self.info = event[1]
+                if isinstance(event, ev.Ready):
+                    self.info = event.info
                     break
-                if event[0] == "error":
+                if isinstance(event, ev.Failed):
                     self._cleanup()
-                    raise EngineError(f"engine: {event[1]}")
+                    raise EngineError(f"engine: {event.text}")
                 self._handle(event)
             elif not self.process.is_alive():
                 code = self.process.exitcode
@@ -147,46 +146,21 @@ class Engine:
         self.stop()
 
     # commands --------------------------------------------------------------
-    def send(self, kind, value=None):
+    def send(self, command):
+        """Queue a command (``commands.Command``) for the worker's next block boundary."""
         if self.process is None or not self.process.is_alive():
             raise EngineError("engine: not running")
-        self._commands.put(cmd.command(kind, value))
-
-    def set_source(self, name):
-        allowed = with_pseudo_sources(self.names)
-        if name not in allowed:
-            raise ParameterError(f"source {name!r}: allowed are {', '.join(allowed)}")
-        self.send("source", name)
-
-    def set_fmax(self, fmax):
-        self.send("fmax", float(fmax))
-
-    def set_hand_target(self, x_m):
-        self.send("hand_target", float(x_m))
-
-    def set_bowing(self, on):
-        self.send("bowing", bool(on))
-
-    def set_gesture(self, name):
-        self.send("gesture", name)
-
-    def reset_string(self):
-        self.send("reset_string")
-
-    def set_volume(self, volume):
-        self.send("volume", float(volume))
-
-    def set_mute(self, muted):
-        self.send("mute", bool(muted))
-
-    def learn(self, control):
-        self.send("learn", control)
+        if isinstance(command, cmd.SetSource):
+            allowed = with_pseudo_sources(self.names)
+            if command.name not in allowed:
+                raise ParameterError(f"source {command.name!r}: allowed are {', '.join(allowed)}")
+        self._commands.put(command)
 
     def clear_fault(self):
         """Unlatch a safety fault in the worker; after a watchdog trip only a restart helps."""
         if self.tripped:
             raise EngineError("engine: the watchdog stopped this engine; start a new one")
-        self.send("clear_fault")
+        self.send(cmd.ClearFault())
 
     # reading ---------------------------------------------------------------
     def _shared(self):
@@ -220,15 +194,14 @@ class Engine:
         return out
 
     def controls(self):
-        """MIDI control events since the last call.
+        """Controls the worker took since the last call: ``events.Applied`` and ``events.Learned`` records.
 
-        ``(control, value, arrived, latency, blocks_late, applied_block)``: the
-        control's name and value in [0, 1], its arrival (``time.monotonic()``),
-        the seconds from arrival to the start of the block that applied its
-        action (``None`` when the control has no action), how many block
-        boundaries it waited for (0 or 1 unless the engine fell behind), and
-        that block's number (its first sample is ``applied_block * block``).
-        A learn-mode binding comes as ``("learned", control, binding)``.
+        An ``Applied`` record names the control and its value in [0, 1], its
+        arrival (``time.monotonic()``), the seconds from arrival to the start of
+        the block that applied its action (``None`` when the control has no
+        action), how many block boundaries it waited for (0 or 1 unless the
+        engine fell behind), that block's number (its first sample is
+        ``block * config.block``) and the mapping's trial tag.
         """
         with self._lock:
             out, self._controls = self._controls, []
@@ -264,18 +237,17 @@ class Engine:
             time.sleep(min(POLL / 2, max(0.0, end - time.monotonic())))
 
     def _handle(self, event):
-        kind = event[0]
-        if kind == "notice":
-            self.say(event[1])
-        elif kind == "fault":
-            self._fault(event[1], event[2])
-        elif kind == "error":
-            self._fault(f"worker error: {event[1]}", time.monotonic())
-        elif kind in ("control", "learned"):
+        if isinstance(event, ev.Notice):
+            self.on_notice(event)
+        elif isinstance(event, ev.Fault):
+            self._fault(event.text, event.when)
+        elif isinstance(event, ev.Failed):
+            self._fault(f"worker error: {event.text}", time.monotonic())
+        elif isinstance(event, (ev.Applied, ev.Learned)):
             with self._lock:
-                self._controls.append(event[1:] if kind == "control" else event)
-        elif kind == "stopped":
-            self.summary = event[1]
+                self._controls.append(event)
+        elif isinstance(event, ev.Stopped):
+            self.summary = event.summary
 
     def _fault(self, text, when):
         with self._lock:
@@ -318,7 +290,7 @@ class Engine:
         self._stopping = True
         if self.process.is_alive():
             with contextlib.suppress(Exception):
-                self._commands.put(cmd.command("stop"))
+                self._commands.put(cmd.Stop())
             end = time.monotonic() + timeout
             heard = time.monotonic()
             while self.process.is_alive() and time.monotonic() < end and not self._stalled(heard):

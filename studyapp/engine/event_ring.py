@@ -14,13 +14,15 @@ if the count is still below ``i + slots`` afterwards (the writer overwrites
 slot ``i`` only while the count equals ``i + slots``, so an event that old is
 skipped, as lost). A reader that
 falls a whole ring behind is told how many events it lost. An event too large
-for a slot is replaced by a short ``("notice", ...)`` saying so.
+for a slot is replaced by a short ``events.Notice`` saying so.
 """
 
 import pickle
 from multiprocessing import shared_memory
 
 import numpy as np
+
+from studyapp.engine.events import Notice
 
 _HEADER = 3
 SLOTS = 256
@@ -60,7 +62,7 @@ class EventRing:
             text = f"an event of {len(raw)} bytes was too large to pass on: {event!s}"
             keep = self.slot_size // 2
             while len(raw) + 4 > self.slot_size:
-                raw = pickle.dumps(("notice", text[:keep]))
+                raw = pickle.dumps(Notice(text[:keep], "warning"))
                 keep //= 2
         n = int(self._header[0])
         slot = self._data[n % self.slots]

@@ -36,6 +36,7 @@ import tempfile
 import textwrap
 import time
 
+from studyapp.engine.events import Applied
 from studyapp.model.sources import LVT_SENSOR
 
 KNOBS = 8
@@ -173,8 +174,8 @@ def flood(rate, seconds, progress=print):
         summary = engine.stop() or {}
     last = {}
     for event in controls:
-        if event[0] != "learned":
-            last[event[0]] = event[1]
+        if isinstance(event, Applied):
+            last[event.control] = event.value
     final = {f"knob{k}": v for k, v in ((int(k), v) for k, v in sent["final"].items())}
     missing = sum(1 for knob, value in final.items() if last.get(knob) != value / 127.0)
     missing += 0 if np.isclose(fmax, fmax_from_knob(final["knob1"], *LIVE_RANGE)) else 1

@@ -26,7 +26,17 @@ earlier block overran): the summary's ``wake_late_max`` says how late.
 Stalls and late starts are the machine's share of the misses, overruns the
 engine's.
 
-The worker stops on a ``stop`` command, or when its parent dies (it checks the
+Besides the loop's signals, each block publishes what a study session needs
+(push, not pull): the friction (the string's normalised force, paper eq. 2),
+the loop's stability monitor's verdict (``broken``, 0 or 1) and ``score``
+(model/stability.py: the one judgement of breakdown), the tag of the mapping
+in force (``trial``) and the trial clock (seconds since the last
+``ResetString``, which starts a trial). Knob and pad actions are applied here,
+in and out of a session, through the mapping installed last
+(``commands.InstallActions``); on-screen controls arrive as ``Control``
+commands and take the same route as MIDI.
+
+The worker stops on a ``Stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
 """
 
@@ -43,6 +53,7 @@ import traceback
 import numpy as np
 
 from studyapp.engine import commands as cmd
+from studyapp.engine import events as ev
 from studyapp.engine.audio import open_sink
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, coalesce, open_input
@@ -53,8 +64,13 @@ from studyapp.engine.status import StatusBlock
 # telemetry channels before the estimates ("estimate:NAME")
 CHANNELS = (
     "t", "position", "velocity_lvt", "velocity_true", "source_velocity", "string_velocity",
-    "force", "fmax", "force_scale",
+    "force", "fmax", "force_scale", "friction", "broken", "stability_score", "trial", "trial_clock",
 )
+# rows with one value per block, and the rest, copied from the loop's output
+_FMAX, _FORCE_SCALE, _BROKEN, _SCORE, _TRIAL, _CLOCK = (
+    CHANNELS.index(c) for c in ("fmax", "force_scale", "broken", "stability_score", "trial", "trial_clock"))
+_SAMPLED = tuple((i, c) for i, c in enumerate(CHANNELS)
+                 if i not in (_FMAX, _FORCE_SCALE, _BROKEN, _SCORE, _TRIAL, _CLOCK))
 REALTIME_PRIORITY = 5  # below JACK's own threads (10 and 9 by default)
 RESYNC = 0.1  # s behind the timer after which the schedule restarts from now
 
@@ -88,7 +104,7 @@ def main(config, ring_spec, status_name, commands, events_name):
         text = f"{type(exc).__name__}: {exc}".splitlines()[0]
         status.set(state="failed", fault=text)
         status.publish(texts=True)
-        events.put(("error", text, traceback.format_exc()[-3000:]))
+        events.put(ev.Failed(text, traceback.format_exc()[-3000:]))
     finally:
         if worker is not None:
             hard_exit = worker.close()
@@ -116,7 +132,8 @@ class Worker:
         status.publish()
         sys.setswitchinterval(0.0005)  # PortAudio's and rtmidi's threads need the GIL promptly
 
-        self.sink = open_sink(config.audio, config.rate, say=self.notice, lead=config.lead)
+        self.sink = open_sink(config.audio, config.rate, lead=config.lead,
+                              say=lambda text: self.notice(text, "warning", "audio"))
         loop_config = LoopConfig(
             rate=config.rate, estimators=config.estimators, source=config.source, fmax=1.0,
             gesture=config.gesture, seed=config.seed, audio=self.sink.render,
@@ -131,11 +148,13 @@ class Worker:
             raise RuntimeError(f"telemetry channels {self.channels} differ from the ring's {ring.channels}")
         self.cmap = ControlMap.from_protocol(config.midi_map) if config.midi_map else ControlMap.lpd8()
         self.actions = config.actions if config.actions is not None else cmd.default_actions(config.sources())
-        self.midi = open_input(config.midi, say=self.notice)
+        self.midi = open_input(config.midi, say=lambda text: self.notice(text, "warning", "midi"))
         self.block = config.block_size()
         self.period = self.block / self.loop.rate
         self.realtime = _try_realtime() if config.realtime else False
         self.k = 0
+        self.trial = 0  # the tag of the mapping in force
+        self.trial_start = 0.0  # loop time (s) of the last ResetString
         self.loads = []  # every timed block's load, for the summary's percentiles
         self.wake_late_max = 0.0  # the timer's worst wake-up delay: the OS's share of a miss
         self.overruns = 0  # misses whose block alone took longer than its period on the CPU
@@ -149,55 +168,79 @@ class Worker:
         )
 
     # messages to the parent ---------------------------------------------------
-    def notice(self, text):
-        self.events.put(("notice", text))
+    def notice(self, text, level="info", topic=""):
+        self.events.put(ev.Notice(text, level, topic))
 
     def fault(self, text):
         self.status.set(faults=self.status.get("faults") + 1, fault=text)
-        self.events.put(("fault", text, time.monotonic()))
+        self.events.put(ev.Fault(text, time.monotonic()))
 
-    # commands -------------------------------------------------------------
+    # commands: one handler per command type ------------------------------------
+    def _source(self, c):
+        self.loop.set_source(c.name)
+        self.status.set(source=self.loop.source)
+
+    def _fmax(self, c):
+        self.loop.set_fmax(self.safety.clamp_fmax(c.newtons))
+
+    def _reset_string(self, c):
+        self.loop.reset_string()
+        self.trial_start = self.k * self.block / self.loop.rate
+
+    def _clear_fault(self, c):
+        if self.loop.fault:
+            self.notice(f"cannot clear: the loop itself latched '{self.loop.fault}'; restart the engine", "warning")
+        else:
+            self.safety.clear()
+            self.status.set(fault="")
+
+    def _install(self, c):
+        self.actions = dict(c.actions)
+        self.trial = int(c.trial)
+
+    def _stop(self, c):
+        self.stopping = True
+
+    HANDLERS = {
+        cmd.SetSource: _source,
+        cmd.SetFmax: _fmax,
+        cmd.SetHandTarget: lambda self, c: self.loop.set_hand_target(c.metres),
+        cmd.SetBowing: lambda self, c: self.loop.set_bowing(bool(c.on)),
+        cmd.SetGesture: lambda self, c: self.loop.set_gesture(c.name),
+        cmd.ResetString: _reset_string,
+        cmd.SetVolume: lambda self, c: self.sink.set_volume(float(c.gain)),
+        cmd.SetMute: lambda self, c: self.sink.set_mute(bool(c.on)),
+        cmd.Learn: lambda self, c: self.cmap.learn(c.control),
+        cmd.ClearFault: _clear_fault,
+        cmd.Stall: lambda self, c: time.sleep(float(c.seconds)),
+        cmd.Stop: _stop,
+        cmd.InstallActions: _install,
+        cmd.Control: lambda self, c: self.control(c.control, c.value, c.sent, self.k, "screen"),
+    }
+
     def apply(self, command):
-        kind, value, sent = command
+        """Apply one command; returns its command-to-effect latency (s), or None if it was refused."""
         try:
-            if kind == "source":
-                self.loop.set_source(value)
-                self.status.set(source=self.loop.source)
-            elif kind == "fmax":
-                self.loop.set_fmax(self.safety.clamp_fmax(value))
-            elif kind == "hand_target":
-                self.loop.set_hand_target(value)
-            elif kind == "bowing":
-                self.loop.set_bowing(bool(value))
-            elif kind == "gesture":
-                self.loop.set_gesture(value)
-            elif kind == "reset_string":
-                self.loop.reset_string()
-            elif kind == "volume":
-                self.sink.set_volume(float(value))
-            elif kind == "mute":
-                self.sink.set_mute(bool(value))
-            elif kind == "learn":
-                self.cmap.learn(value)
-            elif kind == "clear_fault":
-                if self.loop.fault:
-                    self.notice(f"cannot clear: the loop itself latched '{self.loop.fault}'; restart the engine")
-                else:
-                    self.safety.clear()
-                    self.status.set(fault="")
-            elif kind == "stall":
-                time.sleep(float(value))
-            elif kind == "stop":
-                self.stopping = True
+            self.HANDLERS[type(command)](self, command)
         except (ValueError, TypeError) as exc:
-            self.notice(f"command {kind}={value!r} ignored: {exc}")
+            self.notice(f"command {command!r} ignored: {exc}", "warning")
             return None
         # measured when applied, just before the block it affects: a message that arrived after
         # the block's start time was taken but before the drain would otherwise read negative
-        latency = time.monotonic() - sent
+        latency = time.monotonic() - command.sent
         self.status.set(command_latency=latency,
                         command_latency_max=max(self.status.get("command_latency_max"), latency))
         return latency
+
+    def control(self, control, value, arrived, block, origin="midi"):
+        """A control moved (MIDI, or on screen): apply its action, tell the parent."""
+        action = self.actions.get(control)
+        commands = cmd.action_commands(action, value, arrived) if action else ()
+        latency = None
+        for command in commands:
+            latency = self.apply(command)
+        self.events.put(ev.Applied(control, value, arrived, latency, self.k - block, self.k, self.trial,
+                                   commands, origin))
 
     def drain(self):
         while True:
@@ -220,11 +263,8 @@ class Worker:
                 continue
             control, value = hit
             if learning is not None and self.cmap.learning is None:
-                self.events.put(("learned", control, self.cmap.to_dict()[control]))
-            action = self.actions.get(control)
-            command = cmd.action_command(action, value, arrived) if action else None
-            latency = self.apply(command) if command else None
-            self.events.put(("control", control, value, arrived, latency, self.k - block, self.k))
+                self.events.put(ev.Learned(control, self.cmap.to_dict()[control]))
+            self.control(control, value, arrived, block)
 
     # the loop -------------------------------------------------------------
     def prime(self):
@@ -249,13 +289,15 @@ class Worker:
         if self.sink.render:
             self.sink.push(out["audio"])
         rows = self._rows
-        for i, name in enumerate(CHANNELS):
-            if name == "fmax":
-                rows[i] = self.loop.fmax
-            elif name == "force_scale":
-                rows[i] = self.loop.force_scale
-            else:
-                rows[i] = out[name]
+        for i, name in _SAMPLED:
+            rows[i] = out[name]
+        monitor = self.loop.monitor
+        rows[_FMAX] = self.loop.fmax
+        rows[_FORCE_SCALE] = self.loop.force_scale
+        rows[_BROKEN] = monitor.broken
+        rows[_SCORE] = monitor.score
+        rows[_TRIAL] = self.trial
+        np.subtract(out["t"], self.trial_start, out=rows[_CLOCK])
         rows[len(CHANNELS):] = out["estimates"]
         self.ring.write(rows)
         finished = time.monotonic()
@@ -270,7 +312,7 @@ class Worker:
         self.prime()
         status.set(state="running", heartbeat=time.monotonic())
         status.publish(texts=True)
-        self.events.put(("ready", {
+        self.events.put(ev.Ready({
             "rate": self.loop.rate, "block": self.block, "names": list(self.loop.names),
             "audio": self.sink.description, "midi": self.midi.description if self.midi else "none",
             "realtime": self.realtime, "paced": "audio" if self.sink.paced else "timer",
@@ -291,7 +333,7 @@ class Worker:
                     audio_clock = False
                     t0, k0 = time.monotonic(), self.k
                     status.set(audio_paced=False)
-                    self.notice("audio: the device stopped calling back; the timer paces the loop now")
+                    self.notice("audio: the device stopped calling back; the timer paces the loop now", "warning", "audio")
             else:
                 start_at = t0 + (self.k - k0) * self.period
                 now = time.monotonic()
@@ -374,11 +416,11 @@ class Worker:
             stuck = getattr(self.sink, "stuck", False)
             if stuck:
                 self.notice("audio: the device did not release its stream (JACK dropped the client?); "
-                            "leaving it open")
+                            "leaving it open", "warning", "audio")
         if self.midi is not None:
             self.midi.close()
         if getattr(self, "loop", None) is not None:
-            self.events.put(("stopped", self.summary()))
+            self.events.put(ev.Stopped(self.summary()))
             self.status.set(state="stopped", heartbeat=time.monotonic())
             self.status.publish(texts=True)
         sounddevice = sys.modules.get("sounddevice")

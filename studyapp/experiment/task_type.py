@@ -14,6 +14,8 @@ registered by name in ``studyapp.experiment.tasks``:
   row into trials;
 - **trial**: ``start`` makes the state machine of one trial (``TrialState``),
   fed by knob, pad and tick events;
+- **live knobs**: ``knob_actions`` is the mapping the real-time worker applies
+  during a trial (a knob acts once, in the worker: studyapp.session);
 - **captions**: ``heading``, ``knob_captions``, ``response_text`` are the text
   the console and the participant window show (never a condition name under
   blinding unless the task shows it on purpose);
@@ -109,6 +111,11 @@ class TaskType(Protocol):
 
     def knob_captions(self, trial, state: TrialState, knobs: int, hidden: bool) -> list:
         """A caption per knob (empty string: none); ``hidden`` is the console's blinding switch."""
+
+    def knob_actions(self, trial, state: TrialState) -> dict:
+        """{control: action} the engine's worker applies during the trial, in the worker's action
+        vocabulary (``studyapp.engine.commands``): e.g. ``("select", condition, fmax)`` or
+        ``("fmax_log", ceiling, decades)``; {} for a trial without knobs."""
 
     def response_text(self, response: dict) -> str:
         """What the console says when ``response`` is logged, blind-safe."""

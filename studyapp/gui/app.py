@@ -39,7 +39,7 @@ def default_protocol():
 def build(args):
     """The controller and console for ``args`` (not yet shown); ``UserError`` for bad arguments."""
     from studyapp.gui.console import Console
-    from studyapp.gui.session_controller import SessionController
+    from studyapp.session.controller import SessionController
 
     application()
     controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"))

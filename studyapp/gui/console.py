@@ -8,8 +8,10 @@ analysis view (``AnalysisView``) of a results folder; the session's log.
 Bottom: the status bar (loop rate, load, deadline misses, audio underruns,
 faults, scope frame rate).
 
-Every widget is a view of the ``SessionController`` (no Qt in it): widgets
-call its methods, and its events update the widgets. A ``QTimer`` calls
+Every widget is a view of the ``SessionController`` (``studyapp.session``, no
+Qt in it): widgets call its methods, and its events update the widgets.
+Messages are coloured by their level (info, warning, error); a device's
+latest warning (its ``topic``: audio, midi) is shown beside that device. A ``QTimer`` calls
 ``controller.poll()`` every ``POLL_PERIOD``; the poll never waits, so the UI
 thread never blocks on the engine.
 """
@@ -33,21 +35,29 @@ from PySide6.QtWidgets import (
 )
 
 from studyapp.errors import UserError
+from studyapp.experiment.tasks import task_type
 from studyapp.gui.analysis_view import AnalysisView
 from studyapp.gui.bowing_pad import BowingPad
 from studyapp.gui.gui_thread import GuiThreadCaller
 from studyapp.gui.knobs import KnobPanel
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.scope import Scope
-from studyapp.gui.session_controller import GESTURES
 from studyapp.gui.setup_panel import SetupPanel
-from studyapp.gui.simulated_session import SimulatedSession
 from studyapp.gui.status_bar import StatusBar
+from studyapp.session.controller import GESTURES, REST, State
+from studyapp.session.simulated_session import SimulatedSession
 
 POLL_PERIOD_MS = 10
 STOP_STYLE = ("QPushButton { background: #c00; color: white; font-weight: bold; font-size: 14pt; "
               "padding: 10px; border-radius: 4px; } QPushButton:pressed { background: #800; }")
 LOG_LINES = 2000
+STATE_WORDS = {
+    State.IDLE: "No session", State.STARTING: "Starting the session's engine…", State.RUNNING: "Running",
+    State.PAUSED: "Paused", State.EMERGENCY: "EMERGENCY STOP — force zeroed",
+    State.CLEARING: "Clearing the emergency stop…", State.ENGINE_LOST: "Paused: the engine stopped",
+    State.RESTARTING: "Starting a new engine…", State.FINISHED: "Session complete", State.ABORTED: "Session aborted",
+}
+COLOURS = {"error": "#c00", "warning": "#a60"}
 
 
 class Console(QMainWindow):
@@ -91,7 +101,6 @@ class Console(QMainWindow):
         self.response_label = QLabel("")
         self.response_label.setWordWrap(True)
         self._condition_text = ""
-        self._captions = []
 
         buttons = QHBoxLayout()
         buttons.addWidget(self.start_button)
@@ -199,7 +208,7 @@ class Console(QMainWindow):
         self.timer.setInterval(POLL_PERIOD_MS)
         self.timer.timeout.connect(self._tick)
         self.timer.start()
-        self._on_state(state=controller.state, emergency=controller.emergency)
+        self._on_state(state=controller.state)
         self.resize(1500, 940)
 
     # actions --------------------------------------------------------------
@@ -232,10 +241,8 @@ class Console(QMainWindow):
 
     def _pause_or_resume(self):
         c = self.controller
-        if c.emergency or c.state == "paused":
-            c.resume()
-        else:
-            c.pause()
+        act = {State.EMERGENCY: c.clear_emergency, State.PAUSED: c.resume, State.ENGINE_LOST: c.restart_engine}
+        act.get(c.state, c.pause)()
 
     def analyse_results(self):
         self.tabs.setCurrentWidget(self.analysis)
@@ -266,14 +273,13 @@ class Console(QMainWindow):
         sim = self.simulated
         if sim is not None and sim.done:
             if sim.error:
-                self.controller.message(sim.error, level="fault")
+                self.controller.message(sim.error, level="error")
             self.simulated = None
 
     # views of the controller's events --------------------------------------------
     def _on_protocol(self, protocol):
         self.participant_window.show_title(protocol.title)
         self.setWindowTitle(f"studyapp — experimenter console — {protocol.title}")
-        self._captions = []
         self.knobs.set_captions([])
 
     def _on_engine(self, state, info, config):
@@ -283,42 +289,32 @@ class Console(QMainWindow):
         self.status.show_engine(state, info)
         if state == "running":
             self.scope.set_scene(info["rate"], info["names"])
-        self._on_state(self.controller.state, self.controller.emergency)
+        self._on_state(self.controller.state)
 
-    def _on_state(self, state, emergency):
-        words = {"idle": "No session", "starting": "Starting the session's engine…", "running": "Running",
-                 "paused": "Paused", "finished": "Session complete", "aborted": "Session aborted"}
-        text = words[state]
-        if emergency:
-            text = "EMERGENCY STOP — force zeroed"
-        self.state_label.setText(text)
+    def _on_state(self, state):
+        emergency = state == State.EMERGENCY
+        self.state_label.setText(STATE_WORDS[state])
         self.state_label.setStyleSheet("font-weight: bold;" + (" color: #c00;" if emergency else ""))
-        active = state in ("starting", "running", "paused")
-        self.start_button.setEnabled(not active and not emergency)
+        active = self.controller.in_session
+        self.start_button.setEnabled(state in REST)
         self.abort_button.setEnabled(active)
-        self.pause_button.setEnabled(state in ("running", "paused") or emergency)
-        self.pause_button.setText("Resume" if emergency or state == "paused" else "Pause")
+        self.pause_button.setEnabled(state in (State.RUNNING, State.PAUSED, State.EMERGENCY, State.ENGINE_LOST))
+        self.pause_button.setText("Pause" if state == State.RUNNING else "Resume")
         self.setup.set_editable(not active)
-        accepting = self.controller.accepting and not emergency
+        accepting = self.controller.accepting
         self.knobs.setEnabled(accepting)
         self.bowing_pad.setEnabled(accepting)
         self.gesture.setEnabled(accepting)
         self.bow_button.setEnabled(accepting)
         self.participant_window.show_state(state, emergency)
-        if state in ("idle", "finished", "aborted"):
+        if state in REST:
             self.task_label.setText("")
             self.knobs.set_captions([])
-            if state != "idle":
-                self.trial_label.setText(words[state])
+            if state != State.IDLE:
+                self.trial_label.setText(STATE_WORDS[state])
 
     def _on_trial(self, trial, step, total, instructions):
-        if trial.task == "rating":
-            self.task_label.setText(f"Task: rating of {len(trial.conditions)} conditions")
-            self._captions = list(trial.conditions)
-        else:
-            self.task_label.setText(f"Task: adjustment, repetition {trial.trial}")
-            self._captions = ["F_max" if i == self.controller.runner.task.knob_index else ""
-                              for i in range(len(self.knobs.dials))]
+        self.task_label.setText("Task: " + task_type(trial.task).heading(trial))
         self.trial_label.setText(f"Trial {step + 1} of {total}")
         self.progress_bar.setRange(0, total)
         self.progress_bar.setValue(step)
@@ -339,11 +335,9 @@ class Console(QMainWindow):
     def _blinding(self, hidden):
         self.condition_label.setText("hidden (blinding)" if hidden else self._condition_text)
         if self.controller.runner is not None and self.controller.runner.trial is not None:
-            trial = self.controller.runner.trial
-            if trial.task == "rating":
-                self.knobs.set_captions([] if hidden else self._captions)
-            else:
-                self.knobs.set_captions(self._captions)
+            runner = self.controller.runner
+            kind = task_type(runner.trial.task)
+            self.knobs.set_captions(kind.knob_captions(runner.trial, runner.task, len(self.knobs.dials), hidden))
 
     def _on_bowing(self, on):
         self.bow_button.blockSignals(True)
@@ -358,24 +352,18 @@ class Console(QMainWindow):
         if len(block["position"]):
             self.bowing_pad.show_handle(block["position"][-1])
 
-    def _on_status(self, status, lost):
-        self.status.show_status(status, lost)
+    def _on_status(self, status, lost, knob_latency):
+        self.status.show_status(status, lost, knob_latency)
 
-    def _on_message(self, text, level):
-        for prefix in ("audio", "MIDI"):
-            if text.startswith(prefix + ":"):
-                self.notices[prefix] = text
-        colour = {"fault": "#c00", "notice": "#a60"}.get(level)
-        self.log.appendPlainText(("[fault] " if level == "fault" else "") + text)
-        if colour:
+    def _on_message(self, text, level, topic):
+        if topic:
+            self.notices[topic] = text
+        self.log.appendPlainText(("[fault] " if level == "error" else "") + text)
+        if level in COLOURS:
             self.statusBar().showMessage(text, 8000)
 
     def _on_response(self, response, step):
-        if response["task"] == "rating":
-            text = "Ratings recorded."
-        else:
-            text = f"Response recorded: F_max = {response['fmax']:.3g} N."
-        self.response_label.setText(text)
+        self.response_label.setText(task_type(response["task"]).response_text(response))
         self.progress_bar.setValue(step + 1)
 
     # closing ------------------------------------------------------------------

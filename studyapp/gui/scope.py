@@ -35,7 +35,7 @@ from PySide6.QtWidgets import (
 
 from studyapp.atomic import atomic_path
 from studyapp.gui.frame_rate import FrameRateMeter
-from studyapp.gui.scope_buffer import MAX_SECONDS, ScopeBuffer
+from studyapp.session.scope_buffer import MAX_SECONDS, ScopeBuffer
 
 FRAME_PERIOD = 0.015  # s: aim above 60 fps; the measured rate is what counts
 MIN_SECONDS = 0.1

@@ -141,7 +141,7 @@ class SetupPanel(QWidget):
             self.audio.setText(_with_notice(_audio_words(audio), notices.get("audio")))
             midi = info.get("midi", "none")
             self.midi.setText(_with_notice(f"input {midi}" if midi != "none" else "no MIDI input: on-screen knobs",
-                                           notices.get("MIDI")))
+                                           notices.get("midi")))
             self.engine.setText(f"{info['rate']:g} Hz, blocks of {info['block']}, paced by the {info['paced']}")
         elif state == "starting":
             for label in (self.audio, self.midi):

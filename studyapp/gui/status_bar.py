@@ -6,8 +6,9 @@ block period; mean and worst over the last second), deadline misses, audio
 underruns, faults (with the latest fault's text while one is latched), the
 engine's events dropped (MIDI control events and notices its event ring
 overwrote before the console read them), plus telemetry samples the GUI lost
-(it fell more than the ring behind) and the scope's painted frame rate.
-Trouble shows in red.
+(it fell more than the ring behind), the knob-to-effect latency (a control's
+arrival to the first block run with its effect, measured by the worker: the
+last and the largest) and the scope's painted frame rate. Trouble shows in red.
 """
 
 from PySide6.QtWidgets import QLabel, QStatusBar
@@ -28,6 +29,7 @@ class StatusBar(QStatusBar):
             ("faults", "safety faults raised (the force is held at zero while one is latched)"),
             ("dropped", "engine events (MIDI controls, notices) overwritten before the console read them"),
             ("lost", "telemetry samples the GUI read too late to see"),
+            ("knob", "knob to effect: from a control's arrival to the first block run with it (last, largest)"),
             ("fps", "scope frames painted per second"),
         ):
             label = QLabel("")
@@ -47,7 +49,7 @@ class StatusBar(QStatusBar):
             for key in ("rate", "load", "misses", "underruns"):
                 self.labels[key].setText("")
 
-    def show_status(self, status, lost=0):
+    def show_status(self, status, lost=0, knob_latency=(None, None)):
         s = status
         self.labels["rate"].setText(f"Loop {s['achieved_rate']:,.0f} / {s['rate']:,.0f} Hz")
         self.labels["load"].setText(f"Load {100 * s['load_mean']:.0f}% ({100 * s['load_max']:.0f}%)")
@@ -65,6 +67,9 @@ class StatusBar(QStatusBar):
         self.labels["dropped"].setText(f"Events dropped {dropped}" if dropped else "")
         self.labels["dropped"].setStyleSheet(RED if dropped else "")
         self.labels["lost"].setText(f"Lost {lost}" if lost else "")
+        last, largest = knob_latency
+        if last is not None:
+            self.labels["knob"].setText(f"Knob → effect {1e3 * last:.1f} ms (max {1e3 * largest:.1f})")
 
     def show_frame_rate(self, fps):
         self.labels["fps"].setText(f"Scope {fps:.0f} fps" if fps else "")

@@ -70,11 +70,11 @@ def test_a_control_change_from_another_process_sets_fmax_within_one_block(jack_s
             controls = engine.controls()
             time.sleep(0.01)
         assert controls, "no control event reached the engine"
-        control, value, arrived, latency, blocks_late, applied_block = controls[0]
+        applied = controls[0]
         expected = fmax_from_knob(100, *LIVE_RANGE)
-        assert control == "knob1" and value == pytest.approx(100 / 127)
-        assert blocks_late <= 1
-        assert 0 <= latency
+        assert applied.control == "knob1" and applied.value == pytest.approx(100 / 127)
+        assert applied.origin == "midi" and applied.blocks_late <= 1
+        assert 0 <= applied.latency
         time.sleep(0.05)
         assert engine.status()["fmax"] == pytest.approx(expected)
         assert engine.status()["midi_messages"] == 1
@@ -82,7 +82,7 @@ def test_a_control_change_from_another_process_sets_fmax_within_one_block(jack_s
         tel = engine.telemetry(since=0)
         change = np.flatnonzero(np.diff(tel["fmax"])) + 1
         assert len(change) == 1
-        assert tel["start"] + change[0] == applied_block * block
+        assert tel["start"] + change[0] == applied.block * block
         assert tel["fmax"][change[0]] == pytest.approx(expected)
     finally:
         summary = engine.stop()

@@ -83,19 +83,23 @@ def test_learn_mode_binds_the_next_control_that_moves():
 def test_knob_one_uses_the_one_knob_law_over_the_live_range():
     actions = commands.default_actions(["LVT"])
     for step in (0, 1, 64, 127):
-        value = commands.action_command(actions["knob1"], step / 127, sent=0.0)[1]
+        value = commands.action_commands(actions["knob1"], step / 127, sent=0.0)[0].newtons
         assert value == pytest.approx(fmax_from_knob(step, *LIVE_RANGE))
-    assert commands.action_command(actions["knob1"], 1 / 127, 0.0)[1] == pytest.approx(0.1)
-    assert commands.action_command(actions["knob1"], 1.0, 0.0)[1] == pytest.approx(20.0)
+    assert commands.action_commands(actions["knob1"], 1 / 127, 0.0)[0].newtons == pytest.approx(0.1)
+    assert commands.action_commands(actions["knob1"], 1.0, 0.0)[0].newtons == pytest.approx(20.0)
 
 
 def test_default_actions_drive_the_engine_commands():
     actions = commands.default_actions(["KALLEV", "LOWPASS", "LVT"])
-    kind, value, sent = commands.action_command(actions["knob1"], 100 / 127, sent=1.0)
-    assert (kind, sent) == ("fmax", 1.0) and value == pytest.approx(fmax_from_knob(100, *LIVE_RANGE))
-    assert commands.action_command(actions["pad2"], 1.0, 2.0)[:2] == ("source", "LOWPASS")
-    assert commands.action_command(actions["pad2"], 0.0, 2.0) is None  # releasing a pad does nothing
-    assert commands.action_command(actions["knob2"], 0.5, 2.0)[:2] == ("volume", 0.5)
+    made = commands.action_commands
+    assert made(actions["knob1"], 100 / 127, sent=1.0) == (
+        commands.SetFmax(pytest.approx(fmax_from_knob(100, *LIVE_RANGE)), sent=1.0),)
+    assert made(actions["pad2"], 1.0, 2.0) == (commands.SetSource("LOWPASS", sent=2.0),)
+    assert made(actions["pad2"], 0.0, 2.0) == ()  # releasing a pad does nothing
+    assert made(actions["knob2"], 0.5, 2.0) == (commands.SetVolume(0.5, sent=2.0),)
+    # a rating knob selects its condition whatever its position, even at the bottom, at the task's F_max
+    assert made(("select", "LVT", 1.0), 0.0, 3.0) == (commands.SetSource("LVT", sent=3.0),
+                                                      commands.SetFmax(1.0, sent=3.0))
     assert "pad4" not in actions
 
 

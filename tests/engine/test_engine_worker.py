@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 from studyapp.engine.config import EngineConfig
+from studyapp.engine.commands import ResetString, SetFmax, SetSource, Stall
 from studyapp.engine.engine import Engine, EngineError
 from studyapp.errors import ParameterError
+from studyapp.model.stability import StabilityMonitor
 
 RATE = 5000.0
 
@@ -57,8 +59,8 @@ def test_worker_runs_switches_source_and_fmax_and_stops_cleanly():
         before = engine.status()
         assert before["state"] == "running" and before["source"] == "LVT" and before["fmax"] == 1.0
 
-        engine.set_source("KALLEV")
-        engine.set_fmax(3.0)
+        engine.send(SetSource("KALLEV"))
+        engine.send(SetFmax(3.0))
         _wait(lambda: engine.status()["fmax"] == 3.0 and engine.status()["source"] == "KALLEV")
         _wait(lambda: engine.status()["samples"] > before["samples"] + 0.3 * RATE)
         snap = engine.status()
@@ -87,6 +89,24 @@ def test_worker_runs_switches_source_and_fmax_and_stops_cleanly():
         assert set(tel["estimates"]) == {"KALLEV", "LOWPASS"}
         # estimates track the true velocity (a sanity check of the rows' wiring, not of the estimators)
         assert np.corrcoef(tel["estimates"]["LOWPASS"], tel["velocity_true"])[0, 1] > 0.5
+
+        # pushed per block for a session: the friction behind the force (eq. 2: F = -F_max friction,
+        # below the motor clamp), the loop's own stability verdict, the trial clock from ResetString
+        np.testing.assert_allclose(-tel["friction"] * tel["fmax"] * tel["force_scale"], tel["force"], atol=1e-12)
+        engine.send(ResetString())
+        _wait(lambda: np.any(np.diff(engine.telemetry(int(0.2 * RATE))["trial_clock"]) < 0))
+        target = engine.status()["samples"] + 0.2 * RATE
+        _wait(lambda: engine.status()["samples"] > target)
+        tel = engine.telemetry(int(0.4 * RATE))
+        reset = np.flatnonzero(np.diff(tel["trial_clock"]) < 0)[0] + 1
+        assert (tel["start"] + reset) % block == 0 and tel["trial_clock"][reset] == 0.0
+        np.testing.assert_allclose(np.diff(tel["trial_clock"][reset:]), 1 / RATE, rtol=1e-6)
+        monitor = StabilityMonitor(RATE)
+        last = reset + (len(tel["t"]) - reset) // block * block - 1  # the last sample of a whole block
+        monitor.measure(tel["velocity_true"][reset:last + 1])
+        assert tel["stability_score"][last] == pytest.approx(monitor.score, rel=1e-9) and monitor.score > 0
+        assert tel["broken"][last] == float(monitor.broken)
+        assert set(tel["trial"]) == {0.0}
 
         achieved = _wait(lambda: engine.status()["achieved_rate"], timeout=5)
         assert achieved == pytest.approx(RATE, rel=0.1)
@@ -122,7 +142,7 @@ def test_a_hung_worker_is_detected_within_100_ms_and_zeroes_its_force_when_it_wa
     engine = Engine(EngineConfig(rate=RATE, source="TRUE", fmax=2.0, hang_timeout=0.08)).start()
     try:
         _wait(lambda: engine.status()["samples"] > 0.2 * RATE)
-        engine.send("stall", 0.4)
+        engine.send(Stall(0.4))
         _wait(lambda: engine.tripped, timeout=3.0, step=0.001)
         last_beat = engine.status()["heartbeat"]
         assert engine.fault_time - last_beat < 0.1

@@ -36,7 +36,7 @@ def wait_until(app, predicate, timeout, step=0.01):
 @pytest.fixture(scope="package")
 def console(qapp):
     from studyapp.gui.console import Console
-    from studyapp.gui.session_controller import SessionController
+    from studyapp.session.controller import SessionController
 
     controller = SessionController(audio="device", midi="first", hang_timeout=0.5)
     window = Console(controller)
@@ -53,11 +53,11 @@ def console(qapp):
 def idle_console(console, qapp):
     """The shared console, its preview engine running, no session, no emergency stop, bow lifted."""
     c = console.controller
-    if c.state in ("starting", "running", "paused"):
+    if c.in_session:
         console.abort_session()
     if c.emergency:
-        c.resume()
-    wait_until(qapp, lambda: c.engine is not None and not c.clearing, ENGINE_START)
+        c.clear_emergency()
+    wait_until(qapp, lambda: c.engine is not None and c.state in ("idle", "finished", "aborted"), ENGINE_START)
     console.set_bowing(False)
     console.turn_knob(0, 0)
     return console

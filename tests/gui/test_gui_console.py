@@ -77,6 +77,11 @@ def test_status_bar_shows_the_loop(idle_console, qapp):
     for key, word in (("load", "Load"), ("misses", "Deadline misses"), ("underruns", "Audio underruns"),
                       ("faults", "Faults")):
         assert console.status.labels[key].text().startswith(word)
+    # a knob turned on screen: the worker applies it and measures its knob-to-effect latency
+    console.turn_knob(1, 90)
+    wait_until(qapp, lambda: console.status.labels["knob"].text().startswith("Knob → effect"), 5)
+    last = console.controller.latency.last
+    assert 0 < last < 1.0 and f"{1e3 * last:.1f} ms" in console.status.labels["knob"].text()
 
 
 def test_scope_receives_data_and_draws_it(idle_console, qapp, tmp_path):
@@ -152,7 +157,7 @@ def test_emergency_stop_zeroes_force(idle_console, qapp):
     assert console.pause_button.text() == "Resume" and not console.start_button.isEnabled()
     # the experimenter clears it: force may flow again (still F_max 0 until someone turns it up)
     console.pause_button.click()
-    wait_until(qapp, lambda: not c.clearing, 5)
+    wait_until(qapp, lambda: c.state in ("idle", "finished", "aborted"), 5)
     assert not engine.status()["fault_latched"] and engine.status_block.force_enable
     bow_preview(console, qapp)
     assert np.max(np.abs(telemetry_after(console, qapp, 0.3)["force"])) > 0.3
@@ -170,6 +175,6 @@ def test_escape_is_the_emergency_stop_in_every_window(idle_console, qapp, qtbot)
         qtbot.keyClick(window, Qt.Key.Key_Escape)
         assert c.emergency
         assert c.engine.status_block.force_enable is False
-        c.resume()
-        wait_until(qapp, lambda: not c.clearing, 5)
+        c.clear_emergency()
+        wait_until(qapp, lambda: c.state in ("idle", "finished", "aborted"), 5)
     console.participant_window.hide()

@@ -112,10 +112,11 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     pads = console.knobs.pads
 
     # rating: the confirm is refused until both knobs are rated
+    # (every control goes through the worker, which applies its action and reports it back)
     qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
-    assert "confirm refused" in console.log.toPlainText()
+    wait_until(qapp, lambda: "confirm refused" in console.log.toPlainText(), 5)
     console.knobs.dials[0].setValue(110)
-    assert "at F_max = 1 N" in console.condition_label.text()
+    wait_until(qapp, lambda: "at F_max = 1 N" in console.condition_label.text(), 5)
     console.blind.setChecked(True)
     assert console.condition_label.text() == "hidden (blinding)"
     assert all(label.text() == "" for label in console.knobs.captions)
@@ -153,7 +154,7 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     assert dial.value() == 0 and console.knobs.captions[0].text() == "F_max"
     dial.setValue(60)
     qtbot.mouseClick(console.stop_button, Qt.MouseButton.LeftButton)
-    assert c.state == "paused" and c.emergency
+    assert c.state == "emergency" and c.emergency
     qtbot.mouseClick(console.pause_button, Qt.MouseButton.LeftButton)
     wait_until(qapp, lambda: c.playing, 10)
     assert dial.value() == 0

@@ -147,6 +147,9 @@ class Adjustment:
     def knob_captions(self, trial, state, knobs, hidden):
         return ["F_max" if i == state.knob_index else "" for i in range(knobs)]
 
+    def knob_actions(self, trial, state):
+        return {f"knob{state.knob_index + 1}": ("fmax_log", state.ceiling, state.decades)}
+
     def response_text(self, response):
         return f"Response recorded: F_max = {response['fmax']:.3g} N."
 

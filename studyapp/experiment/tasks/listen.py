@@ -113,6 +113,9 @@ class Listen:
     def knob_captions(self, trial, state, knobs, hidden):
         return []
 
+    def knob_actions(self, trial, state):
+        return {}
+
     def response_text(self, response):
         return "Listened."
 

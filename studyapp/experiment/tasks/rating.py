@@ -158,6 +158,9 @@ class Rating:
     def knob_captions(self, trial, state, knobs, hidden):
         return [] if hidden else list(trial.conditions)
 
+    def knob_actions(self, trial, state):
+        return {f"knob{j + 1}": ("select", c, state.rating_fmax) for j, c in enumerate(state.conditions)}
+
     def response_text(self, response):
         return "Ratings recorded."
 

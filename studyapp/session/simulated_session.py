@@ -2,11 +2,14 @@
 
 ``SimulatedParticipant.play(runner)`` (``studyapp.experiment``) is written
 against the session runner's methods and blocks while it bows (``advance``).
-In the GUI it runs on its own thread against ``ParticipantProxy``, which acts
+In a console it runs on its own thread against ``ParticipantProxy``, which acts
 out every call on the GUI thread (``act`` runs a function there and waits for
 it) through the console's widgets: ``knob`` turns the on-screen knob, ``pad``
 clicks the on-screen pad, ``set_bowing`` toggles the Bow button and
-``set_gesture`` picks the hand's gesture, just as a mouse would. The study logic stays in the runner, reached through the
+``set_gesture`` picks the hand's gesture, just as a mouse would. A knob or
+pad goes to the engine's worker, which applies its action and reports it
+back; ``knob`` and ``pad`` return once the controller has taken that report
+(as the runner's own methods return once the task has the event). The study logic stays in the runner, reached through the
 same slots a person's clicks reach.
 
 ``advance(seconds)`` waits until the controller has fed that much of the
@@ -26,7 +29,7 @@ import numpy as np
 from studyapp.experiment.simulated_participant import SimulatedParticipant
 
 WAIT_STEP = 0.004  # s between looks at the controller's progress
-ACTIVE = ("starting", "running", "paused")
+ACTIVE = ("starting", "running", "paused", "emergency", "clearing", "engine_lost", "restarting")
 
 
 class Stopped(Exception):
@@ -80,7 +83,7 @@ class ParticipantProxy:
             if c.state == "finished":
                 return None
             self._check()
-            if c.state == "running" and not c.emergency and c.trial_serial > self._seen:
+            if c.state == "running" and c.trial_serial > self._seen:
                 self._seen = c.trial_serial
                 runner = c.runner
                 self._trial = runner.trial
@@ -88,13 +91,19 @@ class ParticipantProxy:
                 return self._trial
             time.sleep(WAIT_STEP)
 
-    def knob(self, index, value):
+    def _control(self, press):
         self._wait_running()
-        self.act(lambda: self.controls.turn_knob(index, value))
+        c = self.controller
+        ticket = self.act(lambda: (press(), c.controls_sent)[1])
+        while ticket is not None and c.controls_taken < ticket:
+            self._check()
+            time.sleep(WAIT_STEP)
+
+    def knob(self, index, value):
+        self._control(lambda: self.controls.turn_knob(index, value))
 
     def pad(self, index):
-        self._wait_running()
-        self.act(lambda: self.controls.press_pad(index))
+        self._control(lambda: self.controls.press_pad(index))
 
     def set_bowing(self, on):
         self._wait_running()

@@ -1,11 +1,12 @@
-"""The GUI's hold on one real-time engine: started and stopped without blocking, read without waiting.
+"""A session's hold on one real-time engine: started and stopped without blocking, read without waiting. No Qt.
 
 Starting the engine (``studyapp.engine.engine.Engine``) spawns its worker,
 imports and loads compiled code: a few seconds. ``EngineHost.start`` does it
-on a background thread, so the console keeps painting; ``state`` tells the
-GUI thread when it is ``running``. The engine calls back (notices, faults)
-from its watchdog thread; those land in a ``queue.SimpleQueue`` that the GUI
-thread drains (``messages``), so no Qt object is touched off its thread.
+on a background thread, so a console keeps painting; ``state`` tells the
+caller's thread when it is ``running``. The engine calls back (notices,
+faults) from its watchdog thread; those land in a ``queue.SimpleQueue`` as
+``events.Notice`` records (with their level) that the caller's thread drains
+(``drain``), so no view is touched off its thread.
 
 ``read()`` copies every telemetry sample written since the last call from the
 shared-memory ring (a seqlock copy: it never waits for the worker and the
@@ -17,8 +18,9 @@ import queue
 import threading
 
 from studyapp.engine.engine import Engine
+from studyapp.engine.events import Notice
 from studyapp.engine.ring import TornRead
-from studyapp.errors import UserError
+from studyapp.errors import EngineError, UserError
 
 
 class EngineHost:
@@ -40,12 +42,12 @@ class EngineHost:
 
     def _start(self):
         try:
-            engine = Engine(self.config, on_fault=lambda text: self.messages.put(("fault", text)),
-                            say=lambda text: self.messages.put(("notice", text)))
+            engine = Engine(self.config, on_fault=lambda text: self.messages.put(Notice(text, "error")),
+                            on_notice=self.messages.put)
             engine.start()
-        except UserError as exc:
+        except (UserError, EngineError) as exc:
             self.error = str(exc)
-            self.messages.put(("error", self.error))
+            self.messages.put(Notice(self.error, "error"))
             return
         if self._cancelled.is_set():
             engine.stop()
@@ -81,7 +83,7 @@ class EngineHost:
         return block if block["end"] > block["start"] else None
 
     def drain(self):
-        """Every ``(kind, text)`` message since the last call: ``notice``, ``fault`` or ``error``."""
+        """Every ``events.Notice`` since the last call (faults and start errors at level ``error``)."""
         out = []
         while True:
             try:

@@ -1,0 +1,120 @@
+"""A fake engine host for the session controller: no process, no Qt; the engine mimics the worker's mapping.
+
+``FakeEngine.send`` records every command and, like the worker, applies an
+on-screen ``Control`` through the mapping installed last, reporting it back
+as an ``events.Applied`` tagged with the mapping's trial. ``run(n)`` makes a
+telemetry block of n samples tagged likewise, which the host's ``read``
+returns once.
+"""
+
+import numpy as np
+
+from studyapp.engine import commands as cmd
+from studyapp.engine.events import Applied
+
+LATENCY = 0.002  # s, what the fake worker reports for every applied control
+
+
+class FakeStatusBlock:
+    force_enable = True
+
+
+class FakeEngine:
+    def __init__(self, config):
+        self.config = config
+        self.names = list(config.estimators)
+        self.info = {"rate": config.rate, "block": 10, "audio": "null", "midi": "none", "paced": "timer",
+                     "realtime": False, "names": self.names}
+        self.sent = []
+        self.faults = []
+        self.status_block = FakeStatusBlock()
+        self.latched = False
+        self.actions = dict(config.actions or {})
+        self.trial = 0
+        self.fmax = 0.0
+        self.samples = 0
+        self.broken = 0.0
+        self._controls = []
+
+    def send(self, command):
+        self.sent.append(command)
+        if isinstance(command, cmd.InstallActions):
+            self.actions, self.trial = dict(command.actions), command.trial
+        elif isinstance(command, cmd.SetFmax):
+            self.fmax = command.newtons
+        elif isinstance(command, cmd.ClearFault):
+            self.latched = False
+        elif isinstance(command, cmd.Control):
+            self.control(command.control, command.value, "screen")
+
+    def control(self, name, value, origin="midi"):
+        action = self.actions.get(name)
+        commands = cmd.action_commands(action, value, 0.0) if action else ()
+        for command in commands:
+            self.sent.append(command)
+            if isinstance(command, cmd.SetFmax):
+                self.fmax = command.newtons
+        self._controls.append(Applied(name, value, 0.0, LATENCY if commands else None, 0, 0, self.trial,
+                                      commands, origin))
+
+    def clear_fault(self):
+        self.send(cmd.ClearFault())
+
+    def controls(self):
+        out, self._controls = self._controls, []
+        return out
+
+    def status(self):
+        latched = self.latched or not self.status_block.force_enable
+        return {"fault": "", "fault_latched": latched, "source": "LVT", "fmax": self.fmax}
+
+    def run(self, n):
+        start, self.samples = self.samples, self.samples + n
+        zeros = np.zeros(n)
+        return {"force": zeros, "position": zeros, "trial": np.full(n, float(self.trial)),
+                "broken": np.full(n, self.broken), "stability_score": np.full(n, 0.002 * self.broken),
+                "estimates": {}, "start": start, "end": start + n}
+
+    def sent_of(self, kind):
+        return [c for c in self.sent if isinstance(c, kind)]
+
+
+class FakeHost:
+    made = []
+
+    def __init__(self, config, describe=""):
+        self.config = config
+        self.describe = describe
+        self.engine = FakeEngine(config)
+        self.state = "starting"
+        self.error = None
+        self.position = 0
+        self.lost = 0
+        self.stopped = False
+        self._blocks = []
+        FakeHost.made.append(self)
+
+    def start(self):
+        return self
+
+    @property
+    def running(self):
+        return self.state == "running"
+
+    def play(self, seconds):
+        """The worker runs ``seconds``; the controller reads it at its next poll."""
+        self._blocks.append(self.engine.run(int(round(seconds * self.config.rate))))
+
+    def read(self):
+        if not self._blocks or not self.running:
+            return None
+        block, self._blocks = self._blocks[0], self._blocks[1:]
+        self.position = block["end"]
+        return block
+
+    def drain(self):
+        return []
+
+    def stop(self, wait=True):
+        self.stopped = True
+        self.state = "stopped"

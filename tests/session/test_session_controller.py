@@ -1,0 +1,326 @@
+"""The session controller's state machine, driven with a fake engine host: no Qt, no worker process."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from studyapp.engine import commands as cmd
+from studyapp.model.fmax_knob import fmax_from_knob
+from studyapp.session.controller import TRANSITIONS, SessionController, State
+from tests.session.fakes import LATENCY, FakeHost
+
+PROTOCOL = """
+[study]
+name = "machine"
+title = "State machine"
+tasks = ["rating", "adjustment"]
+seed = 3
+
+[apparatus]
+rate = 5000.0
+
+[rating]
+conditions = ["LVT", "LOWPASS"]
+fmax = 1.0
+instructions = "Rate the knobs."
+
+[adjustment]
+conditions = ["LVT"]
+trials = 1
+ceiling = 40.0
+decades = 2.0
+instructions = "Turn up until it breaks, then press the pad."
+"""
+
+S = State
+# What each transition must lead to (the spec; TRANSITIONS must list exactly these pairs).
+EXPECTED = {
+    **{(rest, "open"): S.STARTING for rest in (S.IDLE, S.FINISHED, S.ABORTED)},
+    (S.STARTING, "engine_up"): S.RUNNING,
+    (S.STARTING, "engine_failed"): S.ABORTED,
+    (S.STARTING, "abort"): S.ABORTED,
+    (S.RUNNING, "pause"): S.PAUSED,
+    (S.PAUSED, "resume"): S.RUNNING,
+    (S.RUNNING, "done"): S.FINISHED,
+    (S.PAUSED, "done"): S.FINISHED,
+    (S.EMERGENCY, "done"): S.EMERGENCY,  # the session ends; the stop holds until cleared
+    **{(state, "abort"): S.ABORTED
+       for state in (S.RUNNING, S.PAUSED, S.ENGINE_LOST, S.RESTARTING, S.CLEARING)},
+    (S.EMERGENCY, "abort"): S.EMERGENCY,
+    (S.RUNNING, "engine_failed"): S.ENGINE_LOST,
+    (S.PAUSED, "engine_failed"): S.ENGINE_LOST,
+    (S.ENGINE_LOST, "restart"): S.RESTARTING,
+    (S.RESTARTING, "engine_up"): S.RUNNING,
+    (S.RESTARTING, "engine_failed"): S.ENGINE_LOST,
+    **{(state, "emergency"): S.EMERGENCY for state in S},
+    (S.EMERGENCY, "engine_up"): S.EMERGENCY,
+    (S.EMERGENCY, "clear"): S.CLEARING,
+    (S.CLEARING, "cleared"): S.RUNNING,
+    (S.CLEARING, "engine_failed"): S.ENGINE_LOST,
+}
+
+
+@pytest.fixture
+def controller(tmp_path):
+    FakeHost.made.clear()
+    path = tmp_path / "machine.toml"
+    path.write_text(PROTOCOL)
+    c = SessionController(audio="null", midi="none", make_host=FakeHost)
+    c.load_protocol(str(path))
+    c.results = tmp_path / "results"
+    up(c)
+    yield c
+    c.close()
+
+
+def up(c):
+    c.host.state = "running"
+    c.poll()
+
+
+def fail(c):
+    c.host.state = "failed"
+    c.poll()
+
+
+def start(c):
+    """A new session, each with its own participant (one may not have two)."""
+    c.participants = getattr(c, "participants", 0) + 1
+    c.start_session(f"P{c.participants:02d}", c.results)
+
+
+def log(c):
+    """The session log, without each record's stamp (sequence number and times)."""
+    (path,) = Path(c.results).glob("*/*/*/events.jsonl")
+    stamps = ("seq", "mono", "wall")
+    return [{k: v for k, v in json.loads(line).items() if k not in stamps} for line in path.read_text().splitlines()]
+
+
+def play_rating(c):
+    """Rate the two conditions (knob 1 high, knob 2 low) and confirm: the rating trial ends."""
+    c.knob(0, 100)
+    c.knob(1, 20)
+    c.pad(0)
+    c.poll()
+
+
+def reach(c, state):
+    """Drive the controller into ``state`` through its public methods and the engine's states."""
+    if state == S.IDLE:
+        return
+    if state in (S.FINISHED, S.ABORTED):
+        reach(c, S.RUNNING)
+        if state == S.ABORTED:
+            c.abort()
+        else:
+            play_rating(c)
+            c.knob(0, 30)
+            c.pad(0)
+            c.poll()
+        return
+    start(c)
+    if state == S.STARTING:
+        return
+    up(c)
+    if state == S.RUNNING:
+        return
+    if state == S.PAUSED:
+        c.pause()
+    elif state in (S.EMERGENCY, S.CLEARING):
+        c.emergency_stop()
+        if state == S.CLEARING:
+            c.host.engine.latched = True  # the worker latched the stop; clearing waits for it
+            c.clear_emergency()
+    elif state in (S.ENGINE_LOST, S.RESTARTING):
+        fail(c)
+        if state == S.RESTARTING:
+            c.restart_engine()
+
+
+def take(c, state, event):
+    """Make ``event`` happen in ``state`` the way it happens in use."""
+    if event == "open":
+        start(c)
+    elif event == "engine_up":
+        if state == S.EMERGENCY:
+            reach_emergency_while_starting(c)
+        up(c)
+    elif event == "engine_failed":
+        fail(c)
+    elif event == "cleared":
+        c.host.engine.latched = False
+        c.poll()
+    else:
+        {"abort": c.abort, "pause": c.pause, "resume": c.resume, "emergency": c.emergency_stop,
+         "clear": c.clear_emergency, "restart": c.restart_engine, "done": lambda: c.fire("done")}[event]()
+
+
+def reach_emergency_while_starting(c):
+    c.clear_emergency()
+    c.abort()
+    c.poll()
+    start(c)
+    c.emergency_stop()
+
+
+def test_the_table_is_the_spec():
+    assert set(TRANSITIONS) == set(EXPECTED)
+
+
+@pytest.mark.parametrize(("state", "event"), sorted(EXPECTED), ids=lambda x: str(x))
+def test_every_transition(controller, state, event):
+    c = controller
+    reach(c, state)
+    assert c.state == state
+    take(c, state, event)
+    assert c.state == EXPECTED[(state, event)]
+
+
+def test_events_a_state_does_not_list_are_ignored(controller):
+    c = controller
+    c.resume()
+    c.pause()
+    c.restart_engine()
+    assert c.state == S.IDLE and not c.fire("cleared")
+
+
+def test_a_knob_acts_in_the_worker_once_and_reaches_the_task(controller):
+    c = controller
+    start(c)
+    up(c)
+    engine = c.host.engine
+    before = len(engine.sent_of(cmd.SetFmax))
+    c.knob(0, 100)  # rating knob 1: the worker selects its condition at the rating F_max
+    c.poll()
+    assert engine.fmax == 1.0 and c.runner.task.values[c.runner.task.conditions[0]] == 100
+    # one SetFmax, by the worker's own action: the runner's wish for the same F_max is not sent again
+    assert len(engine.sent_of(cmd.SetFmax)) == before + 1
+    assert c.latency.last == LATENCY
+    c.knob(1, 20)
+    c.pad(0)
+    c.poll()
+    # the adjustment trial: knob 1 sets F_max on the protocol's logarithmic scale, in the worker
+    c.knob(0, 30)
+    c.poll()
+    assert engine.fmax == pytest.approx(fmax_from_knob(30, 40.0, 2.0))
+    assert c.runner.task.fmax == engine.fmax
+    records = [e for e in log(c) if e["type"] == "knob_latency"]
+    assert records == [{"step": 0, "task": "rating", "type": "knob_latency", "controls": 2, "midi": 0,
+                        "median": LATENCY, "max": LATENCY}]
+
+
+def test_midi_and_controls_of_an_old_or_held_trial_do_not_reach_the_task(controller):
+    c = controller
+    start(c)
+    up(c)
+    engine = c.host.engine
+    engine.control("knob1", 64 / 127)  # a MIDI knob
+    c.poll()
+    task = c.runner.task
+    assert task.values[task.conditions[0]] == 64
+    c.pause()
+    c.knob(1, 10)  # on screen while paused: refused
+    engine.control("knob2", 10 / 127)  # MIDI while paused: the worker holds no mapping, the task ignores it
+    c.poll()
+    assert task.values[task.conditions[1]] is None
+    assert engine.trial == -c.trial_serial and engine.actions == {}
+    c.resume()
+    assert engine.fmax == 1.0 and engine.trial == c.trial_serial
+
+
+def test_samples_reach_the_trial_only_while_it_plays_and_the_verdict_is_the_workers(controller):
+    c = controller
+    start(c)
+    up(c)
+    c.knob(0, 100)
+    c.poll()
+    task = c.runner.task
+    c.host.play(0.1)
+    c.poll()
+    assert task.elapsed == pytest.approx(0.1)
+    c.pause()
+    c.host.play(0.2)
+    c.poll()
+    c.resume()
+    c.host.engine.broken = 1.0
+    c.host.play(0.05)  # resumed: this block counts, and the worker calls it broken
+    c.poll()
+    assert task.elapsed == pytest.approx(0.15)
+    stability = [e for e in log(c) if e["type"] == "stability"]
+    assert stability == [{"step": 0, "task": "rating", "type": "stability", "broken": True, "score": 0.002,
+                          "fmax": 1.0}]
+
+
+def test_emergency_stop_zeroes_at_once_and_the_trial_starts_again_when_cleared(controller):
+    c = controller
+    start(c)
+    up(c)
+    play_rating(c)
+    engine = c.host.engine
+    c.knob(0, 60)
+    c.poll()
+    c.emergency_stop()
+    assert c.state == S.EMERGENCY and engine.status_block.force_enable is False
+    assert engine.sent[-3:] == [cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.InstallActions({}, trial=-2)]
+    assert not c.accepting
+    c.knob(0, 90)  # refused
+    engine.latched = True
+    c.clear_emergency()
+    assert c.state == S.CLEARING and engine.status_block.force_enable and engine.sent[-1] == cmd.ClearFault()
+    c.poll()
+    assert c.state == S.RUNNING and c.runner.task.value == 0 and engine.fmax == 0.0
+    events = log(c)
+    assert [e["type"] for e in events][-5:] == ["emergency_stop", "emergency_clear", "resume", "knob_latency",
+                                                "trial_start"]
+    assert [e["value"] for e in events if e["type"] == "knob" and e["task"] == "adjustment"] == [60]
+    assert [e["restart"] for e in events if e["type"] == "trial_start" and e["task"] == "adjustment"] == [
+        False, True]
+
+
+def test_an_emergency_stop_while_the_engine_starts_holds_the_new_engine(controller):
+    c = controller
+    start(c)
+    c.emergency_stop()
+    up(c)
+    engine = c.host.engine
+    assert c.state == S.EMERGENCY and engine.status_block.force_enable is False
+    assert engine.fmax == 0.0 and engine.actions == {}
+    engine.latched = True
+    c.clear_emergency()
+    engine.latched = False
+    c.poll()
+    assert c.state == S.RUNNING and c.runner.trial.step == 0
+
+
+def test_a_lost_engine_is_replaced_and_the_trial_starts_again(controller):
+    c = controller
+    start(c)
+    up(c)
+    c.knob(0, 100)
+    c.poll()
+    lost = c.host
+    fail(c)
+    assert c.state == S.ENGINE_LOST and c.engine is None
+    c.restart_engine()
+    assert c.state == S.RESTARTING and c.host is not lost and lost.stopped
+    assert c.host.config == lost.config  # the same seed and scene
+    up(c)
+    assert c.state == S.RUNNING and c.runner.loop.engine is c.host.engine
+    events = log(c)
+    assert [e["type"] for e in events if e["type"] in ("engine", "engine_failed")] == [
+        "engine", "engine_failed", "engine"]
+    assert [e["restart"] for e in events if e["type"] == "trial_start"] == [False, True]
+    assert events[-1]["restored_knobs"] == 1  # the rating knob turned before the loss comes back
+
+
+def test_after_a_session_the_engine_is_the_preview_again(controller):
+    c = controller
+    reach(c, S.FINISHED)
+    engine = c.host.engine
+    assert engine.actions == cmd.default_actions(["LVT", "LOWPASS"])
+    c.knob(0, 127)  # the live knob 1: F_max over the live range
+    c.poll()
+    assert engine.fmax == 20.0
+    events = log(c)
+    assert events[-2]["type"] == "session_end" and events[-1] == {"type": "run_stop", "reason": "done"}
