@@ -182,11 +182,6 @@ class SimulatedDevice(HapticDevice):
         self._target = None  # the hand's target at the sample last read
 
     @property
-    def moving_mass(self):
-        """Device plus hand (kg)."""
-        return float(self._dp[DP_MASS])
-
-    @property
     def fault(self):
         if self._ds[DS_FAULT] != 0.0:
             return "the virtual hand's force was non-finite; the hand let go and the handle was put at rest"
