@@ -1,6 +1,6 @@
 """The virtual hand: an arm impedance that couples a gesture to the handle.
 
-The hand holds the handle; its effective mass moves with it (loop.py adds
+The hand holds the handle; its effective mass moves with it (simulated_device.py adds
 ``mass`` to the device's). It follows the gesture's target x_g(t) (gestures.py)
 with a feedforward of the intended motion plus a spring and a damper around it:
 

@@ -1,19 +1,24 @@
-"""The closed haptic loop (paper Fig. 1), one compiled function per block.
+"""The closed haptic loop (paper Fig. 1): the controller and a device, block by block.
 
 One sample k of the loop:
 
-    hand + device state x[k], v[k]        (device.py, hand.py)
-    -> sensors: LVDT x_m, LVT v_m, accelerometer a_m    (sensors.py)
-    -> the source velocity: the selected estimator stepped on (x_m, a_m, v_m)
-       (studyapp.estimators.dispatch.step_guarded), the LVT sensor, or TRUE v[k]
-    -> bow: v_bow = s * v_source (string units; s = VELOCITY_SCALE, calibration.py)
-    -> string step (bowed_string.py): u = rho(v_delta) v_delta
-    -> force F[k] = -G u * force_scale, clamped to the motor limits (device.py)
-    -> the device moves over [k, k+1] under F[k] plus the hand's force
+    device: hand + mechanics at x[k], v[k] -> sensors x_m, v_m, a_m       (a HapticDevice, device.py)
+    -> controller: source velocity -> bow -> string -> force F[k],
+       clamped to the motor limits                                       (control.py)
+    -> device: moves over [k, k+1] under F[k] (plus the hand's force)
 
 so the position sampled at k+1 is the first to feel F[k] (one-step delay).
-G = F_max / max|rho(v) v| makes the peak friction force F_max (bow_table.py,
-paper eqs. 2 and 20).
+
+Every device goes through one path: ``run(n)`` calls
+``device.exchange(control, n, out, est_out)`` once. A real driver inherits
+the interface's per-sample ``exchange`` (read the sensors, ``control.sample``,
+write the force); the simulated device (simulated_device.py, the default)
+overrides it with one compiled function per block that fuses its mechanics,
+sensors and hand with the same compiled controller, and gives the same
+samples. The loop holds no knowledge of which it drives: what a simulation
+knows beyond its sensors (the true motion, for the source TRUE and the
+recorded ``*_true`` columns) comes through ``device.truth()``, the gesture
+through ``device.follow``.
 
 The other active estimators only observe the stream, so they are stepped
 after the block over its recorded sensor samples: exactly the per-sample
@@ -21,65 +26,42 @@ result (a test checks it against the Bank's block form), without a dispatch
 per estimator per sample inside the loop, and every estimator is warm when
 the source switches at a block boundary.
 
-The stability monitor (stability.py) is advanced per sample inside the block.
-Python runs only at block boundaries: it draws the block's sensor noise from
-seeded generators (one per sensor, two for the accelerometer's white and
-low-frequency noise, so the stream does not depend on how the run is cut into
-blocks), computes the gesture's target, applies setting
-changes (source, F_max, force scale, bowing, gesture) and reads the
-monitor's verdict. Everything inside a block is one ``@njit`` function.
+The stability monitor (stability.py) is advanced per sample by the
+controller. Python runs only at block boundaries: it applies setting changes
+(source, F_max, force scale, bowing, gesture) and reads the monitor's
+verdict.
 
-Built only as needed: no accelerometer (filter, noise) when no active
-estimator reads acceleration (unless ``accelerometer=True``), and no body
-filter when ``audio=False``.
+Built only as needed: the default device has no accelerometer (filter,
+noise) when no active estimator reads acceleration (unless
+``accelerometer=True``), and there is no body filter when ``audio=False``.
 
-Compiled with numpy's error model (as the estimator dispatch is): a division
-by zero gives inf, not an exception, and inf is caught as a fault below. The
-block releases the GIL (``nogil``): in the live engine the audio device's
-callback thread needs it. Holding it through every block, a 10-minute run at
-48 kHz on a dummy JACK server had one "client not finished" xrun; releasing
-it, two such runs had none.
-
-Safety: a non-finite value anywhere (sensor, estimate, string, device) latches
-``fault`` (a one-line description); from that sample on the force is 0 and the
-bow is lifted.
+Safety: a non-finite value anywhere (sensor, estimate, string, force) latches
+``fault`` (a one-line description); from that sample on the force is 0 and
+the bow is lifted. A device that reports its own ``fault`` has it latched at
+the end of the block.
 """
 
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from studyapp.errors import ParameterError
 from studyapp.estimators import Bank
-from studyapp.estimators.dispatch import run_block as run_estimator_block
-from studyapp.estimators.dispatch import step_guarded
 from studyapp.estimators.registry import SPECS
 from studyapp.estimators.spec import validate_rate
-from studyapp.model import body, bow_table, bowed_string, calibration, contact_mic, hand, sensors, stability
-from studyapp.model import device as mechanics
+from studyapp.model import body, bow_table, bowed_string, calibration, contact_mic, control
+from studyapp.model.control import (
+    C_BOWING, C_BREAKAWAY, C_FORCE_SCALE, C_GAIN, C_PEAK, C_SCALE, C_SOURCE, C_USE_AUDIO, FAULT_DEVICE, FAULT_ESTIMATE,
+    FAULT_FORCE, FAULT_SENSOR, FAULT_STRING, L_FAULT, L_FAULT_SAMPLE, N_CONTROL, N_LOOP_STATE, OUTPUTS,
+)
+from studyapp.model.device import N_LIMIT_STATE, HapticDevice
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
+from studyapp.model.simulated_device import SimulatedDevice
 from studyapp.model.sources import LVT_SENSOR, LVT_SENSOR_INDEX, TRUE, TRUE_INDEX, with_pseudo_sources
 from studyapp.model.stability import StabilityMonitor
 
 FMAX_LIMIT = 200.0  # N: nothing above the motors' impulsive limit makes sense
 F0_RANGE = (20.0, 2000.0)
-
-# control vector
-C_GAIN, C_SCALE, C_FORCE_SCALE, C_BOWING, C_SOURCE, C_USE_ACC, C_USE_AUDIO, C_PEAK, C_BREAKAWAY = range(9)
-N_CONTROL = 9
-# loop state
-L_FAULT, L_FAULT_SAMPLE, L_PUSH = range(3)
-FAULT_SENSOR, FAULT_ESTIMATE, FAULT_STRING, FAULT_DEVICE = 1, 2, 3, 4
-# output rows
-(O_POSITION, O_VELOCITY_LVT, O_ACCELERATION, O_VELOCITY_TRUE, O_ACCELERATION_TRUE,
- O_FORCE, O_STRING_VELOCITY, O_AUDIO, O_SOURCE_VELOCITY, O_V_DELTA, O_STICK, O_HAND_FORCE,
- O_FRICTION, O_POSITION_TRUE) = range(14)
-OUTPUTS = (
-    "position", "velocity_lvt", "acceleration", "velocity_true", "acceleration_true",
-    "force", "string_velocity", "audio", "source_velocity", "v_delta", "stick", "hand_force", "friction",
-    "position_true",
-)
 
 GESTURES = ("strokes", "strokes-validation", "hold", "live", "playback")
 
@@ -137,150 +119,9 @@ def check_f0(f0):
     return value
 
 
-@njit(cache=True, inline="always")
-def _bad(x):
-    return not np.isfinite(x)
-
-
-@njit(cache=True, inline="always")
-def _fault(state, code, k):
-    if state[L_FAULT] == 0.0:
-        state[L_FAULT] = code
-        state[L_FAULT_SAMPLE] = k
-
-
-@njit(cache=True, inline="always")
-def bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out):
-    """The string and the force for one sample of the source velocity; returns the unclamped force (N)."""
-    if _bad(v_src):
-        _fault(state, FAULT_ESTIMATE, k)
-    faulted = state[L_FAULT] != 0.0
-    bowing = ctl[C_BOWING] != 0.0 and not faulted
-    v_bow = ctl[C_SCALE] * v_src if bowing else 0.0
-    u, v_string, v_bridge, v_delta = bowed_string.step(sp, ss, bridge, nut, v_bow, bowing)
-    if _bad(u) or _bad(v_string) or _bad(v_bridge):
-        _fault(state, FAULT_STRING, k)
-        # a poisoned string is set back to rest so every output stays finite
-        bridge[:] = 0.0
-        nut[:] = 0.0
-        ss[:] = 0.0
-        u = 0.0
-        v_string = 0.0
-        v_bridge = 0.0
-        v_delta = 0.0
-    if state[L_FAULT] != 0.0:
-        u = 0.0
-    audio = 0.0
-    if ctl[C_USE_AUDIO] != 0.0:
-        audio = v_bridge
-        for j in range(body_s.shape[0] // 2):
-            audio = sensors.section_at(body_p, 5 * j, body_s, 2 * j, audio)
-    friction = u / ctl[C_PEAK]
-    out[O_SOURCE_VELOCITY, k] = v_src
-    out[O_STRING_VELOCITY, k] = v_string / ctl[C_SCALE]
-    out[O_AUDIO, k] = audio
-    out[O_V_DELTA, k] = v_delta
-    out[O_FRICTION, k] = friction
-    out[O_STICK, k] = 1.0 if bowing and abs(v_delta) <= ctl[C_BREAKAWAY] else 0.0
-    return -ctl[C_GAIN] * u * ctl[C_FORCE_SCALE]
-
-
-@njit(cache=True, error_model="numpy")
-def observe_others(src, kinds, est_s, est_p, out, est_out):
-    """Advance every estimator but the source over the block, from the recorded sensor rows.
-
-    They only observe the stream, so stepping each over the whole block in turn
-    gives exactly the per-sample result (DESIGN.md, "Data flow").
-    """
-    for e in range(kinds.shape[0]):
-        if e != src:
-            run_estimator_block(kinds[e], est_s[e], est_p[e], out[O_POSITION], out[O_ACCELERATION],
-                                out[O_VELOCITY_LVT], est_out[e])
-
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def run_block(ctl, state, dp, ds, hp, snp, sns, kinds, est_s, est_p, sp, ss, bridge, nut,
-              body_p, body_s, cp, cs, mp, ms, target, target_v, target_a, noise_x, noise_v, noise_a, noise_lf,
-              out, est_out):
-    """``target.shape[0]`` samples of the simulated world; fills ``out`` and ``est_out``."""
-    n = target.shape[0]
-    use_acc = ctl[C_USE_ACC] != 0.0
-    src = int(ctl[C_SOURCE])
-    for k in range(n):
-        x = ds[mechanics.DS_X]
-        v = ds[mechanics.DS_V]
-        a = ds[mechanics.DS_A]
-        x_m = sensors.lvdt(snp, x, noise_x[k])
-        v_m = sensors.lvt(snp, sns, v, noise_v[k])
-        a_m = sensors.accelerometer(snp, sns, a, noise_a[k], noise_lf[k]) if use_acc else 0.0
-        if _bad(x_m) or _bad(v_m) or _bad(a_m):
-            _fault(state, FAULT_SENSOR, k)
-        if src >= 0:
-            v_src = step_guarded(kinds[src], est_s[src], est_p[src], x_m, a_m, v_m)
-            est_out[src, k] = v_src
-        elif src == TRUE_INDEX:
-            v_src = v
-        else:
-            v_src = v_m
-        f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out)
-        stability.observe(mp, ms, v)
-        if ctl[C_USE_AUDIO] != 0.0:
-            out[O_AUDIO, k] += contact_mic.step(cp, cs, a)
-        f = mechanics.clamp_force(dp, ds, f)
-        f_hand = hand.force(hp, target[k], target_v[k], target_a[k], x, v, state[L_PUSH])
-        if _bad(f) or _bad(f_hand):
-            _fault(state, FAULT_DEVICE, k)
-        if state[L_FAULT] != 0.0:
-            f = 0.0
-            if _bad(f_hand) or _bad(state[L_PUSH]):
-                f_hand = 0.0
-                state[L_PUSH] = 0.0
-                ds[mechanics.DS_X] = 0.0
-                ds[mechanics.DS_V] = 0.0
-                ds[mechanics.DS_A] = 0.0
-        state[L_PUSH] = hand.learn_push(hp, state[L_PUSH], f)
-        out[O_POSITION, k] = x_m
-        out[O_VELOCITY_LVT, k] = v_m
-        out[O_ACCELERATION, k] = a_m
-        out[O_VELOCITY_TRUE, k] = v
-        out[O_ACCELERATION_TRUE, k] = a
-        out[O_POSITION_TRUE, k] = x
-        out[O_FORCE, k] = f
-        out[O_HAND_FORCE, k] = f_hand
-        mechanics.advance(dp, ds, f + f_hand)
-    observe_others(src, kinds, est_s, est_p, out, est_out)
-
-
-@njit(cache=True, error_model="numpy")
-def run_external_sample(ctl, state, k, dp, ds, kinds, est_s, est_p, sp, ss, bridge, nut,
-                        body_p, body_s, cp, cs, mp, ms, x_m, a_m, v_m, out, est_out):
-    """One sample for a device outside the simulation: returns the clamped force command."""
-    if _bad(x_m) or _bad(v_m) or _bad(a_m):
-        _fault(state, FAULT_SENSOR, k)
-    for e in range(kinds.shape[0]):
-        est_out[e, k] = step_guarded(kinds[e], est_s[e], est_p[e], x_m, a_m, v_m)
-    src = int(ctl[C_SOURCE])
-    v_src = est_out[src, k] if src >= 0 else v_m
-    f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out)
-    stability.observe(mp, ms, v_m)
-    if ctl[C_USE_AUDIO] != 0.0:
-        out[O_AUDIO, k] += contact_mic.step(cp, cs, a_m)
-    f = mechanics.clamp_force(dp, ds, f)
-    if state[L_FAULT] != 0.0 or _bad(f):
-        f = 0.0
-    out[O_POSITION, k] = x_m
-    out[O_VELOCITY_LVT, k] = v_m
-    out[O_ACCELERATION, k] = a_m
-    out[O_VELOCITY_TRUE, k] = np.nan
-    out[O_ACCELERATION_TRUE, k] = np.nan
-    out[O_POSITION_TRUE, k] = np.nan
-    out[O_FORCE, k] = f
-    out[O_HAND_FORCE, k] = np.nan
-    return f
-
 
 class ClosedLoop:
-    """The simulated world (or a real device) with the string, run block by block.
+    """A device (the simulated one by default, or any ``HapticDevice``) with the string, run block by block.
 
     ``run(n)`` advances ``n`` samples and returns a dict of length-n arrays
     (``OUTPUTS`` plus ``t`` and ``estimates``, shape (len(names), n)).
@@ -289,7 +130,6 @@ class ClosedLoop:
 
     def __init__(self, config=None, device=None):
         config = config or LoopConfig()
-        dev = device
         self.config = config
         self.rate = validate_rate(config.rate)
         f0 = check_f0(calibration.F0 if config.f0 is None else config.f0)
@@ -299,44 +139,39 @@ class ClosedLoop:
         self.bank = Bank(self.rate, estimators)
         self.names = list(self.bank.names)
         self.reads = set(self.bank.reads)
-        if dev is None:
-            dev = mechanics.SimulatedDevice(self.rate, calibration.DEVICE_MASS)
-        self.device = dev
-        self.simulated = isinstance(dev, mechanics.SimulatedDevice)
-        if getattr(dev, "rate", self.rate) != self.rate:
-            raise ParameterError(f"device rate {dev.rate:g} Hz differs from the loop rate {self.rate:g} Hz")
+        if device is None:
+            use_acc = ("acceleration" in self.reads) if config.accelerometer is None else bool(config.accelerometer)
+            device = SimulatedDevice(self.rate, seed=config.seed, accelerometer=use_acc)
+        elif not isinstance(device, HapticDevice):
+            raise ParameterError(f"device {type(device).__name__}: expected a studyapp.model.device.HapticDevice "
+                                 "(subclass it and implement read_sensors and write_force)")
+        if getattr(device, "rate", self.rate) != self.rate:
+            raise ParameterError(f"device rate {device.rate:g} Hz differs from the loop rate {self.rate:g} Hz")
+        self.device = device
         self.string = bowed_string.StringDesign(self.rate, f0)
-        self.sensor_spec = sensors.SensorSpec()
-        self.hand = hand.HandImpedance(calibration.HAND_MASS, calibration.HAND_STIFFNESS, calibration.HAND_DAMPING,
-                                       calibration.HAND_REACTION)
         self.velocity_scale = calibration.VELOCITY_SCALE
-        use_acc = ("acceleration" in self.reads) if config.accelerometer is None else bool(config.accelerometer)
         self._ctl = np.zeros(N_CONTROL)
         self._ctl[C_SCALE] = self.velocity_scale
         self._ctl[C_PEAK] = self.string.peak_friction()
         self._ctl[C_BREAKAWAY] = bow_table.breakaway(self.string.slope, self.string.offset)
         self._ctl[C_FORCE_SCALE] = 1.0
         self._ctl[C_BOWING] = 1.0
-        self._ctl[C_USE_ACC] = 1.0 if use_acc else 0.0
         self._ctl[C_USE_AUDIO] = 1.0 if config.audio else 0.0
-        self._state = np.zeros(3)
-        # the hand's mass moves with the handle (hand.py)
-        self._dp = dev.params(extra_mass=self.hand.mass) if self.simulated else _limits_params(self.rate, dev.limits)
-        self._ds = np.zeros(mechanics.N_STATE)
-        self._hp = self.hand.params(self._dp[mechanics.DP_MASS], self.rate) if self.simulated else np.zeros(4)
-        self._snp = self.sensor_spec.params(self.rate)
-        self._sns = np.zeros(sensors.N_STATE)
+        self._state = np.zeros(N_LOOP_STATE)
         self._sp = self.string.params()
         self._ss, self._bridge, self._nut = self.string.new_state()
         self._body = body.sections(self.rate).ravel() if config.audio else np.zeros(0)
         self._body_s = np.zeros(2 * (self._body.shape[0] // 5))
         self._mic = contact_mic.params(self.rate)
         self._mic_s = contact_mic.new_state()
-        # the accelerometer's low-frequency noise is the 4th child, so the first three streams stay as they were
-        seeds = np.random.SeedSequence(int(config.seed)).spawn(4)
-        self._rng_x, self._rng_v, self._rng_a, self._rng_lf = (np.random.default_rng(s) for s in seeds)
         self._sample = 0
         self._fault_text = None
+        self.monitor = StabilityMonitor(self.rate, f0)
+        self.control = control.Control((
+            self._ctl, self._state, device.limits.params(self.rate), np.zeros(N_LIMIT_STATE),
+            self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss, self._bridge, self._nut,
+            self._body, self._body_s, self.monitor.params, self.monitor.state, self._mic, self._mic_s,
+        ))
         self.source = None
         self.set_source(config.source)
         self.fmax = None
@@ -344,12 +179,11 @@ class ClosedLoop:
         self.gesture_name = None
         self._trajectory = config.trajectory
         self.set_gesture(config.gesture)
-        self.monitor = StabilityMonitor(self.rate, f0)
 
     # settings -------------------------------------------------------------
     def set_source(self, name):
         if name == TRUE:
-            if not self.simulated:
+            if self.device.truth() is None:
                 raise ParameterError(f"source {TRUE!r} needs the simulated device (a real one has no true velocity)")
             index = TRUE_INDEX
         elif name == LVT_SENSOR:
@@ -380,9 +214,10 @@ class ClosedLoop:
     def set_gesture(self, name, trajectory=None):
         if trajectory is not None:
             self._trajectory = trajectory
-        position = self._ds[mechanics.DS_X] if self.simulated else 0.0
+        truth = self.device.truth()
+        position = truth[0] if truth is not None else 0.0
         self._gesture = make_gesture(name, self.rate, self._trajectory, position)
-        self._gesture_start = self._sample
+        self.device.follow(self._gesture)
         self.gesture_name = name
 
     def set_hand_target(self, x_m):
@@ -421,10 +256,12 @@ class ClosedLoop:
             raise ParameterError(f"n = {n}: allowed is a number of samples >= 0")
         out = np.zeros((len(OUTPUTS), n))
         est = np.zeros((len(self.names), n))
-        if self.simulated:
-            self._run_simulated(n, out, est)
-        else:
-            self._run_external(n, out, est)
+        self.device.exchange(self.control, n, out, est)
+        src = int(self._ctl[C_SOURCE])
+        control.observe_others(src, self.bank.kinds, self.bank.states, self.bank.params, out, est)
+        if self._state[L_FAULT] == 0.0 and self.device.fault:
+            self._state[L_FAULT] = FAULT_DEVICE
+            self._state[L_FAULT_SAMPLE] = max(n - 1, 0)
         if self._fault_text is None and self._state[L_FAULT] != 0.0:
             self._fault_text = self._describe_fault()
         result = {name: out[i] for i, name in enumerate(OUTPUTS)}
@@ -434,31 +271,6 @@ class ClosedLoop:
         self.monitor.judge()
         return result
 
-    def _run_simulated(self, n, out, est):
-        target, target_v, target_a = self._gesture.block(self._sample - self._gesture_start, n, self.rate)
-        nx = self._rng_x.standard_normal(n)
-        nv = self._rng_v.standard_normal(n)
-        na = self._rng_a.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
-        nl = self._rng_lf.standard_normal(n) if self._ctl[C_USE_ACC] else np.zeros(n)
-        run_block(self._ctl, self._state, self._dp, self._ds, self._hp, self._snp, self._sns,
-                  self.bank.kinds, self.bank.states, self.bank.params, self._sp, self._ss,
-                  self._bridge, self._nut, self._body, self._body_s, self._mic, self._mic_s,
-                  self.monitor.params, self.monitor.state,
-                  np.ascontiguousarray(target), np.ascontiguousarray(target_v), np.ascontiguousarray(target_a),
-                  nx, nv, na, nl, out, est)
-
-    def _run_external(self, n, out, est):
-        dev = self.device
-        for k in range(n):
-            x_m, a_m, v_m = dev.read_sensors()
-            f = run_external_sample(self._ctl, self._state, k, self._dp, self._ds, self.bank.kinds,
-                                    self.bank.states, self.bank.params, self._sp, self._ss, self._bridge,
-                                    self._nut, self._body, self._body_s, self._mic, self._mic_s, self.monitor.params,
-                                    self.monitor.state,
-                                    float(x_m), float(a_m), float(v_m),
-                                    out, est)
-            dev.write_force(f)
-
     def _describe_fault(self):
         code = int(self._state[L_FAULT])
         t = (self._sample + max(self._state[L_FAULT_SAMPLE], 0)) / self.rate
@@ -466,10 +278,8 @@ class ClosedLoop:
             FAULT_SENSOR: "a sensor sample",
             FAULT_ESTIMATE: f"the velocity source {self.source}",
             FAULT_STRING: "the string model",
-            FAULT_DEVICE: "the device force",
-        }[code]
-        return f"non-finite value from {what} at t = {t:.4f} s; force held at 0"
-
-
-def _limits_params(rate, limits):
-    return mechanics.SimulatedDevice(rate, 1.0, limits).params()
+            FAULT_FORCE: "the device force",
+        }
+        if code == FAULT_DEVICE:
+            return f"the device reported a fault at t = {t:.4f} s ({self.device.fault}); force held at 0"
+        return f"non-finite value from {what[code]} at t = {t:.4f} s; force held at 0"

@@ -13,7 +13,7 @@ handle's true velocity turns this coupling from a brake into a drive, and past
 a gain the loop oscillates by itself: the force swings between +F_max and
 -F_max at that frequency, the handle buzzes (mm/s) and the string
 near the bow rings with it (the sound distorts; the handle's buzz is heard
-too, loop.py).
+too, control.py).
 
 Criterion, on absolute quantities (pinned by tests/model/test_model_stability.py).
 The monitor watches the handle's velocity v (m/s: the simulation's true

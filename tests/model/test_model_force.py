@@ -51,13 +51,13 @@ def _hold_command(p, s, command, n, out):
 
 def test_motor_limits_impulsive_and_sustained():
     rate = 5000.0
-    dev = device.SimulatedDevice(rate, 1.0)
-    p, s = dev.params(), np.zeros(device.N_STATE)
+    limits = device.DeviceLimits()
+    p, s = limits.params(rate), np.zeros(device.N_LIMIT_STATE)
     out = np.empty(int(5 * rate))
     _hold_command(p, s, 500.0, out.size, out)
     assert out[0] == 200.0  # impulsive limit
     # the mean square of F climbs as 200^2 (1 - exp(-t / tau)) until its root passes 60 N
-    t_switch = -dev.limits.sustained_window * np.log(1.0 - (60.0 / 200.0) ** 2)
+    t_switch = -limits.sustained_window * np.log(1.0 - (60.0 / 200.0) ** 2)
     first_60 = np.argmax(out < 200.0) / rate
     assert first_60 == pytest.approx(t_switch, abs=2.0 / rate)
     # from then on the RMS stays at the sustained limit

@@ -1,0 +1,231 @@
+"""The simulated 1-DOF device, held by the virtual hand, behind the device interface (paper Sec. 4).
+
+``SimulatedDevice`` is a ``HapticDevice`` (device.py): the loop drives it as
+it drives a real one. It holds what a real device has in the world: the
+moving mass, the sensors (sensors.py) with their seeded noise, and the hand
+that holds the handle and follows a gesture (hand.py, gestures.py).
+
+The mechanics: a moving mass m (device plus hand: the hand's mass moves with
+the handle) between end stops at +-11 mm (the LVDT's 2.2 cm range), pushed by
+the motor and by the hand. The force command F[k] computed from the sensors
+at sample k is held over [k, k+1] (zero-order hold), so the position sampled
+at k+1 is the first to feel it: the one-step delay of the paper's Fig. 1 and
+Sec. 2. Over one step the mass moves exactly under the constant total force f:
+
+    x[k+1] = x[k] + T v[k] + T^2 f / (2 m),   v[k+1] = v[k] + T f / m
+
+and an end stop is inelastic: the position is held at the stop and the
+velocity into it is set to zero (a rigid stop; stable at any rate).
+
+Two paths give the same samples. ``read_sensors`` / ``write_force`` step the
+world one sample (the hand's force and the sensors from the state at k, then
+the move under F[k] plus the hand's force); ``exchange`` runs a whole block in
+one compiled function that calls the loop's compiled controller
+(control.sample) between the same two steps, releasing the GIL (``nogil``:
+in the live engine the audio device's callback thread needs it). Python runs
+only at block boundaries there: it draws the block's sensor noise from seeded
+generators (one per sensor, two for the accelerometer's white and
+low-frequency noise, so the stream does not depend on how the run is cut into
+blocks or samples) and computes the gesture's target. A gesture defined per
+block (``Live``, which ramps to its new target across the next block) ramps
+across one sample when read sample by sample.
+
+No accelerometer (filter, noise) when ``accelerometer=False``: it reads 0.
+
+A non-finite hand force (a gesture that overflows) makes the hand let go and
+puts the handle at rest at 0, keeping every output finite, and sets ``fault``.
+"""
+
+import numpy as np
+from numba import njit
+
+from studyapp.estimators.dispatch import step_guarded
+from studyapp.model import calibration, contact_mic, control, hand, sensors, stability
+from studyapp.model.device import DeviceLimits, HapticDevice
+from studyapp.model.gestures import Hold
+from studyapp.model.sources import TRUE_INDEX
+
+DP_T, DP_MASS, DP_TRAVEL, DP_ACCELEROMETER = range(4)
+N_PARAMS = 4
+# state: true position, velocity, acceleration over the last step, the hand's push, fault
+DS_X, DS_V, DS_A, DS_PUSH, DS_FAULT = range(5)
+N_STATE = 5
+
+
+@njit(cache=True, inline="always")
+def hand_force(hp, ds, x_target, v_target, a_target):
+    """The hand's force on the handle now (N), as given (non-finite included)."""
+    return hand.force(hp, x_target, v_target, a_target, ds[DS_X], ds[DS_V], ds[DS_PUSH])
+
+
+@njit(cache=True, inline="always")
+def sense(use_acc, ds, snp, sns, noise_x, noise_v, noise_a, noise_lf):
+    """The sensors on the state now: (x_m, a_m, v_m)."""
+    x_m = sensors.lvdt(snp, ds[DS_X], noise_x)
+    v_m = sensors.lvt(snp, sns, ds[DS_V], noise_v)
+    a_m = sensors.accelerometer(snp, sns, ds[DS_A], noise_a, noise_lf) if use_acc else 0.0
+    return x_m, a_m, v_m
+
+
+@njit(cache=True, inline="always")
+def advance(dp, ds, f_total):
+    """Move the mass over one sample under the constant force ``f_total`` (N)."""
+    t = dp[DP_T]
+    a = f_total / dp[DP_MASS]
+    v0 = ds[DS_V]
+    x = ds[DS_X] + t * v0 + 0.5 * t * t * a
+    v = v0 + t * a
+    stop = dp[DP_TRAVEL]
+    if x > stop:
+        x = stop
+        if v > 0.0:
+            v = 0.0
+    elif x < -stop:
+        x = -stop
+        if v < 0.0:
+            v = 0.0
+    ds[DS_X] = x
+    ds[DS_A] = (v - v0) / t
+    ds[DS_V] = v
+
+
+@njit(cache=True, inline="always")
+def actuate(dp, ds, hp, f, f_hand):
+    """The step [k, k+1] under the command ``f`` and the hand's force ``f_hand`` (from ``hand_force``)."""
+    if not np.isfinite(f_hand):
+        f_hand = 0.0
+        ds[DS_PUSH] = 0.0
+        ds[DS_X] = 0.0
+        ds[DS_V] = 0.0
+        ds[DS_A] = 0.0
+        ds[DS_FAULT] = 1.0
+    ds[DS_PUSH] = hand.learn_push(hp, ds[DS_PUSH], f)
+    advance(dp, ds, f + f_hand)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, noise_v, noise_a, noise_lf,
+              out, est_out):
+    """``target.shape[0]`` samples of the device and the loop's controller ``c``: control.sample's sequence."""
+    ctl, state, lp, ls, kinds, est_s, est_p, sp, ss, bridge, nut, body_p, body_s, mon_p, mon_s, mic_p, mic_s = c
+    src = int(ctl[control.C_SOURCE])
+    use_acc = dp[DP_ACCELEROMETER] != 0.0
+    for k in range(target.shape[0]):
+        x = ds[DS_X]
+        v = ds[DS_V]
+        a = ds[DS_A]
+        f_hand = hand_force(hp, ds, target[k], target_v[k], target_a[k])
+        x_m, a_m, v_m = sense(use_acc, ds, snp, sns, noise_x[k], noise_v[k], noise_a[k], noise_lf[k])
+        control.check_sensors(state, k, x_m, a_m, v_m)
+        # control.source_velocity and control.observe, written out: as inline calls they cost 15-20 ns
+        # of a 48 kHz sample's 0.8 us (measured 2026-11-23); the per-sample test holds the two equal
+        if src >= 0:
+            v_src = step_guarded(kinds[src], est_s[src], est_p[src], x_m, a_m, v_m)
+            est_out[src, k] = v_src
+        elif src == TRUE_INDEX:
+            v_src = v
+        else:
+            v_src = v_m
+        f = control.bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out)
+        stability.observe(mon_p, mon_s, v)
+        if ctl[control.C_USE_AUDIO] != 0.0:
+            out[control.O_AUDIO, k] += contact_mic.step(mic_p, mic_s, a)
+        f = control.command(state, lp, ls, k, f)
+        control.record(out, k, x_m, a_m, v_m, x, v, a, f, f_hand if np.isfinite(f_hand) else 0.0)
+        actuate(dp, ds, hp, f, f_hand)
+
+
+@njit(cache=True, error_model="numpy")
+def read_once(dp, ds, snp, sns, noise_x, noise_v, noise_a, noise_lf):
+    return sense(dp[DP_ACCELEROMETER] != 0.0, ds, snp, sns, noise_x, noise_v, noise_a, noise_lf)
+
+
+@njit(cache=True, error_model="numpy")
+def hand_once(hp, ds, x_target, v_target, a_target):
+    return hand_force(hp, ds, x_target, v_target, a_target)
+
+
+@njit(cache=True, error_model="numpy")
+def write_once(dp, ds, hp, f, f_hand):
+    actuate(dp, ds, hp, f, f_hand)
+
+
+class SimulatedDevice(HapticDevice):
+    """The simulated device and the virtual hand holding it (calibration.py documents the constants).
+
+    ``seed`` seeds the sensors' noise; ``accelerometer=False`` leaves the accelerometer out (it reads 0).
+    """
+
+    def __init__(self, rate, mass=calibration.DEVICE_MASS, limits=DeviceLimits(), *, hand_impedance=None,
+                 sensor_spec=None, seed=0, accelerometer=True):
+        self.rate = float(rate)
+        self.mass = float(mass)
+        self.limits = limits
+        self.hand = hand_impedance or hand.HandImpedance(calibration.HAND_MASS, calibration.HAND_STIFFNESS,
+                                                         calibration.HAND_DAMPING, calibration.HAND_REACTION)
+        self.sensor_spec = sensor_spec or sensors.SensorSpec()
+        self.accelerometer = bool(accelerometer)
+        self._dp = np.zeros(N_PARAMS)
+        self._dp[DP_T] = 1.0 / self.rate
+        self._dp[DP_MASS] = self.mass + self.hand.mass
+        self._dp[DP_TRAVEL] = limits.travel
+        self._dp[DP_ACCELEROMETER] = 1.0 if self.accelerometer else 0.0
+        self._ds = np.zeros(N_STATE)
+        self._hp = self.hand.params(self._dp[DP_MASS], self.rate)
+        self._snp = self.sensor_spec.params(self.rate)
+        self._sns = np.zeros(sensors.N_STATE)
+        # the accelerometer's low-frequency noise is the 4th child, so the first three streams stay as they were
+        streams = np.random.SeedSequence(int(seed)).spawn(4)
+        self._rng_x, self._rng_v, self._rng_a, self._rng_lf = (np.random.default_rng(s) for s in streams)
+        self._sample = 0
+        self._gesture = Hold()
+        self._gesture_start = 0
+        self._target = None  # the hand's target at the sample last read
+
+    @property
+    def fault(self):
+        if self._ds[DS_FAULT] != 0.0:
+            return "the virtual hand's force was non-finite; the hand let go and the handle was put at rest"
+        return None
+
+    def follow(self, gesture):
+        """The hand follows ``gesture`` from the next sample on."""
+        self._gesture = gesture
+        self._gesture_start = self._sample
+
+    def truth(self):
+        f_hand = 0.0
+        if self._target is not None:
+            f_hand = hand_once(self._hp, self._ds, *self._target)
+        return (float(self._ds[DS_X]), float(self._ds[DS_V]), float(self._ds[DS_A]),
+                f_hand if np.isfinite(f_hand) else 0.0)
+
+    def _targets(self, n):
+        target = self._gesture.block(self._sample - self._gesture_start, n, self.rate)
+        return tuple(np.ascontiguousarray(t, dtype=np.float64) for t in target)
+
+    def _noise(self, n):
+        nx = self._rng_x.standard_normal(n)
+        nv = self._rng_v.standard_normal(n)
+        if self.accelerometer:
+            return nx, nv, self._rng_a.standard_normal(n), self._rng_lf.standard_normal(n)
+        return nx, nv, np.zeros(n), np.zeros(n)
+
+    def read_sensors(self):
+        self._target = tuple(float(t[0]) for t in self._targets(1))
+        nx, nv, na, nl = (float(z[0]) for z in self._noise(1))
+        return read_once(self._dp, self._ds, self._snp, self._sns, nx, nv, na, nl)
+
+    def write_force(self, force):
+        target = self._target if self._target is not None else tuple(float(t[0]) for t in self._targets(1))
+        f_hand = hand_once(self._hp, self._ds, *target)
+        write_once(self._dp, self._ds, self._hp, float(force), f_hand)
+        self._target = None
+        self._sample += 1
+
+    def exchange(self, control, n, out, est_out):
+        target, target_v, target_a = self._targets(n)
+        nx, nv, na, nl = self._noise(n)
+        run_block(control.arrays, self._dp, self._ds, self._hp, self._snp, self._sns, target, target_v, target_a,
+                  nx, nv, na, nl, out, est_out)
+        self._sample += n
