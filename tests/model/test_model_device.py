@@ -9,6 +9,7 @@ from studyapp.model.bow_table import table
 from studyapp.model.device import DeviceLimits, HapticDevice
 from studyapp.model.loop import OUTPUTS, ClosedLoop, LoopConfig
 from studyapp.model.simulated_device import SimulatedDevice
+from studyapp.model.sources import LVT_SENSOR, TRUE
 
 RATE = 5000.0
 
@@ -37,7 +38,7 @@ def test_a_pure_mass_without_force_moves_as_the_closed_form():
     """F_max = 0: only the constant push acts, x = x0 + v0 t + F t^2 / (2 m) at every sample."""
     x0, v0, push, mass = 0.002, 0.03, 0.4, 0.5
     dev = PureMass(RATE, mass, x0, v0, push)
-    loop = ClosedLoop(LoopConfig(rate=RATE, fmax=0.0, source="LVT", estimators={"LOWPASS": {}}), device=dev)
+    loop = ClosedLoop(LoopConfig(rate=RATE, fmax=0.0, source=LVT_SENSOR, estimators={"LOWPASS": {}}), device=dev)
     block = loop.run(3000)
     t = np.arange(3000) / RATE
     np.testing.assert_allclose(block["position"], x0 + v0 * t + push * t ** 2 / (2 * mass), rtol=0, atol=1e-12)
@@ -45,8 +46,8 @@ def test_a_pure_mass_without_force_moves_as_the_closed_form():
     assert np.all(block["force"] == 0.0)
     # a driver knows no true motion: those columns are NaN, and the source TRUE is refused
     assert np.all(np.isnan(block["velocity_true"])) and np.all(np.isnan(block["hand_force"]))
-    with pytest.raises(ParameterError, match="TRUE"):
-        loop.set_source("TRUE")
+    with pytest.raises(ParameterError, match="source 'TRUE' needs the simulated device"):
+        loop.set_source(TRUE)
     # the observing estimator saw the same stream
     assert np.all(np.isfinite(block["estimates"])) and block["estimates"].shape == (1, 3000)
 
@@ -55,7 +56,7 @@ def test_a_bowed_pure_mass_gets_the_friction_law_and_the_string_its_pitch(fft_pe
     """A heavy mass at a bowing speed: F = -G rho(v_delta) v_delta every sample, the string at f0."""
     fmax = 2.0
     dev = PureMass(RATE, mass=1000.0, v0=0.04)
-    loop = ClosedLoop(LoopConfig(rate=RATE, fmax=fmax, source="LVT"), device=dev)
+    loop = ClosedLoop(LoopConfig(rate=RATE, fmax=fmax, source=LVT_SENSOR), device=dev)
     block = loop.run(int(1.0 * RATE))
     vd = block["v_delta"]
     np.testing.assert_allclose(block["force"], -fmax / loop.string.peak_friction() * table(vd) * vd,
@@ -108,7 +109,7 @@ def test_a_fault_the_device_reports_is_latched_and_the_force_held_at_0():
             return "amplifier over temperature" if self.x > 0.001 else None
 
     dev = Failing(RATE, mass=1000.0, v0=0.04)
-    loop = ClosedLoop(LoopConfig(rate=RATE, fmax=2.0, source="LVT"), device=dev)
+    loop = ClosedLoop(LoopConfig(rate=RATE, fmax=2.0, source=LVT_SENSOR), device=dev)
     first = loop.run(500)  # reaches 1 mm at 0.025 s, inside this block
     assert np.any(first["force"] != 0.0)
     assert loop.fault is not None and "amplifier over temperature" in loop.fault

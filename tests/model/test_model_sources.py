@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-from studyapp.errors import ParameterError
 from studyapp.estimators import lvt, names
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import LVT_SENSOR, PSEUDO_SOURCES, TRUE, is_pseudo, with_pseudo_sources
@@ -31,10 +30,3 @@ def test_the_lvt_estimator_passes_the_sensor_reading_the_sensor_source_uses():
     loop = ClosedLoop(LoopConfig(estimators={lvt.NAME: {}}, source=LVT_SENSOR, fmax=1.0, audio=False))
     out = loop.run(2000)
     assert np.array_equal(out["estimates"][0], out["source_velocity"])
-
-
-def test_true_velocity_needs_the_simulated_device():
-    loop = ClosedLoop(LoopConfig(source=LVT_SENSOR, fmax=1.0, audio=False))
-    loop.simulated = False  # as with a real device driver
-    with pytest.raises(ParameterError, match="source 'TRUE' needs the simulated device"):
-        loop.set_source(TRUE)

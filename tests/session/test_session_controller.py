@@ -1,11 +1,11 @@
 """The session controller's state machine, driven with a fake engine host: no Qt, no worker process."""
 
-import json
 from pathlib import Path
 
 import pytest
 
 from studyapp.engine import commands as cmd
+from studyapp.experiment.session_log import read_events
 from studyapp.model.fmax_knob import fmax_from_knob
 from studyapp.session.controller import TRANSITIONS, SessionController, State
 from tests.session.fakes import LATENCY, FakeHost
@@ -94,7 +94,7 @@ def log(c):
     """The session log, without each record's stamp (sequence number and times)."""
     (path,) = Path(c.results).glob("*/*/*/events.jsonl")
     stamps = ("seq", "mono", "wall")
-    return [{k: v for k, v in json.loads(line).items() if k not in stamps} for line in path.read_text().splitlines()]
+    return [{k: v for k, v in event.items() if k not in stamps} for event in read_events(path)]
 
 
 def play_rating(c):
