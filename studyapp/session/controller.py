@@ -255,6 +255,8 @@ class SessionController:
             described = {"device": self.device or "simulated", "engine": "real-time", **(apparatus or {})}
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described)
         self.session = session
+        for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
+            self.message(note, level="warning")
         self.fire("open")
         return session
 

@@ -1,5 +1,6 @@
 """The session controller's state machine, driven with a fake engine host: no Qt, no worker process."""
 
+import json
 from pathlib import Path
 
 import pytest
@@ -324,3 +325,18 @@ def test_after_a_session_the_engine_is_the_preview_again(controller):
     assert engine.fmax == 20.0
     events = log(c)
     assert events[-2]["type"] == "session_end" and events[-1] == {"type": "run_stop", "reason": "done"}
+
+
+def test_what_a_resume_repaired_reaches_the_console_as_a_warning(controller):
+    c = controller
+    start(c)
+    up(c)
+    c.abort()
+    (described,) = Path(c.results).glob("*/*/*/session.json")
+    described.write_text(described.read_text()[:20])  # truncated, as by a crash mid-write
+    said = []
+    c.events.message.connect(lambda text, level, topic: said.append((level, text)))
+    c.start_session("P01", c.results, resume=True)
+    warnings = [text for level, text in said if level == "warning"]
+    assert any("rebuilt from events.jsonl" in text for text in warnings), said
+    assert json.loads(described.read_text())["participant"] == "P01"
