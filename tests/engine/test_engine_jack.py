@@ -74,7 +74,7 @@ def test_a_control_change_from_another_process_sets_fmax_within_one_block(jack_s
         expected = fmax_from_knob(100, *LIVE_RANGE)
         assert applied.control == "knob1" and applied.value == pytest.approx(100 / 127)
         assert applied.origin == "midi" and applied.blocks_late <= 1
-        assert 0 <= applied.latency
+        assert 0 < applied.latency < 1.0  # from the message's arrival to a later block start, well within the wait
         time.sleep(0.05)
         assert engine.status()["fmax"] == pytest.approx(expected)
         assert engine.status()["midi_messages"] == 1
