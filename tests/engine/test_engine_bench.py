@@ -90,7 +90,7 @@ def test_one_real_probe_reports_what_it_ran():
 
 @pytest.mark.parametrize("args, words", [
     (["--seconds", "0"], "--seconds 0"),
-    (["--seconds", "nan"], "--seconds nan"),
+    (["--seconds", "nan"], "--seconds: 'nan' is not a finite number"),
     (["--block-ms", "500"], "--block-ms 500"),
     (["--block-ms", "x"], "--block-ms"),
 ])
