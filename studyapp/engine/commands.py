@@ -91,10 +91,15 @@ class Stop(Command):
 
 @dataclass(frozen=True)
 class InstallActions(Command):
-    """The ``{control: action}`` mapping from now on; ``trial`` tags the controls it applies."""
+    """The ``{control: action}`` mapping from now on; ``trial`` tags the controls it applies.
+
+    ``positions``: the rating knobs' positions (``{control: 0..127}``, a rated
+    knob's level for pickup) from now on; None keeps the worker's (a pause).
+    """
 
     actions: dict
     trial: int = 0
+    positions: dict | None = None
 
 
 @dataclass(frozen=True)

@@ -50,7 +50,10 @@ class Applied:
     then to the start of the block that applied the action (None without an
     action); ``blocks_late``: block boundaries it waited for; ``block``: that
     block's number; ``trial``: the mapping's tag (``InstallActions.trial``);
-    ``commands``: what the action did; ``origin``: ``midi`` or ``screen``.
+    ``commands``: what the action did; ``origin``: ``midi`` or ``screen``;
+    ``pending_pickup``: a physical knob that has not yet passed through the
+    level in force (soft takeover, engine/pickup.py), so it did nothing;
+    ``pickup_target``: that level's knob position, in [0, 1] like ``value``.
     """
 
     control: str
@@ -62,6 +65,8 @@ class Applied:
     trial: int
     commands: tuple = ()
     origin: str = "midi"
+    pending_pickup: bool = False
+    pickup_target: float | None = None
     level: str = "info"
 
 

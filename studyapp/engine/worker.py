@@ -34,7 +34,11 @@ in force (``trial``) and the trial clock (seconds since the last
 ``ResetString``, which starts a trial). Knob and pad actions are applied here,
 in and out of a session, through the mapping installed last
 (``commands.InstallActions``); on-screen controls arrive as ``Control``
-commands and take the same route as MIDI.
+commands and take the same route as MIDI. A physical (MIDI) knob that sets a
+level acts only once it has passed through the level in force (soft takeover,
+``engine/pickup.py``): until then it is reported with ``pending_pickup`` and
+changes nothing, so a knob left high never jumps F_max at a trial start or
+after a pause. On-screen knobs show the level itself and need no pickup.
 
 The worker stops on a ``Stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
@@ -57,9 +61,11 @@ from studyapp.engine import events as ev
 from studyapp.engine.audio import open_sink
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, coalesce, open_input
+from studyapp.engine.pickup import LEVEL_ACTIONS, level_position, passes_through
 from studyapp.engine.ring import Ring
 from studyapp.engine.safety import Safety
 from studyapp.engine.status import StatusBlock
+from studyapp.model.fmax_knob import KNOB_MAX
 
 # telemetry channels before the estimates ("estimate:NAME")
 CHANNELS = (
@@ -155,6 +161,8 @@ class Worker:
         self.k = 0
         self.trial = 0  # the tag of the mapping in force
         self.trial_start = 0.0  # loop time (s) of the last ResetString
+        self.knob_seen = {}  # each MIDI control's last position (0..127), whatever the mapping: for pickup
+        self.ratings = {}  # each rating knob's position, the level its "select" action sets
         self.loads = []  # every timed block's load, for the summary's percentiles
         self.wake_late_max = 0.0  # the timer's worst wake-up delay: the OS's share of a miss
         self.overruns = 0  # misses whose block alone took longer than its period on the CPU
@@ -197,6 +205,8 @@ class Worker:
     def _install(self, c):
         self.actions = dict(c.actions)
         self.trial = int(c.trial)
+        if c.positions is not None:
+            self.ratings = dict(c.positions)
 
     def _stop(self, c):
         self.stopping = True
@@ -235,12 +245,28 @@ class Worker:
     def control(self, control, value, arrived, block, origin="midi"):
         """A control moved (MIDI, or on screen): apply its action, tell the parent."""
         action = self.actions.get(control)
-        commands = cmd.action_commands(action, value, arrived) if action else ()
+        step = round(value * KNOB_MAX)
+        target = self._pickup_target(control, action, step) if origin == "midi" else None
+        commands = cmd.action_commands(action, value, arrived) if action and target is None else ()
         latency = None
         for command in commands:
             latency = self.apply(command)
+        if commands and action[0] == "select":
+            self.ratings[control] = step
         self.events.put(ev.Applied(control, value, arrived, latency, self.k - block, self.k, self.trial,
-                                   commands, origin))
+                                   commands, origin, pending_pickup=target is not None,
+                                   pickup_target=None if target is None else target / KNOB_MAX))
+
+    def _pickup_target(self, control, action, step):
+        """The knob step a physical knob must pass through before it acts; None when it acts now."""
+        previous, self.knob_seen[control] = self.knob_seen.get(control), step
+        if not action or action[0] not in LEVEL_ACTIONS:
+            return None
+        volume = self.sink.gain.volume if action[0] == "volume" else None
+        target = level_position(action, self.loop.fmax, volume, self.ratings.get(control))
+        if target is None or passes_through(target, previous, step):
+            return None
+        return target
 
     def drain(self):
         while True:

@@ -4,7 +4,8 @@ One row per response, first the columns of the "Study results" contract:
 
     participant, session, task, condition, trial, fmax, rating, time, protocol_hash
 
-then ``study, step, value, knob, peak_fmax, duration, app_version``.
+then ``study, step, value, knob, peak_fmax, duration, app_version`` and the
+trial's engine health ``deadline_misses, underruns, faults, events_dropped``.
 
 - ``task`` names the task type; ``trial``, ``fmax``, ``time``, ``step`` and
   ``duration`` come from the response event, the rest from the task type's
@@ -20,6 +21,10 @@ then ``study, step, value, knob, peak_fmax, duration, app_version``.
 - Listen rows: ``fmax`` the F_max played (N), ``duration`` how long; ``rating``
   and ``value`` empty.
 - ``time`` is the ISO-8601 wall time of the response (the confirm).
+- ``deadline_misses``, ``underruns``, ``faults``, ``events_dropped``: what the
+  real-time engine counted while the trial ran (the session's ``trial_health``
+  records of its step, summed over its attempts); empty for a session without
+  a real-time engine (``studyapp run``).
 
 Incomplete sessions are exported too: every confirmed response is data. A
 session that cannot be read is skipped, and a damaged line of a log left out
@@ -39,8 +44,9 @@ from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_descript
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
 
+HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
-           "study", "step", "value", "knob", "peak_fmax", "duration", "app_version"]
+           "study", "step", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS]
 
 
 def _session_rows(folder, problems):
@@ -75,6 +81,7 @@ def _session_rows(folder, problems):
         number, _, raw = log.malformed[0]
         raise InputDataError(f"{events_file} line {number}: {raw.strip()[:40]!r} is not an event: "
                              "allowed is a JSON object with a 'type'")
+    health = _trial_health(log.events)
     rows = []
     for event in log.events:
         if event.get("type") != "response":
@@ -85,8 +92,26 @@ def _session_rows(folder, problems):
             raise InputDataError(f"{folder / EVENTS_FILE}: response event seq {seq}: {wrong}")
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
                 "time": event["wall"], "step": event["step"], "duration": event.get("duration")}
+        base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
+
+
+def _trial_health(events):
+    """{step: {column: count}} from the ``trial_health`` records, summed over a step's attempts."""
+    health = {}
+    for event in events:
+        if event.get("type") != "trial_health":
+            continue
+        counts = health.setdefault(event.get("step"), dict.fromkeys(HEALTH_COLUMNS, 0))
+        for column in HEALTH_COLUMNS:
+            value = event.get(column)
+            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+                seq = event.get("seq", "?")
+                raise InputDataError(f"trial_health event seq {seq}: {column} = {value!r}: "
+                                     "allowed is a whole number >= 0")
+            counts[column] += value
+    return health
 
 
 def session_folders_under(root):
@@ -119,6 +144,8 @@ def export_responses(results_dir, problems=None):
     frame["step"] = frame["step"].astype("int64")
     frame["knob"] = frame["knob"].astype("Int64")
     frame["value"] = frame["value"].astype("Int64")  # empty for a task without a knob answer
+    for column in HEALTH_COLUMNS:
+        frame[column] = frame[column].astype("Int64")  # empty without a real-time engine
     return frame.reset_index(drop=True)
 
 

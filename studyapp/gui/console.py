@@ -99,6 +99,8 @@ class Console(QMainWindow):
         self.blind = QCheckBox("Hide the condition (blinding)")
         self.blind.toggled.connect(self._blinding)
         self.response_label = QLabel("")
+        self.pickup_label = QLabel("")  # a physical knob waiting for pickup (engine/pickup.py)
+        self.pickup_label.setStyleSheet("color: #06c; font-weight: bold;")
         self.response_label.setWordWrap(True)
         self._condition_text = ""
 
@@ -116,6 +118,7 @@ class Console(QMainWindow):
         p.addWidget(self.condition_label)
         p.addWidget(self.blind)
         p.addWidget(self.response_label)
+        p.addWidget(self.pickup_label)
         left = QWidget()
         lv = QVBoxLayout(left)
         lv.addWidget(self.setup)
@@ -203,6 +206,7 @@ class Console(QMainWindow):
         e.status.connect(self._on_status)
         e.message.connect(self._on_message)
         e.response.connect(self._on_response)
+        e.pickup.connect(self._on_pickup)
 
         self.timer = QTimer(self)
         self.timer.setInterval(POLL_PERIOD_MS)
@@ -361,6 +365,10 @@ class Console(QMainWindow):
         self.log.appendPlainText(("[fault] " if level == "error" else "") + text)
         if level in COLOURS:
             self.statusBar().showMessage(text, 8000)
+
+    def _on_pickup(self, control, index, pending, text):
+        self.pickup_label.setText(f"{control}: {text}" if pending else "")
+        self.participant_window.show_pickup(text)
 
     def _on_response(self, response, step):
         self.response_label.setText(task_type(response["task"]).response_text(response))

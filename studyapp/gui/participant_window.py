@@ -36,12 +36,15 @@ class ParticipantWindow(QWidget):
         self.instructions.setAlignment(Qt.AlignmentFlag.AlignTop | Qt.AlignmentFlag.AlignLeft)
         self.notice = QLabel(MESSAGES["idle"])
         self.notice.setStyleSheet("font-size: 16pt; color: #a60;")
+        self.pickup = QLabel("")
+        self.pickup.setStyleSheet("font-size: 16pt; color: #06c;")
         self.knobs = KnobPanel(knobs, pads)
         layout = QVBoxLayout(self)
         layout.addWidget(self.title)
         layout.addWidget(self.progress)
         layout.addWidget(self.instructions, 1)
         layout.addWidget(self.notice)
+        layout.addWidget(self.pickup)
         layout.addWidget(self.knobs)
         self.resize(900, 560)
 
@@ -51,6 +54,10 @@ class ParticipantWindow(QWidget):
     def show_trial(self, step, total, instructions):
         self.progress.setText(f"Trial {step + 1} of {total}")
         self.instructions.setText(instructions)
+
+    def show_pickup(self, text):
+        """A physical knob waiting for pickup: say which way to turn it ("" once it acts)."""
+        self.pickup.setText(text)
 
     def show_state(self, state, emergency=False):
         if emergency:

@@ -38,6 +38,20 @@ hands those of the current trial to the runner, which logs them and keeps the
 task's state. Their knob-to-effect latencies are shown and logged
 (``knob_latency``).
 
+Pickup. A physical knob that sets a level acts only once it has passed
+through the level in force (the worker's soft takeover, engine/pickup.py): at
+a trial start (F_max 0) and after a pause. Until then the worker reports it
+``pending_pickup`` and the controller announces ``pickup`` (the views show
+"turn the knob down to pick up"); the task never sees it. Once it acts, a
+``pickup`` record (control, trial, when: the trial's clock in s, ignored: the
+messages it took) goes to the session log.
+
+Trial health. The engine's counters (``deadline_misses``, ``audio_underruns``,
+``faults``, ``events_dropped``) are read when a trial starts and when it ends
+(its response, the session's end, or its engine lost); their differences are
+logged as a ``trial_health`` record (``underruns`` for the audio underruns),
+which export carries as columns.
+
 Engines. A protocol gets a *preview* engine with every condition it names.
 Starting a session starts a fresh engine seeded with the session's seed; once
 the session ends it stays as the preview engine.
@@ -73,7 +87,10 @@ from studyapp.session.evented import EventGroup
 from studyapp.session.knob_latency import KnobLatency
 
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
-GESTURES = ("strokes", "hold", "live")  # what the console offers: scripted strokes, a held handle, the mouse
+GESTURES = ("strokes", "hold", "live")
+# the engine's fault counters a trial_health record logs, and their names there
+HEALTH = {"deadline_misses": "deadline_misses", "audio_underruns": "underruns", "faults": "faults",
+          "events_dropped": "events_dropped"}  # what the console offers: scripted strokes, a held handle, the mouse
 
 
 class State(StrEnum):
@@ -158,7 +175,7 @@ class SessionController:
         self.clock = clock
         self.make_host = make_host
         self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing", "gesture",
-                                 "telemetry", "status", "message", "response")
+                                 "telemetry", "status", "message", "response", "pickup")
         self.protocol = None
         self.host = None
         self.session = None
@@ -172,6 +189,8 @@ class SessionController:
         self.controls_taken = 0  # ... and reported back by it (a player may wait for its own)
         self._engine_state = None
         self._next_status = 0.0
+        self._pickup = {}  # control -> messages ignored while it waits for pickup
+        self._health = None  # the engine and its counters when the current trial started
 
     # the state machine ----------------------------------------------------------
     def fire(self, event):
@@ -336,6 +355,8 @@ class SessionController:
 
     def _end(self, how):
         self._log_latency()
+        self._log_health()
+        self._forget_pickups()
         self.runner.finish("done" if how == State.FINISHED else str(how))
         self.session.close()
         self.message(f"session {how}: {self.session.folder}")
@@ -349,6 +370,7 @@ class SessionController:
         return how
 
     def _lose_engine(self):
+        self._log_health()
         engine = self.host.engine
         self.runner.log({"type": "engine_failed", "faults": list(engine.faults) if engine else []})
         self.message("the engine stopped (force is zero); the session is paused: press Resume to start "
@@ -434,8 +456,32 @@ class SessionController:
 
     def _make_loop(self, estimators, source, seed):
         self.trial_serial += 1
-        actions = trial_actions(self.runner.trial, self.runner.task)
-        return EngineLoop(self.host.engine, estimators, source, self.protocol.gesture, self.trial_serial, actions)
+        task = self.runner.task
+        actions = trial_actions(self.runner.trial, task)
+        positions = {f"knob{i + 1}": int(v) for i, v in task.knob_positions().items() if v is not None}
+        return EngineLoop(self.host.engine, estimators, source, self.protocol.gesture, self.trial_serial, actions,
+                          positions)
+
+    def _counters(self):
+        """The session engine and its fault counters now (None without a running engine)."""
+        engine = self.engine
+        if engine is None:
+            return None
+        status = engine.status()
+        return engine, {key: int(status[key]) for key in HEALTH}
+
+    def _log_health(self):
+        """Log the current trial's ``trial_health``: its engine's counters now minus at its start."""
+        started, self._health = self._health, None
+        if started is None or self.runner is None or self.runner.trial is None:
+            return
+        engine, before = started
+        try:
+            now = engine.status()
+        except (OSError, ValueError, KeyError):
+            return  # the engine is gone with its status block: nothing to count
+        self.runner.log({"type": "trial_health", "trial": self.runner.trial.trial,
+                         **{HEALTH[key]: int(now[key]) - before[key] for key in HEALTH}})
 
     def _log_latency(self):
         record = self.latency.take()
@@ -448,9 +494,12 @@ class SessionController:
         Returns ``state``, or FINISHED when no trial is left. Outside RUNNING the new trial is held.
         """
         self._log_latency()
+        self._log_health()
+        self._forget_pickups()
         trial = self.runner.start_trial()
         if trial is None:
             return self._end(State.FINISHED)
+        self._health = self._counters()
         if state != State.RUNNING:
             self.runner.loop.hold(True)
         task = self.runner.task
@@ -513,6 +562,8 @@ class SessionController:
         live = record.trial == 0 and self.state in REST
         if not (ours or live):
             return  # a held trial's, a stale trial's, or the preview's while a session starts
+        if self._picked_up(record, knob, ours):
+            return
         if record.latency is not None:
             self.latency.add(record.latency, record.origin)
         if knob is not None:
@@ -524,6 +575,30 @@ class SessionController:
             self._task_records(self.runner.knob(knob, round(record.value * 127)))
         elif pad is not None and record.value > 0:
             self._task_records(self.runner.pad(pad))
+
+    def _picked_up(self, record, knob, ours):
+        """Follow a knob's pickup; True while it waits for it (the task must not see it)."""
+        if record.pending_pickup:
+            waiting = record.control in self._pickup
+            self._pickup[record.control] = self._pickup.get(record.control, 0) + 1
+            if not waiting:
+                down = record.value > record.pickup_target
+                self.events.pickup.emit(control=record.control, index=knob, pending=True,
+                                        text=f"turn the knob {'down' if down else 'up'} to pick up")
+            return True
+        ignored = self._pickup.pop(record.control, None)
+        if ignored is not None:
+            self.events.pickup.emit(control=record.control, index=knob, pending=False, text="")
+            if ours:
+                self.runner.log({"type": "pickup", "control": record.control, "trial": self.runner.trial.trial,
+                                 "when": getattr(self.runner.task, "elapsed", None), "ignored": ignored})
+        return False
+
+    def _forget_pickups(self):
+        """A new mapping: a knob waiting for pickup waits for the new level (announced by its next message)."""
+        for control in self._pickup:
+            self.events.pickup.emit(control=control, index=_control_index(control, "knob"), pending=False, text="")
+        self._pickup = {}
 
     def _task_records(self, records):
         for record in records:

@@ -12,7 +12,8 @@ time the engine ran. Nothing here waits.
 Push, not pull. A trial starts with one burst of commands: F_max 0, bow
 lifted, ``ResetString`` (string at rest, the worker's stability monitor
 afresh, trial clock 0), the gesture, the source, and last the trial's knob
-mapping tagged with the trial's number (``InstallActions``). The worker tags
+mapping tagged with the trial's number (``InstallActions``, with the knob
+positions the task restored: a rated knob's level, for pickup). The worker tags
 every block with the mapping's number, so ``consume(block)`` keeps only the
 samples run for this trial, with every one of its settings in force. The
 stability verdict is the worker's own (``broken`` and ``stability_score``,
@@ -30,6 +31,8 @@ Holding. ``hold(True)`` (pause, emergency stop) sends F_max = 0, lifts the bow
 and installs an empty mapping tagged ``-trial`` (so the held samples and any
 control are not the trial's), without changing what the runner asked for;
 ``hold(False)`` sends the runner's settings and the trial's mapping again.
+A physical knob that moved meanwhile must then pass through the level again
+before it acts (the worker's pickup, engine/pickup.py).
 
 The engine keeps one noise seed for the session, so the ``loop_seed`` the
 runner logs per trial is not used here (the session log says so in its
@@ -53,7 +56,7 @@ class Verdict:
 
 
 class EngineLoop:
-    def __init__(self, engine, estimators, source, gesture, trial=0, actions=None):
+    def __init__(self, engine, estimators, source, gesture, trial=0, actions=None, positions=None):
         missing = [name for name in estimators if name not in engine.names]
         if missing:
             raise ParameterError(f"estimator {missing[0]!r} is not running in the engine: "
@@ -73,7 +76,8 @@ class EngineLoop:
         self._fault = None
         self._in_engine = {}  # what the worker has in force, as far as this trial set it
         for command in (cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.ResetString(), cmd.SetGesture(gesture),
-                        cmd.SetSource(source), cmd.InstallActions(self.actions, trial=self.trial)):
+                        cmd.SetSource(source),
+                        cmd.InstallActions(self.actions, trial=self.trial, positions=dict(positions or {}))):
             self._send(command)
 
     def _send(self, command):

@@ -47,6 +47,7 @@ class Events(list):
 def worker():
     w = Worker.__new__(Worker)
     w.loop, w.events, w.k, w.block, w.actions, w.trial = FakeLoop(), Events(), 7, 10, {}, 0
+    w.knob_seen, w.ratings = {}, {}
     w.safety = type("Safety", (), {"clamp_fmax": staticmethod(lambda f: min(f, 20.0))})()
     w.status = StatusBlock.create()
     yield w

@@ -192,3 +192,27 @@ def test_export_of_nothing(tmp_path):
     with pytest.raises(UserError, match="no responses found"):
         write_responses(tmp_path, tmp_path / "r.csv")
     assert not (tmp_path / "r.csv").exists()
+
+
+def test_export_carries_each_trials_engine_health_and_leaves_it_empty_headless(tmp_path, protocol):
+    session = Session.create(protocol, "H01", tmp_path, seed=1)
+    run_simulated(session).finish()
+    counts = {"deadline_misses": 2, "underruns": 1, "faults": 0, "events_dropped": 4}
+    for step, scale in ((0, 1), (3, 1), (3, 2)):  # step 3 ran twice (an engine lost): both attempts count
+        session.log.append({"type": "trial_health", "step": step, "task": "x", "trial": 1,
+                            **{k: scale * v for k, v in counts.items()}})
+    session.close()
+    headless = Session.create(protocol, "H02", tmp_path, seed=2)
+    run_simulated(headless).finish()
+    headless.close()
+    frame = export_responses(tmp_path)
+    columns = ["deadline_misses", "underruns", "faults", "events_dropped"]
+    assert columns == COLUMNS[-4:]
+    logged = frame[frame.participant == "H01"].set_index(["step", "knob"])[columns]
+    assert logged.loc[0].to_numpy().tolist() == [[2, 1, 0, 4]] * 3  # the rating: one row per condition
+    assert logged.loc[3].to_numpy().tolist() == [[6, 3, 0, 12]]
+    assert logged.drop(index=[0, 3], level="step").isna().all().all()
+    assert frame.loc[frame.participant == "H02", columns].isna().all().all()
+    write_responses(tmp_path, tmp_path / "r.csv")
+    back = pd.read_csv(tmp_path / "r.csv")
+    assert back.loc[(back.participant == "H01") & (back.step == 3), "events_dropped"].tolist() == [12]

@@ -187,3 +187,12 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
 
     assert console.choose_protocol(str(DEMO))
     wait_until(qapp, lambda: c.engine is not None, ENGINE_START)
+
+
+def test_a_knob_waiting_for_pickup_is_shown_on_the_console_and_to_the_participant(idle_console):
+    pickup = idle_console.controller.events.pickup
+    pickup.emit(control="knob1", index=0, pending=True, text="turn the knob down to pick up")
+    assert idle_console.pickup_label.text() == "knob1: turn the knob down to pick up"
+    assert idle_console.participant_window.pickup.text() == "turn the knob down to pick up"
+    pickup.emit(control="knob1", index=0, pending=False, text="")
+    assert idle_console.pickup_label.text() == "" and idle_console.participant_window.pickup.text() == ""

@@ -34,6 +34,7 @@ class FakeEngine:
         self.fmax = 0.0
         self.samples = 0
         self.broken = 0.0
+        self.counters = {"deadline_misses": 0, "audio_underruns": 0, "faults": 0, "events_dropped": 0}
         self._controls = []
 
     def send(self, command):
@@ -57,6 +58,11 @@ class FakeEngine:
         self._controls.append(Applied(name, value, 0.0, LATENCY if commands else None, 0, 0, self.trial,
                                       commands, origin))
 
+    def pending(self, name, value, target):
+        """A MIDI knob the worker holds back until it passes through ``target`` (pickup)."""
+        self._controls.append(Applied(name, value, 0.0, None, 0, 0, self.trial, (), "midi",
+                                      pending_pickup=True, pickup_target=target))
+
     def clear_fault(self):
         self.send(cmd.ClearFault())
 
@@ -66,7 +72,7 @@ class FakeEngine:
 
     def status(self):
         latched = self.latched or not self.status_block.force_enable
-        return {"fault": "", "fault_latched": latched, "source": "LVT", "fmax": self.fmax}
+        return {"fault": "", "fault_latched": latched, "source": "LVT", "fmax": self.fmax, **self.counters}
 
     def run(self, n):
         start, self.samples = self.samples, self.samples + n

@@ -272,8 +272,9 @@ def test_emergency_stop_zeroes_at_once_and_the_trial_starts_again_when_cleared(c
     c.poll()
     assert c.state == S.RUNNING and c.runner.task.value == 0 and engine.fmax == 0.0
     events = log(c)
-    assert [e["type"] for e in events][-5:] == ["emergency_stop", "emergency_clear", "resume", "knob_latency",
-                                                "trial_start"]
+    # the interrupted attempt's fault counts, then the trial again
+    assert [e["type"] for e in events][-6:] == ["emergency_stop", "emergency_clear", "resume", "knob_latency",
+                                                "trial_health", "trial_start"]
     assert [e["value"] for e in events if e["type"] == "knob" and e["task"] == "adjustment"] == [60]
     assert [e["restart"] for e in events if e["type"] == "trial_start" and e["task"] == "adjustment"] == [
         False, True]
@@ -340,3 +341,53 @@ def test_what_a_resume_repaired_reaches_the_console_as_a_warning(controller):
     warnings = [text for level, text in said if level == "warning"]
     assert any("rebuilt from events.jsonl" in text for text in warnings), said
     assert json.loads(described.read_text())["participant"] == "P01"
+
+
+def test_a_knob_waiting_for_pickup_is_announced_kept_from_the_task_and_its_pickup_logged(controller):
+    c = controller
+    start(c)
+    up(c)
+    c.knob(0, 100)
+    c.knob(1, 20)
+    c.pad(0)
+    c.poll()  # the rating done: the adjustment trial starts at F_max 0
+    shown = []
+    c.events.pickup.connect(lambda **fields: shown.append(fields))
+    engine = c.host.engine
+    engine.pending("knob1", 90 / 127, 0.0)  # the physical knob still high
+    engine.pending("knob1", 60 / 127, 0.0)
+    c.poll()
+    assert shown == [{"control": "knob1", "index": 0, "pending": True, "text": "turn the knob down to pick up"}]
+    assert c.runner.task.value == 0 and engine.fmax == 0.0
+    c.host.play(0.2)
+    c.poll()
+    engine.control("knob1", 0.0)  # through 0: picked up
+    engine.control("knob1", 30 / 127)
+    c.poll()
+    assert shown[-1] == {"control": "knob1", "index": 0, "pending": False, "text": ""}
+    assert c.runner.task.value == 30 and engine.fmax == pytest.approx(fmax_from_knob(30, 40.0, 2.0))
+    (pickup,) = [e for e in log(c) if e["type"] == "pickup"]
+    assert pickup == {"step": 1, "task": "adjustment", "type": "pickup", "control": "knob1", "trial": 1,
+                      "when": pytest.approx(0.2), "ignored": 2}
+
+
+def test_each_trial_logs_the_engine_faults_counted_while_it_ran(controller):
+    c = controller
+    start(c)
+    engine = c.host.engine
+    engine.counters.update(deadline_misses=5, audio_underruns=1, faults=0, events_dropped=7)  # before the trial
+    up(c)
+    c.knob(0, 100)
+    c.knob(1, 20)
+    engine.counters.update(deadline_misses=8, audio_underruns=3, events_dropped=7)
+    c.pad(0)
+    c.poll()
+    engine.counters.update(deadline_misses=9, faults=1, events_dropped=10)
+    c.abort()
+    health = [e for e in log(c) if e["type"] == "trial_health"]
+    assert health == [
+        {"step": 0, "task": "rating", "type": "trial_health", "trial": 1,
+         "deadline_misses": 3, "underruns": 2, "faults": 0, "events_dropped": 0},
+        {"step": 1, "task": "adjustment", "type": "trial_health", "trial": 1,
+         "deadline_misses": 1, "underruns": 0, "faults": 1, "events_dropped": 3},
+    ]

@@ -40,7 +40,7 @@ def test_a_trial_starts_silent_at_rest_and_tags_its_samples_with_its_number():
     EngineLoop(engine, {"KALLEV": {}}, "KALLEV", "hold", trial=4, actions=RATING)
     assert engine.sent == [cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.ResetString(),
                                          cmd.SetGesture("hold"), cmd.SetSource("KALLEV"),
-                                         cmd.InstallActions(RATING, trial=4)]
+                                         cmd.InstallActions(RATING, trial=4, positions={})]
 
 
 def test_what_the_worker_applied_from_a_knob_is_not_sent_again():
