@@ -86,4 +86,4 @@ def test_a_control_change_from_another_process_sets_fmax_within_one_block(jack_s
         assert tel["fmax"][change[0]] == pytest.approx(expected)
     finally:
         summary = engine.stop()
-    assert summary["midi_messages"] == 1
+    assert summary["midi_messages"] == 1 and summary["midi_overflows"] == 0
