@@ -130,7 +130,7 @@ class Worker:
         self.sink = None
         status.set(state="starting", rate=config.rate)
         status.publish()
-        sys.setswitchinterval(0.0005)  # PortAudio's and rtmidi's threads need the GIL promptly
+        sys.setswitchinterval(0.0005)  # PortAudio's callback thread needs the GIL promptly
 
         self.sink = open_sink(config.audio, config.rate, lead=config.lead,
                               say=lambda text: self.notice(text, "warning", "audio"))

@@ -52,11 +52,11 @@ def test_a_control_change_flood_is_coalesced_per_block_and_every_final_value_rea
     assert after["midi_messages"] - before["midi_messages"] == sent["sent"] == int(FLOOD_RATE * FLOOD_SECONDS)
     assert after["events_dropped"] == before["events_dropped"] == 0
     # coalesced: at most one control event per knob per block
-    per_block = Counter((control, applied_block) for control, _, _, _, _, applied_block in controls)
+    per_block = Counter((c.control, c.block) for c in controls)
     assert max(per_block.values()) == 1
     assert len(controls) < sent["sent"]
     # no control lost: each knob's last event carries the last value sent on it, and the loop has it
-    last = {control: value for control, value, *_ in controls}
+    last = {c.control: c.value for c in controls}
     assert last == {f"knob{k}": value / 127 for k, value in ((int(k), v) for k, v in sent["final"].items())}
     assert after["fmax"] == pytest.approx(fmax_from_knob(sent["final"]["1"], *LIVE_RANGE))
 
@@ -84,7 +84,7 @@ def test_events_the_ring_overwrites_are_counted_as_dropped(engine):
     after = engine.status()
     received = after["midi_messages"] - before["midi_messages"]
     dropped = after["events_dropped"] - before["events_dropped"]
-    assert all(control == "pad1" for control, *_ in controls)
+    assert all(c.control == "pad1" for c in controls)
     assert received > SLOTS  # JACK may itself drop some of a burst: count what arrived
     # each press the worker received made one control event: those the parent missed are counted
     assert dropped > 0 and dropped + len(controls) == received
