@@ -11,21 +11,38 @@ value in [0, 1]:
 
 ``open_input(spec)`` opens an input: ``"virtual"`` makes a port others connect
 to, ``"first"`` takes the first source found, any other text picks the first
-port whose name contains it, ``"none"`` opens nothing. rtmidi calls back from
-its own thread, once per message, taking the GIL from the loop each time; so
-the callback does the least it can: it puts the raw bytes with
-``(time.monotonic(), block)`` on a ``queue.SimpleQueue`` (whose ``put`` never
-blocks), ``block`` being the engine's block counter at arrival. Parsing waits
-for the engine, which drains the queue at block boundaries with control
-changes coalesced (``coalesce``: the last value of each controller in a
-block) and parses only what is left. (Parsing every message in the callback,
-as mido's own ports do, cost ~10 us of GIL per message: at 10,000 messages/s
-a tenth of a core, and deadline misses.) Without a back-end (these machines
-have no ALSA sequencer, and JACK needs a running server) ``open_input`` prints
-one line and returns ``None``: the on-screen knobs take over.
+port whose name contains it, ``"none"`` opens nothing. No Python runs on
+rtmidi's thread: it puts each message on its own C++ queue
+(``queue_size_limit`` = ``QUEUE`` messages, 3.3 s at 10,000 messages/s) and the
+engine polls that queue at block boundaries (``MidiInput.poll``), then
+coalesces control changes (``coalesce``: the last value of each controller in
+a block) and parses only what is left. (A Python callback, even one that only
+queued the raw bytes, took the GIL from the loop once per message: at 10,000
+messages/s, tens of deadline misses in 5 s; parsing in it, as mido's own
+ports do, cost ~10 us of GIL per message more.) Without a back-end (these
+machines have no ALSA sequencer, and JACK needs a running server)
+``open_input`` prints one line and returns ``None``: the on-screen knobs take
+over.
+
+**Arrival times.** rtmidi gives each message its delta time d_i, the seconds
+since the message before it, on its own clock (JACK: the time of the process
+cycle that delivered it, in microseconds; so messages delivered in one cycle
+share a time). A poll at time T (``time.monotonic()``) that empties the queue
+takes messages 1..n, all of which arrived after the previous poll at T_prev
+(it emptied the queue too). ``arrival_times`` anchors the last at T and goes
+back by the delta times:
+
+    a_n = T,   a_i = max(a_{i+1} - d_{i+1}, T_prev)   (i = n-1 .. 1)
+
+Since the true arrival r_n lies in (T_prev, T], every a_i is late by the same
+e = T - r_n, 0 <= e < T - T_prev, i.e. at most one block period (plus any
+lateness of the wake-up) when the loop keeps time; the clamp at T_prev only
+moves a_i towards the truth. The knob-to-effect latencies measured from a_i
+are short by e at most. If rtmidi's queue overflowed, it dropped the newest
+messages (it prints a line on stderr, the only sign it gives), so a poll
+that finds ``QUEUE`` messages or more counts one ``overflow``.
 """
 
-import queue
 import time
 
 import mido
@@ -37,6 +54,7 @@ CLIENT = "studyapp"
 VIRTUAL_PORT = "studyapp MIDI in"
 APIS = ("UNIX_JACK", "LINUX_ALSA")
 CONTROL_CHANGE = 0xB0  # status byte's high nibble
+QUEUE = 2**15  # rtmidi's queue, messages: seconds at 10,000/s, beyond any stall the watchdog lets pass
 
 
 def _key(kind, channel, number):
@@ -153,33 +171,64 @@ class MidiUnavailable(RuntimeError):
     """No MIDI back-end or no such port."""
 
 
-class MidiInput:
-    """An open MIDI input; ``poll()`` returns the raw ``(bytes, time, block)`` received since the last poll.
+def arrival_times(deltas, polled, previous):
+    """Arrival times of one poll's messages from rtmidi's delta times (see module docstring).
 
-    ``block`` is whatever the engine last stored in ``self.block`` (its block counter).
+    ``deltas``: each message's seconds since the message before it; ``polled``:
+    the time of this poll (the last message is anchored there); ``previous``:
+    the time of the poll before, which emptied the queue, so no message
+    arrived before it.
+    """
+    times = [0.0] * len(deltas)
+    at = polled
+    for i in range(len(deltas) - 1, -1, -1):
+        times[i] = at
+        at = max(at - deltas[i], previous)
+    return times
+
+
+class MidiInput:
+    """An open MIDI input; ``poll()`` returns the raw ``(bytes, arrival time, block)`` received since the last poll.
+
+    ``block`` is the engine's block counter at arrival: the engine reports
+    each new block with ``new_block(k, time)``.
     """
 
-    def __init__(self, port, api):
+    def __init__(self, port, api, rt=None, queue_size=QUEUE):
         self.port = port
         self.api = api
-        self.queue = queue.SimpleQueue()
+        self.queue_size = queue_size
         self.received = 0
+        self.overflows = 0
         self.block = 0
-        self._rt = None
+        self._block_time = self._polled = time.monotonic()
+        self._rt = rt
 
-    def _callback(self, event, data=None):
-        # Runs on rtmidi's thread with the GIL: no parsing, no lock; SimpleQueue.put never blocks.
-        self.queue.put((event[0], time.monotonic(), self.block))
+    def new_block(self, k, at):
+        """Block ``k`` starts counting at time ``at``: later messages arrived in it."""
+        self.block, self._block_time = k, at
 
     def poll(self):
-        out = []
+        if self._rt is None:
+            return []
+        get = self._rt.get_message  # C++ queue, no lock shared with Python
+        messages = []
         while True:
-            try:
-                out.append(self.queue.get_nowait())
-            except queue.Empty:
+            message = get()
+            if message is None:
                 break
-        self.received += len(out)
-        return out
+            messages.append(message)
+        polled, previous = time.monotonic(), self._polled
+        self._polled = polled
+        if not messages:
+            return []
+        self.received += len(messages)
+        if len(messages) >= self.queue_size:
+            self.overflows += 1
+        times = arrival_times([d for _, d in messages], polled, previous)
+        # all arrived after the previous poll, so in the block now counted or in the one before
+        k, since = self.block, self._block_time
+        return [(raw, at, k if at >= since else k - 1) for (raw, _), at in zip(messages, times)]
 
     @property
     def description(self):
@@ -187,7 +236,6 @@ class MidiInput:
 
     def close(self):
         if self._rt is not None:
-            self._rt.cancel_callback()
             self._rt.close_port()
             self._rt.delete()
             self._rt = None
@@ -199,9 +247,10 @@ def _open(spec, api, client):
     rtapi = getattr(rtmidi, f"API_{api}")
     if rtapi not in rtmidi.get_compiled_api():
         raise MidiUnavailable(f"python-rtmidi was built without {api}")
-    rt = rtmidi.MidiIn(rtapi=rtapi, name=client)  # sysex, clock and active sensing stay filtered out
+    # sysex, clock and active sensing stay filtered out
+    rt = rtmidi.MidiIn(rtapi=rtapi, name=client, queue_size_limit=QUEUE)
     try:
-        midi = MidiInput(None, api)
+        midi = MidiInput(None, api, queue_size=QUEUE)
         if spec == "virtual":
             rt.open_virtual_port(VIRTUAL_PORT)
             midi.port = f"{client}:{VIRTUAL_PORT}" if api == "UNIX_JACK" else VIRTUAL_PORT
@@ -216,7 +265,6 @@ def _open(spec, api, client):
                 raise MidiUnavailable(f"no MIDI input matches {spec!r} (inputs: {have})")
             rt.open_port(names.index(match[0]))
             midi.port = match[0]
-        rt.set_callback(midi._callback)
     except BaseException:
         rt.delete()
         raise

@@ -14,6 +14,8 @@ live`` does. Per run the bench reports:
   control event, plus 1 if F_max in the loop is not knob 1's final value;
 - ``sent``, ``midi_received`` (messages the worker took from its MIDI input)
   and ``control_events`` (control events the parent received);
+- ``midi_overflows``: polls that found rtmidi's input queue full (it may have
+  dropped messages then; see midi.py);
 - ``overruns``: misses whose block alone took longer than its period on the CPU
   (the engine's share; the rest are the machine's, see worker.py);
 - ``quiet_deadline_misses``: the misses of the same engine run as long without
@@ -182,6 +184,7 @@ def flood(rate, seconds, progress=print):
     result = {
         "rate": rate, "seconds": sent["seconds"], "sent": sent["sent"],
         "midi_received": summary.get("midi_messages", 0), "control_events": len(controls),
+        "midi_overflows": summary.get("midi_overflows", 0),
         "events_dropped": engine.events_dropped, "finals_missing": missing,
         "deadline_misses": summary.get("deadline_misses", -1), "overruns": summary.get("overruns", -1),
         "quiet_deadline_misses": background, "load_max": summary.get("load_max", 0.0),
@@ -211,8 +214,8 @@ def run_cli(args):
 
     with dummy_jack():
         runs = [flood(args.rate, args.seconds, progress) for _ in range(args.runs)]
-    keys = ("sent", "midi_received", "control_events", "events_dropped", "finals_missing", "deadline_misses",
-            "overruns", "quiet_deadline_misses")
+    keys = ("sent", "midi_received", "control_events", "midi_overflows", "events_dropped", "finals_missing",
+            "deadline_misses", "overruns", "quiet_deadline_misses")
     medians = {k: statistics.median(r[k] for r in runs) for k in keys}
     result = {"rate": args.rate, "seconds": args.seconds, "runs": runs, "median": medians}
     if args.json:

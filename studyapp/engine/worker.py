@@ -136,7 +136,7 @@ class Worker:
         self.sink = None
         status.set(state="starting", rate=config.rate)
         status.publish()
-        sys.setswitchinterval(0.0005)  # PortAudio's and rtmidi's threads need the GIL promptly
+        sys.setswitchinterval(0.0005)  # PortAudio's callback thread needs the GIL promptly
 
         self.sink = open_sink(config.audio, config.rate, lead=config.lead,
                               say=lambda text: self.notice(text, "warning", "audio"))
@@ -330,7 +330,7 @@ class Worker:
         cpu = time.thread_time() - cpu_started
         self.k += 1
         if self.midi is not None:
-            self.midi.block = self.k
+            self.midi.new_block(self.k, finished)
         return finished, finished - started, cpu
 
     def run(self):
@@ -426,6 +426,7 @@ class Worker:
             "seconds": end - start if start else 0.0, "achieved_rate": achieved, "deadline_misses": int(s.get("deadline_misses")),
             "audio_underruns": self.sink.underruns, "audio_xruns": self.sink.xruns,
             "audio_frames": self.sink.frames_played, "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
+            "midi_overflows": self.midi.overflows if self.midi else 0,
             "command_latency_max": float(s.get("command_latency_max")),
             "load_mean": float(np.mean(self.loads)) if self.loads else 0.0,
             "load_p99": float(np.percentile(self.loads, 99)) if self.loads else 0.0,

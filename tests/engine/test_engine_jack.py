@@ -87,7 +87,7 @@ def test_a_control_change_from_another_process_sets_fmax_within_one_block(jack_s
         assert tel["fmax"][change[0]] == pytest.approx(expected)
     finally:
         summary = engine.stop()
-    assert summary["midi_messages"] == 2
+    assert summary["midi_messages"] == 2 and summary["midi_overflows"] == 0
 
 
 def wait_for_controls(engine, n, timeout=5.0):

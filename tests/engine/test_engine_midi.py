@@ -1,14 +1,15 @@
-"""MIDI: the LPD8 factory map, protocol maps, learn mode, knob scales, the callback queue, and the
+"""MIDI: the LPD8 factory map, protocol maps, learn mode, knob scales, polling rtmidi's queue, and the
 one-line fallback without a back-end. Messages come from mido fake ports (mido.ports.BaseInput)."""
 
 import os
-import threading
+import time
 
 import mido
+import numpy as np
 import pytest
 
 from studyapp.engine import commands
-from studyapp.engine.midi import ControlMap, MidiInput, coalesce, open_input
+from studyapp.engine.midi import ControlMap, MidiInput, arrival_times, coalesce, open_input
 from studyapp.errors import ParameterError
 from studyapp.model.fmax_knob import LIVE_RANGE, fmax_from_knob
 
@@ -103,24 +104,55 @@ def test_default_actions_drive_the_engine_commands():
     assert "pad4" not in actions
 
 
-def test_the_callback_only_queues_raw_bytes_and_the_engine_drains_in_order():
-    midi = MidiInput("fake", "UNIX_JACK")
+class FakeRtMidiIn:
+    """python-rtmidi's ``MidiIn`` polled without a callback: ``get_message()`` -> ([bytes], delta time) or None."""
+
+    def __init__(self, messages):
+        self.messages = list(messages)
+
+    def get_message(self):
+        return self.messages.pop(0) if self.messages else None
+
+
+def test_arrival_times_go_back_from_the_poll_by_the_delta_times_and_never_before_the_previous_poll():
+    rng = np.random.default_rng(14)
+    deltas = rng.exponential(0.0004, 50)
+    polled, previous = 100.0, 100.0 - 0.002
+    got = np.array(arrival_times(list(deltas), polled, previous))
+    # closed form: the last at the poll, each earlier one by the sum of the delta times after it
+    after = np.concatenate([np.cumsum(deltas[::-1])[::-1][1:], [0.0]])
+    np.testing.assert_allclose(got, np.maximum(polled - after, previous), rtol=0, atol=1e-12)
+    assert (got >= previous).all() and got[-1] == polled and (np.diff(got) >= 0).all()
+    assert arrival_times([0.0, 0.001, 0.002, 0.0005], 10.0, 9.0) == pytest.approx([9.9965, 9.9975, 9.9995, 10.0])
+    assert arrival_times([], 10.0, 9.0) == []
+
+
+def test_the_engine_polls_rtmidis_queue_in_order_with_arrival_times_and_blocks():
     sent = [[0xB0, 1, v] for v in range(100)]
-
-    def rtmidi_thread():  # python-rtmidi calls back with ([bytes], delta time) and the user data
-        for i, m in enumerate(sent):
-            midi.block = i // 10
-            midi._callback((m, 0.001), None)
-
-    thread = threading.Thread(target=rtmidi_thread)
-    thread.start()
-    thread.join(5)
+    midi = MidiInput("fake", "UNIX_JACK", rt=FakeRtMidiIn([(m, 0.0) for m in sent[:-2]]))
+    midi.new_block(5, time.monotonic())
+    before = time.monotonic()
     got = midi.poll()
-    assert [m for m, _, _ in got] == sent
-    assert [b for _, _, b in got] == [i // 10 for i in range(100)]
-    times = [t for _, t, _ in got]
-    assert times == sorted(times)
-    assert midi.received == 100 and midi.poll() == []
+    assert [m for m, _, _ in got] == sent[:-2]
+    assert before <= got[-1][1] <= time.monotonic()  # the last is anchored at the poll
+    assert {b for _, _, b in got} == {5}  # all arrived after block 5 began
+    assert midi.received == 98 and midi.poll() == []
+    # a long delta puts the earlier message before the block began, but never before the previous poll
+    midi._rt.messages = [(sent[-2], 0.0), (sent[-1], 10.0)]
+    polled_before = midi._polled
+    midi.new_block(6, time.monotonic())
+    (first, t1, b1), (last, t2, b2) = midi.poll()
+    assert (first, last) == (sent[-2], sent[-1])
+    assert t1 == polled_before and (b1, b2) == (5, 6) and t2 > t1
+    assert midi.received == 100 and midi.overflows == 0
+
+
+def test_a_poll_that_finds_rtmidis_queue_full_counts_an_overflow():
+    midi = MidiInput("fake", "UNIX_JACK", rt=FakeRtMidiIn([([0xB0, 1, v], 0.0) for v in range(8)]), queue_size=8)
+    assert len(midi.poll()) == 8 and midi.overflows == 1
+    midi._rt.messages = [([0xB0, 1, v], 0.0) for v in range(7)]
+    assert len(midi.poll()) == 7 and midi.overflows == 1
+    assert MidiInput("closed", "UNIX_JACK").poll() == []
 
 
 def test_a_block_keeps_only_the_last_value_of_each_controller_and_every_note():
