@@ -6,10 +6,10 @@ import pytest
 
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
-from studyapp.engine.status import StatusBlock
 from studyapp.engine.worker import Worker
 from studyapp.errors import EngineError, UserError
 from studyapp.model.fmax_knob import fmax_from_knob
+from tests.engine.fake_worker import fake_worker
 
 
 def test_every_command_type_has_exactly_one_handler():
@@ -23,33 +23,9 @@ def test_every_command_type_has_exactly_one_handler():
     assert made.sent > 0
 
 
-class FakeLoop:
-    rate = 5000.0
-    fault = None
-
-    def __init__(self):
-        self.fmax, self.source = 0.0, "LVT"
-
-    def set_fmax(self, fmax):
-        self.fmax = fmax
-
-    def set_source(self, name):
-        if name not in ("LVT", "KALLEV"):
-            raise ValueError(f"unknown source {name!r}")
-        self.source = name
-
-
-class Events(list):
-    put = list.append
-
-
 @pytest.fixture
 def worker():
-    w = Worker.__new__(Worker)
-    w.loop, w.events, w.k, w.block, w.actions, w.trial = FakeLoop(), Events(), 7, 10, {}, 0
-    w.knob_seen, w.ratings = {}, {}
-    w.safety = type("Safety", (), {"clamp_fmax": staticmethod(lambda f: min(f, 20.0))})()
-    w.status = StatusBlock.create()
+    w = fake_worker()
     yield w
     w.status.close()
 

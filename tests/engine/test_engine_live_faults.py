@@ -10,19 +10,10 @@ import numpy as np
 
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
+from tests.engine.waiting import wait_for
 
 RATE = 5000.0
 FMAX = 2.0
-
-
-def _wait(predicate, timeout=10.0, step=0.002):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(step)
-    raise AssertionError("timed out waiting")
 
 
 def _gone(pid):
@@ -38,12 +29,12 @@ def test_after_a_watchdog_trip_not_one_sample_of_force_even_after_sigcont():
     pid = engine.process.pid
     try:
         # the scripted strokes bow the string: the force is up near F_max before the stop
-        _wait(lambda: np.max(np.abs(engine.telemetry(int(0.05 * RATE))["force"])) > 0.5 * FMAX)
+        wait_for(lambda: np.max(np.abs(engine.telemetry(int(0.05 * RATE))["force"])) > 0.5 * FMAX)
         os.kill(pid, signal.SIGSTOP)
-        _wait(lambda: engine.tripped, timeout=3.0)
+        wait_for(lambda: engine.tripped, timeout=3.0)
         written = engine.telemetry(1)["end"]  # every sample the worker wrote before it was stopped
         os.kill(pid, signal.SIGCONT)
-        _wait(lambda: engine.telemetry(1)["end"] > written + 0.1 * RATE)
+        wait_for(lambda: engine.telemetry(1)["end"] > written + 0.1 * RATE)
         tel = engine.telemetry(since=written)
         assert tel["start"] == written and tel["end"] > written + 0.1 * RATE
         assert np.all(tel["force"] == 0.0) and np.all(tel["force_scale"] == 0.0)
@@ -57,9 +48,9 @@ def test_stop_lets_go_of_a_stalled_worker_at_once():
     engine = Engine(EngineConfig(rate=RATE, source="LVT", hang_timeout=0.08)).start()
     pid = engine.process.pid
     try:
-        _wait(lambda: engine.status()["samples"] > 0.1 * RATE)
+        wait_for(lambda: engine.status()["samples"] > 0.1 * RATE)
         os.kill(pid, signal.SIGSTOP)  # stopped: it will not answer a stop command, nor a SIGTERM
-        _wait(lambda: engine.tripped, timeout=3.0)
+        wait_for(lambda: engine.tripped, timeout=3.0)
         stopping = time.monotonic()
         engine.stop()
         took = time.monotonic() - stopping

@@ -4,11 +4,9 @@ import pytest
 
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
-from studyapp.engine.audio import Gain
 from studyapp.engine.pickup import level_position, passes_through
-from studyapp.engine.status import StatusBlock
-from studyapp.engine.worker import Worker
 from studyapp.model.fmax_knob import fmax_from_knob
+from tests.engine.fake_worker import fake_worker
 
 ADJUST = {"knob1": ("fmax_log", 40.0, 2.0)}
 
@@ -38,32 +36,9 @@ def test_the_level_position_of_each_action():
     assert level_position(("source", "LVT"), 1.0, None) is None
 
 
-class FakeLoop:
-    rate = 5000.0
-    fault = None
-
-    def __init__(self):
-        self.fmax, self.source = 0.0, "LVT"
-
-    def set_fmax(self, fmax):
-        self.fmax = fmax
-
-    def set_source(self, name):
-        self.source = name
-
-
-class Events(list):
-    put = list.append
-
-
 @pytest.fixture
 def worker():
-    w = Worker.__new__(Worker)
-    w.loop, w.events, w.k, w.block, w.actions, w.trial = FakeLoop(), Events(), 7, 10, {}, 0
-    w.knob_seen, w.ratings = {}, {}
-    w.sink = type("Sink", (), {"gain": Gain(), "set_volume": lambda self, v: setattr(self.gain, "volume", v)})()
-    w.safety = type("Safety", (), {"clamp_fmax": staticmethod(lambda f: min(f, 20.0))})()
-    w.status = StatusBlock.create()
+    w = fake_worker()
     yield w
     w.status.close()
 

@@ -14,18 +14,9 @@ from studyapp.engine.commands import ResetString, SetFmax, SetSource, Stall
 from studyapp.engine.engine import Engine, EngineError
 from studyapp.errors import ParameterError
 from studyapp.model.stability import StabilityMonitor
+from tests.engine.waiting import wait_for
 
 RATE = 5000.0
-
-
-def _wait(predicate, timeout=10.0, step=0.005):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(step)
-    raise AssertionError("timed out waiting")
 
 
 def _segments(engine):
@@ -55,14 +46,14 @@ def test_worker_runs_switches_source_and_fmax_and_stops_cleanly():
     try:
         block = engine.info["block"]
         assert engine.info["names"] == ["KALLEV", "LOWPASS"] and block == 10
-        _wait(lambda: engine.status()["samples"] > 0.3 * RATE)
+        wait_for(lambda: engine.status()["samples"] > 0.3 * RATE)
         before = engine.status()
         assert before["state"] == "running" and before["source"] == "LVT" and before["fmax"] == 1.0
 
         engine.send(SetSource("KALLEV"))
         engine.send(SetFmax(3.0))
-        _wait(lambda: engine.status()["fmax"] == 3.0 and engine.status()["source"] == "KALLEV")
-        _wait(lambda: engine.status()["samples"] > before["samples"] + 0.3 * RATE)
+        wait_for(lambda: engine.status()["fmax"] == 3.0 and engine.status()["source"] == "KALLEV")
+        wait_for(lambda: engine.status()["samples"] > before["samples"] + 0.3 * RATE)
         snap = engine.status()
         tel = engine.telemetry(int(RATE))
         tel_end = tel["end"]
@@ -94,9 +85,9 @@ def test_worker_runs_switches_source_and_fmax_and_stops_cleanly():
         # below the motor clamp), the loop's own stability verdict, the trial clock from ResetString
         np.testing.assert_allclose(-tel["friction"] * tel["fmax"] * tel["force_scale"], tel["force"], atol=1e-12)
         engine.send(ResetString())
-        _wait(lambda: np.any(np.diff(engine.telemetry(int(0.2 * RATE))["trial_clock"]) < 0))
+        wait_for(lambda: np.any(np.diff(engine.telemetry(int(0.2 * RATE))["trial_clock"]) < 0))
         target = engine.status()["samples"] + 0.2 * RATE
-        _wait(lambda: engine.status()["samples"] > target)
+        wait_for(lambda: engine.status()["samples"] > target)
         tel = engine.telemetry(int(0.4 * RATE))
         reset = np.flatnonzero(np.diff(tel["trial_clock"]) < 0)[0] + 1
         assert (tel["start"] + reset) % block == 0 and tel["trial_clock"][reset] == 0.0
@@ -108,14 +99,14 @@ def test_worker_runs_switches_source_and_fmax_and_stops_cleanly():
         assert tel["broken"][last] == float(monitor.broken)
         assert set(tel["trial"]) == {0.0}
 
-        achieved = _wait(lambda: engine.status()["achieved_rate"], timeout=5)
+        achieved = wait_for(lambda: engine.status()["achieved_rate"], timeout=5)
         assert achieved == pytest.approx(RATE, rel=0.1)
     finally:
         summary = engine.stop()
     assert summary["faults"] == [] and summary["samples"] >= 0.6 * RATE
     assert summary["achieved_rate"] == pytest.approx(RATE, rel=0.1)
     assert engine.process is None and engine.faults == []
-    _wait(lambda: _reaped(pid), timeout=5)
+    wait_for(lambda: _reaped(pid), timeout=5)
     assert _unlinked(segments)
 
 
@@ -124,34 +115,34 @@ def test_sigkill_of_the_worker_is_detected_within_100_ms():
     pid = engine.process.pid
     segments = _segments(engine)
     try:
-        _wait(lambda: engine.status()["samples"] > 0.2 * RATE)
+        wait_for(lambda: engine.status()["samples"] > 0.2 * RATE)
         killed = time.monotonic()
         os.kill(pid, signal.SIGKILL)
-        _wait(lambda: engine.tripped, timeout=2.0, step=0.001)
+        wait_for(lambda: engine.tripped, timeout=2.0, step=0.001)
         assert engine.fault_time - killed < 0.1
         assert "died" in engine.faults[0] and "-9" in engine.faults[0]
         assert engine.force_output == 0.0
         assert not engine.alive
     finally:
         engine.stop()
-    _wait(lambda: _reaped(pid), timeout=5)
+    wait_for(lambda: _reaped(pid), timeout=5)
     assert _unlinked(segments)
 
 
 def test_a_hung_worker_is_detected_within_100_ms_and_zeroes_its_force_when_it_wakes():
     engine = Engine(EngineConfig(rate=RATE, source="TRUE", fmax=2.0, hang_timeout=0.08)).start()
     try:
-        _wait(lambda: engine.status()["samples"] > 0.2 * RATE)
+        wait_for(lambda: engine.status()["samples"] > 0.2 * RATE)
         engine.send(Stall(0.4))
-        _wait(lambda: engine.tripped, timeout=3.0, step=0.001)
+        wait_for(lambda: engine.tripped, timeout=3.0, step=0.001)
         last_beat = engine.status()["heartbeat"]
         assert engine.fault_time - last_beat < 0.1
         assert "heartbeat" in engine.faults[0]
         assert engine.force_output == 0.0
         # the worker wakes, finds the force disabled, latches a fault and holds the force at zero
-        _wait(lambda: engine.status()["fault_latched"], timeout=5.0)
+        wait_for(lambda: engine.status()["fault_latched"], timeout=5.0)
         end = engine.status()["samples"]
-        _wait(lambda: engine.status()["samples"] > end + 0.1 * RATE)
+        wait_for(lambda: engine.status()["samples"] > end + 0.1 * RATE)
         tel = engine.telemetry(int(0.1 * RATE))
         assert np.all(tel["force"] == 0.0) and np.all(tel["force_scale"] == 0.0)
         assert "watchdog" in engine.status()["fault"]
@@ -165,8 +156,8 @@ def test_a_nan_from_the_device_gives_zero_force_and_a_latched_fault():
                           device="tests.engine.nan_device:make")
     engine = Engine(config).start()
     try:
-        _wait(lambda: engine.status()["fault_latched"], timeout=10.0)
-        _wait(lambda: engine.status()["samples"] > 3000)
+        wait_for(lambda: engine.status()["fault_latched"], timeout=10.0)
+        wait_for(lambda: engine.status()["samples"] > 3000)
         tel = engine.telemetry(since=0)
         assert tel["start"] == 0
         bad = 1999  # the 2000th sensor reading is sample 1999
