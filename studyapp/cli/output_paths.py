@@ -22,12 +22,7 @@ def _existing_parent(path, option):
         parent = parent.parent
     if not parent.is_dir():
         raise UserError(f"{option} {path}: cannot create a file in {parent}: it is a file, not a directory")
-    try:
-        fd, probe = tempfile.mkstemp(prefix=".studyapp-probe.", dir=parent)
-    except OSError as exc:
-        raise UserError(f"{option} {path}: cannot create a file in {parent} ({exc.strerror or exc})") from None
-    os.close(fd)
-    os.unlink(probe)
+    _probe(parent, f"{option} {path}: cannot create a file in {parent}")
 
 
 def check_file(path, option="-o", inputs=()):
@@ -49,11 +44,16 @@ def check_folder(path, option="-o"):
     if path.exists() and not path.is_dir():
         raise UserError(f"{option} {path}: exists and is not a directory")
     if path.is_dir():
-        try:
-            fd, probe = tempfile.mkstemp(prefix=".studyapp-probe.", dir=path)
-        except OSError as exc:
-            raise UserError(f"{option} {path}: cannot create a file in it ({exc.strerror or exc})") from None
-        os.close(fd)
-        os.unlink(probe)
+        _probe(path, f"{option} {path}: cannot create a file in it")
         return
     _existing_parent(path, option)
+
+
+def _probe(folder, refusal):
+    """Create and delete a file in ``folder`` (as root, permissions alone do not tell); ``refusal`` if it fails."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".studyapp-probe.", dir=folder)
+    except OSError as exc:
+        raise UserError(f"{refusal} ({exc.strerror or exc})") from None
+    os.close(fd)
+    os.unlink(probe)
