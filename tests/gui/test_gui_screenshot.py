@@ -6,7 +6,6 @@ X libraries Qt's xcb plugin loads.
 """
 
 import os
-import shutil
 import subprocess
 import sys
 
@@ -16,30 +15,6 @@ import pytest
 from tests.gui.conftest import DEMO, ROOT
 
 pytestmark = pytest.mark.gui
-
-
-@pytest.fixture(scope="module")
-def xvfb_display():
-    xvfb = shutil.which("Xvfb")
-    if xvfb is None:
-        pytest.skip("Xvfb not installed (Debian xvfb, listed in scripts/system-deps.txt)")
-    read, write = os.pipe()
-    proc = subprocess.Popen([xvfb, "-displayfd", str(write), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
-                            pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    os.close(write)
-    try:
-        with os.fdopen(read) as f:
-            number = f.readline().strip()
-        if not number.isdigit():
-            pytest.fail(f"Xvfb did not report a display (exit code {proc.poll()})")
-        yield f":{number}"
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
 
 
 def test_screenshot_of_the_running_console(xvfb_display, tmp_path):
