@@ -70,6 +70,15 @@ class SetMute(Command):
 
 
 @dataclass(frozen=True)
+class ReferenceTone(Command):
+    """The headphone level check's sine tone (issue 15): ``hz`` at ``level_dbfs`` (peak, dB re full scale)
+    in place of the string's sound; ``level_dbfs`` None ends it and gives the string back."""
+
+    hz: float = 1000.0
+    level_dbfs: float | None = None
+
+
+@dataclass(frozen=True)
 class Learn(Command):
     control: str  # bind it to the next MIDI control that moves
 
