@@ -17,8 +17,10 @@ engine run of a session (a resumed session, a restarted engine).
 
 Cues. ``cue(...)`` notes a trial boundary at the recording's current frame: the
 worker calls it when it applies an ``AudioCue`` command, at a block boundary,
-so ``sample`` is the file's frame of the first sample of the block run after it
-(exact in frames; the sound itself lags by the resampler's short filter delay).
+so ``sample`` is the file's frame of the first sample of the block run after it.
+The controller sends the cue right after the trial's knob mapping; the two
+usually arrive in the same block, at worst a block (2 ms) apart. The sound
+itself lags by the resampler's short filter delay.
 The writer appends it to ``audio_cues.csv`` beside the file (columns
 ``CUE_COLUMNS``), one row per cue, shared by every file of the session.
 """

@@ -464,7 +464,7 @@ class Worker:
         """Let every recording's writer finish; say what one could not write."""
         if self.recorder is not None:
             self.recorder.stop()
-            self.recorder = None
+            self.sink.recorder = self.recorder = None  # the sink's flush on close is not the session's
         for recorder in self.recordings:
             if not recorder.join(timeout):
                 self.notice(f"audio: {recorder.path}: the writer did not finish within {timeout:g} s", "warning", "audio")
