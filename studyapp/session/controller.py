@@ -89,6 +89,7 @@ from studyapp.engine.events import Learned
 from studyapp.errors import UserError
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session, check_participant
+from studyapp.experiment.session_info import order_text
 from studyapp.experiment.session_runner import SessionRunner
 from studyapp.experiment.tasks import task_type
 from studyapp.session.engine_host import EngineHost
@@ -270,8 +271,11 @@ class SessionController:
                 engine.send(command)
 
     # session: the experimenter's buttons ---------------------------------------------
-    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None):
-        """Open the participant's session (``UserError`` when refused) and start its engine."""
+    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None):
+        """Open the participant's session (``UserError`` when refused) and start its engine.
+
+        ``details``: ``experimenter``, ``session_number``, ``notes``, ``order_row`` (experiment/session_info.py).
+        """
         if self.protocol is None:
             raise UserError("no protocol loaded: choose one first")
         if self.in_session:
@@ -280,10 +284,11 @@ class SessionController:
             raise UserError("the emergency stop is set: clear it (Resume) before starting a session")
         check_participant(participant)
         if resume:
-            session = Session.resume(self.protocol, participant, results, seed=seed)
+            session = Session.resume(self.protocol, participant, results, seed=seed, **(details or {}))
         else:
             described = {"device": self.device or "simulated", "engine": "real-time", **(apparatus or {})}
-            session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described)
+            session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
+                                     **(details or {}))
         self.session = session
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
@@ -318,7 +323,7 @@ class SessionController:
         self.runner = None
         self._replace_host(self._engine_config(self.session.seed, {}), f"session {self.session.folder}")
         self.message(f"session {self.session.folder}: {len(self.session.finished_steps())} of "
-                     f"{len(self.session.schedule)} trials done; starting the engine")
+                     f"{len(self.session.schedule)} trials done, {order_text(self.session.info)}; starting the engine")
         return State.STARTING
 
     def _begin(self):
