@@ -222,7 +222,8 @@ class Worker:
         if c.path is None:
             return
         if not self.sink.render:
-            raise ValueError(f"the {self.sink.description} sink renders no audio: nothing to record")
+            self.notice(f"audio: the {self.sink.description} sink renders no audio: nothing to record", "warning", "audio")
+            return
         self.recorder = self.sink.recorder = AudioRecorder(c.path, self.sink.rate)
         self.recordings.append(self.recorder)
         self.notice(f"audio: recording what is heard to {self.recorder.path}", "info", "audio")
