@@ -40,8 +40,10 @@ class Trial:
         return task_type(self.task).describe(self)
 
 
-def build_schedule(protocol, participant_index):
+def build_schedule(protocol, participant_index, order_row=None):
     """The trials of the ``participant_index``-th participant (from 0) under ``protocol``.
+
+    ``order_row`` (``session_info``) picks the Latin-square rows in place of the enrolment index.
 
     Returns ``(trials, squares)``: ``squares`` records, per task, the number of
     rows of its Latin square and the rows used, for session.json.
@@ -51,7 +53,8 @@ def build_schedule(protocol, participant_index):
         spec = protocol.task(task)
         seed = task_seed(protocol.seed, task)
         square = balanced_latin_square(spec.conditions, seed)
-        planned, used = task_type(task).schedule(spec, square, participant_index)
+        row = participant_index if order_row is None else order_row
+        planned, used = task_type(task).schedule(spec, square, row)
         for number, conditions, condition in planned:
             trials.append(Trial(len(trials), task, number, tuple(conditions), condition))
         squares[task] = {"rows": len(square), "rows_used": used, "seed": seed}
