@@ -93,15 +93,13 @@ class KnobPanel(QWidget):
 
     def _participant_layout(self):
         # box layouts, not a grid: a hidden dial or pad then takes no room at all
-        dials = QHBoxLayout()
-        dials.setSpacing(12)
-        dials.addStretch(1)
         for dial in self.dials:
             dial.setNotchesVisible(False)
             dial.setFixedSize(PARTICIPANT_DIAL, PARTICIPANT_DIAL)
             dial.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-            dials.addWidget(dial)
-            dials.addStretch(1)
+        self._dial_row = QHBoxLayout()
+        self._dial_row.setSpacing(12)
+        self._space_dials(self.dials)
         pads = QHBoxLayout()
         pads.addStretch(1)
         for pad in self.pads:
@@ -111,8 +109,18 @@ class KnobPanel(QWidget):
         column = QVBoxLayout(self)
         column.setContentsMargins(0, 0, 0, 0)
         column.setSpacing(16)
-        column.addLayout(dials)
+        column.addLayout(self._dial_row)
         column.addLayout(pads)
+
+    def _space_dials(self, shown):
+        """The participant's row: the ``shown`` dials spread evenly across the width."""
+        row = self._dial_row
+        while row.count():
+            row.takeAt(0)
+        row.addStretch(1)
+        for dial in shown:
+            row.addWidget(dial)
+            row.addStretch(1)
 
     def _turned(self, index, value):
         self._show_value(index, value)
@@ -152,6 +160,8 @@ class KnobPanel(QWidget):
         """Show just the dials in ``knobs`` and the pads in ``pads`` (indices from 0); the pads read ``pad_text``."""
         for i, dial in enumerate(self.dials):
             dial.setVisible(i in knobs)
+        if self.participant:
+            self._space_dials([dial for i, dial in enumerate(self.dials) if i in knobs])
         for i, pad in enumerate(self.pads):
             pad.setVisible(i in pads)
             if pad_text:

@@ -164,6 +164,7 @@ class ParticipantWindow(QWidget):
     def show_state(self, state, emergency=False):
         self.notice.setText(MESSAGES["paused"] if emergency else MESSAGES.get(state, ""))
         if state not in ACTIVE:
+            self.progress.setText("")
             self.instructions.setText("")
             self.show_controls([], [])
             self.show_refusal("")
