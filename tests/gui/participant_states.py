@@ -9,6 +9,7 @@ adjustment, the demo's three-condition rating), started by their task types.
 
 import json
 import sys
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -34,12 +35,13 @@ class FakeController:
         self.bowing_asked.append(bool(on))
         self.events.bowing.emit(on=bool(on))
 
-    def start(self, protocol, task, step=0):
-        """Start the participant's first trial of ``task`` as the controller does; returns what the console shows."""
+    def start(self, protocol, task, step=0, **spec_changes):
+        """Start the participant's first trial of ``task`` as the controller does (its spec changed
+        by ``spec_changes``); returns what the console shows."""
         protocol = load_protocol(ROOT / "protocols" / protocol)
         trials, _ = build_schedule(protocol, 0)
         trial = next(t for t in trials if t.task == task)
-        self.runner.task = task_type(task).start(protocol.task(task), trial)
+        self.runner.task = task_type(task).start(replace(protocol.task(task), **spec_changes), trial)
         shown = {"step": step, "total": len(trials), "instructions": instructions_for(protocol, task)}
         self.events.trial.emit(trial=trial, **shown)
         return shown
@@ -47,7 +49,7 @@ class FakeController:
 
 def put_in_state(window, controller, state):
     """Show ``state`` (one of ``STATES``) in ``window``, as the console would."""
-    window.show_title("Velocity estimators: noisiness and stability")
+    window.show_title("Bowing a virtual string")
     if state == "idle":
         window.show_state("idle")
         return
