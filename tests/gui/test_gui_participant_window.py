@@ -14,6 +14,18 @@ pytestmark = pytest.mark.gui
 KNOB_LABEL = re.compile(r"\b[KP]\d+\b|knob \d|:\s*\d+$")  # "K1: 75", "P1", "knob 1 (MIDI ...)"
 
 
+@pytest.fixture(autouse=True)
+def active_window_kept(qapp, qtbot):
+    """The window active before a test is active again after it (the console's tests press keys in it)."""
+    from PySide6.QtWidgets import QApplication
+
+    before = QApplication.activeWindow()
+    yield
+    if before is not None and before.isVisible() and QApplication.activeWindow() is not before:
+        before.activateWindow()
+        qtbot.waitUntil(lambda: QApplication.activeWindow() is before, timeout=2000)
+
+
 @pytest.fixture
 def window(qapp):
     from studyapp.gui.participant_window import ParticipantWindow
