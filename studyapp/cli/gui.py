@@ -10,8 +10,7 @@ exits; ``--measure-scope SECONDS`` prints the live scope's frame rate with
 every trace on and exits. ``--participant-screen N`` opens the participant's
 window full-screen on screen N (from 0), remembered for the next
 ``--participant-window``; ``--participant-screenshot FILE`` saves that window
-as a PNG once the first trial shows (with ``--start``; else once the engine
-runs) and exits. See docs/gui.md.
+as a PNG (with ``--start``, once the first trial shows) and exits. See docs/gui.md.
 """
 
 

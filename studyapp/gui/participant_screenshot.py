@@ -1,11 +1,10 @@
 """``studyapp gui --participant-screenshot FILE``: the participant's window, as the participant sees it, saved as a PNG.
 
-The window is opened (full-screen if a screen was chosen). Once the engine
-runs, and with ``--start`` once the session's first trial is on screen, the
-window is grabbed (``QWidget.grab``: no window manager needed), written
-atomically, its path printed, and the application exits with 0. An engine
-that fails, or nothing to show within ``timeout`` seconds, is one line on
-stderr and exit code 1.
+The window is opened (full-screen if a screen was chosen) and grabbed at
+once, or with ``--start`` once the session's first trial is on screen
+(``QWidget.grab``: no window manager needed); the PNG is written atomically,
+its path printed, and the application exits with 0. An engine that fails, or
+no trial within ``timeout`` seconds, is one line on stderr and exit code 1.
 """
 
 import sys
@@ -44,6 +43,6 @@ class ParticipantScreenshot:
         elif self.clock() > self.deadline:
             self._exit(1, f"studyapp gui: error: nothing to show after {self.timeout:g} s "
                           f"(engine {state}, session {c.state})", sys.stderr)
-        elif state == "running" and (not self.wait_for_trial or (c.state == "running" and c.runner.trial)):
+        elif not self.wait_for_trial or (state == "running" and c.state == "running" and c.runner.trial):
             save_widget(self.console.participant_window, self.path)
             self._exit(0, self.path, sys.stdout)

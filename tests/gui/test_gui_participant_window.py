@@ -187,3 +187,37 @@ def test_bad_participant_options_are_one_line(qapp, settings_in, argv, words, ca
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"studyapp: error: {words}") and "\n" not in err
+
+
+def test_participant_screenshot_waits_for_the_first_trial_then_saves(qapp, tmp_path, capsys):
+    from types import SimpleNamespace
+
+    from PySide6.QtWidgets import QWidget
+
+    from studyapp.gui.participant_screenshot import ParticipantScreenshot
+    from studyapp.gui.participant_window import ParticipantWindow
+
+    now = [0.0]
+    controller = SimpleNamespace(host=SimpleNamespace(state="starting", error=None), state="starting",
+                                 runner=None)
+    console = QWidget()
+    console.controller = controller
+    console.participant_window = ParticipantWindow()
+    path = tmp_path / "p.png"
+    shot = ParticipantScreenshot(console, str(path), wait_for_trial=True, timeout=30, clock=lambda: now[0])
+    shot._check()
+    assert not path.exists() and shot.timer.isActive()  # the session's engine is still starting
+    controller.host.state, controller.state = "running", "running"
+    controller.runner = SimpleNamespace(trial=object())
+    shot._check()
+    assert path.is_file() and not shot.timer.isActive()
+    assert capsys.readouterr().out.strip() == str(path)
+
+    late = ParticipantScreenshot(console, str(tmp_path / "late.png"), wait_for_trial=True, timeout=30,
+                                 clock=lambda: now[0])
+    controller.state = "starting"
+    now[0] = 31.0
+    late._check()
+    err = capsys.readouterr().err.strip()
+    assert err == "studyapp gui: error: nothing to show after 30 s (engine running, session starting)"
+    assert not (tmp_path / "late.png").exists()
