@@ -5,8 +5,12 @@ pytest-qt), the ``SessionController`` (audio and MIDI as asked, falling back
 to no sound and the on-screen knobs when nothing is found), and the console;
 loads the protocol (``--protocol``, else ``protocols/sinclair2014.toml`` or the
 first protocol in ``protocols/``); fills in the participant; starts the
-session at once with ``--start``; and runs the event loop. ``--screenshot`` and
-``--measure-scope`` run the console unattended and exit.
+session at once with ``--start``; and runs the event loop. ``--screenshot``,
+``--participant-screenshot`` and ``--measure-scope`` run the console
+unattended and exit. The participant's window opens with
+``--participant-window``, ``--participant-screen N`` or
+``--participant-screenshot``, full-screen on the chosen (or remembered)
+screen; a screen that does not exist is refused before anything starts.
 """
 
 import signal
@@ -65,12 +69,24 @@ def build(args):
 
 def main(args):
     """Run the console until it is closed; returns the exit code."""
+    from studyapp.gui.participant_screen import choose_screen
+
     app = application()
+    screen_choice = getattr(args, "participant_screen", None)
+    shot = getattr(args, "participant_screenshot", None)
+    participant = getattr(args, "participant_window", False) or screen_choice is not None or bool(shot)
+    screen = choose_screen(screen_choice) if participant else None
     controller, console = build(args)
     console.show()
-    if getattr(args, "participant_window", False):
+    if screen is not None:
+        console.participant_window.show_full_screen(screen)
+    if participant:
         console.show_participant.setChecked(True)
-    if getattr(args, "screenshot", None):
+    if shot:
+        from studyapp.gui.participant_screenshot import ParticipantScreenshot
+
+        console.unattended = ParticipantScreenshot(console, shot, wait_for_trial=getattr(args, "start", False))
+    elif getattr(args, "screenshot", None):
         from studyapp.gui.screenshot import Screenshot
 
         console.unattended = Screenshot(console, args.screenshot)
@@ -78,7 +94,7 @@ def main(args):
         from studyapp.gui.scope_benchmark import ScopeBenchmark
 
         console.unattended = ScopeBenchmark(console, args.measure_scope)
-    elif getattr(args, "start", False):
+    if getattr(args, "start", False) and not (getattr(args, "screenshot", None) or getattr(args, "measure_scope", None)):
         _start_when_possible(console, getattr(args, "seed", None))
     # Ctrl-C in the terminal closes the console cleanly (Python sees signals between Qt events)
     signal.signal(signal.SIGINT, lambda *_: console.close())

@@ -182,7 +182,7 @@ class Console(QMainWindow):
         self.status = StatusBar()
         self.setStatusBar(self.status)
 
-        self.participant_window = ParticipantWindow()
+        self.participant_window = ParticipantWindow(controller)
         self.participant_window.knobs.knob_turned.connect(controller.knob)
         self.participant_window.knobs.pad_pressed.connect(controller.pad)
         self.show_participant = QAction("Participant window", self, checkable=True)
