@@ -1,5 +1,11 @@
 """The participant's window: the task's instructions, progress, and nothing that reveals the condition.
 
+Between trials it shows the session's pages (welcome, instructions, breaks,
+...: ``page_view.PageView``) in place of the instructions and knobs; its
+Continue button is ``page_view.continued``. Progress counts the current
+task's practice or real trials ("Practice 1 of 2", "Trial 2 of 12"); a
+refused confirm shows its reason (which names knobs, never conditions).
+
 Shown on a second screen (or not at all). It never names an estimator, a
 condition, F_max or a knob's meaning: only the study's title, the current
 task's instructions from the protocol, "trial x of y", and whether the session
@@ -12,6 +18,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
 from studyapp.gui.knobs import KnobPanel
+from studyapp.gui.page_view import PageView
 
 MESSAGES = {
     "idle": "Please wait: the session has not started yet.",
@@ -39,10 +46,13 @@ class ParticipantWindow(QWidget):
         self.pickup = QLabel("")
         self.pickup.setStyleSheet("font-size: 16pt; color: #06c;")
         self.knobs = KnobPanel(knobs, pads)
+        self.page_view = PageView()
+        self.page_view.hide()
         layout = QVBoxLayout(self)
         layout.addWidget(self.title)
         layout.addWidget(self.progress)
         layout.addWidget(self.instructions, 1)
+        layout.addWidget(self.page_view, 1)
         layout.addWidget(self.notice)
         layout.addWidget(self.pickup)
         layout.addWidget(self.knobs)
@@ -51,9 +61,28 @@ class ParticipantWindow(QWidget):
     def show_title(self, title):
         self.title.setText(title)
 
-    def show_trial(self, step, total, instructions):
-        self.progress.setText(f"Trial {step + 1} of {total}")
+    def show_trial(self, step, total, instructions, phase="trial", number=None, of=None):
+        self._show_page_view(phase == "page")
+        if phase != "page":
+            word = "Practice" if phase == "practice" else "Trial"
+            self.progress.setText(f"{word} {number} of {of}" if number else f"Trial {step + 1} of {total}")
         self.instructions.setText(instructions)
+        self.notice.setText("")
+
+    def show_page(self, kind, title, text, by):
+        """A page in place of the instructions and knobs (``text`` in Markdown)."""
+        self._show_page_view(True)
+        self.progress.setText("")
+        self.page_view.show_page(kind, title, text, by)
+
+    def _show_page_view(self, on):
+        self.page_view.setVisible(on)
+        self.instructions.setVisible(not on)
+        self.knobs.setVisible(not on)
+
+    def show_refusal(self, reason):
+        """Why a confirm was not taken (blind-safe: the tasks name knobs, not conditions)."""
+        self.notice.setText(f"Not yet: {reason}")
 
     def show_pickup(self, text):
         """A physical knob waiting for pickup: say which way to turn it ("" once it acts)."""
@@ -66,4 +95,5 @@ class ParticipantWindow(QWidget):
             self.notice.setText(MESSAGES.get(state, ""))
         if state in ("finished", "aborted", "idle"):
             self.instructions.setText("")
+            self._show_page_view(False)
         self.knobs.setEnabled(state == "running" and not emergency)

@@ -64,7 +64,7 @@ back). Each step is announced by the ``trial`` event with its ``phase``
 (``page``, ``practice`` or ``trial``) and its ``number`` ``of`` the steps of
 that phase (of its task, for trials: "Practice 1 of 2", "Trial 2 of 12");
 a page also by the ``page`` event (``kind``, ``title``, ``text`` in
-Markdown, ``by``: who acknowledges it). ``acknowledge_page(by)`` is the
+Markdown, ``by``: who acknowledges it, ``step``, ``tone_hz``, ``level_dbfs``). ``acknowledge_page(by)`` is the
 participant's Continue button or the experimenter's confirm. A calibration
 page sends ``ReferenceTone(tone_hz, level_dbfs)`` when it starts and
 ``ReferenceTone(level_dbfs=None)`` when it ends (acknowledged, paused,
@@ -546,7 +546,8 @@ class SessionController:
                                number=number, of=of)
         if trial.page is not None:
             page = trial.page
-            self.events.page.emit(kind=page.kind, title=page.title, text=page.text, by=page.by, step=trial.step)
+            self.events.page.emit(kind=page.kind, title=page.title, text=page.text, by=page.by, step=trial.step,
+                                  tone_hz=page.tone_hz, level_dbfs=page.level_dbfs)
         self._announce_selection()
         self.events.gesture.emit(name=self.runner.gesture)
         self.events.bowing.emit(on=self.runner.bowing)
