@@ -341,3 +341,21 @@ def test_the_task_hears_whether_the_bow_is_on(tmp_path):
     runner.advance(0.3)
     assert runner.pad(3)[0]["accepted"] is True
     session.close()
+
+
+@pytest.mark.parametrize(("change", "named"), [
+    ('[[pages]]\nkind = "calibration"\ntext = "x"\ntone_hz = 1000\nlevel_dbfs = -61', "[[pages]] #5 level_dbfs"),
+    ("[adjustment]\nmin_listen_s = -1", "[adjustment] min_listen_s = -1"),
+])
+def test_studyapp_run_refuses_a_bad_page_or_phase_field_and_enrols_nobody(tmp_path, capsys, change, named):
+    from studyapp.cli import main
+
+    text = FLOW + "\n" + change + "\n" if change.startswith("[[") else FLOW.replace("[adjustment]\n", change + "\n")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    results = tmp_path / "results"
+    code = main(["run", "--protocol", str(bad), "--participant", "P1", "--headless", "--simulated-participant",
+                 "--results", str(results)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and err.startswith(f"studyapp: error: {bad}: ") and named in err
+    assert not results.exists()
