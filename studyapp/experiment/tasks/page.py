@@ -13,7 +13,8 @@ A page is done when it is acknowledged: by the participant with its ``pad``
 logged and refused. The acknowledgement is logged as a ``response`` of task
 ``page`` (``kind``, ``title``, ``by``, and for a calibration page
 ``tone_hz`` and ``level_dbfs``), so a resumed session never shows an
-acknowledged page again. It is not a response row: ``export_rows`` is empty
+acknowledged page again; how long it was read is the time between its
+``trial_start`` and this record. It is not a response row: ``export_rows`` is empty
 and ``measure`` None (the log keeps when each page was acknowledged).
 """
 
@@ -71,7 +72,7 @@ class PageTrial:
     def _acknowledged(self, by):
         p = self.page
         self.response = {"type": "response", "task": self.task, "trial": self.trial, "fmax": 0.0, "kind": p.kind,
-                         "title": p.title, "by": by, "duration": self.elapsed}
+                         "title": p.title, "by": by}
         if p.kind == "calibration":
             self.response.update(tone_hz=p.tone_hz, level_dbfs=p.level_dbfs)
         return self.response
