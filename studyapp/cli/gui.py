@@ -2,12 +2,16 @@
 
     studyapp gui [--protocol FILE] [--participant ID] [--results DIR] [--resume]
                  [--simulated-participant] [--start] [--seed N] [--audio SPEC] [--midi SPEC]
+                 [--experimenter NAME] [--session-number N] [--notes TEXT] [--order-row N]
                  [--participant-window] [--screenshot FILE] [--measure-scope SECONDS]
 
 ``--screenshot FILE`` starts the console, lets it run, saves it as a PNG and
 exits; ``--measure-scope SECONDS`` prints the live scope's frame rate with
-every trace on and exits. See docs/gui.md.
+every trace on and exits. The session-info options fill the set-up panel's
+fields (checked as ``studyapp run`` checks them). See docs/gui.md.
 """
+
+from studyapp.cli.session_info_options import add_session_info_options
 
 
 def register(sub):
@@ -28,6 +32,7 @@ def register(sub):
     parser.add_argument("--screenshot", metavar="FILE", help="save the running console as a PNG and exit")
     parser.add_argument("--measure-scope", type=float, metavar="SECONDS",
                         help="measure the scope's frame rate with every trace on for SECONDS, print it and exit")
+    add_session_info_options(parser)
     parser.set_defaults(func=run)
 
 
@@ -35,6 +40,11 @@ def run(args):
     from studyapp.errors import UserError
     from studyapp.gui.display import require_display
 
+    from studyapp.experiment.session_info import check_experimenter, check_notes, check_session_number
+
+    check_experimenter(args.experimenter)
+    check_session_number(args.session_number)
+    check_notes(args.notes)
     require_display()
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")

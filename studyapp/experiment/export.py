@@ -4,9 +4,10 @@ One row per response, first the columns of the "Study results" contract:
 
     participant, session, task, condition, trial, fmax, rating, time, protocol_hash
 
-then ``study, step, practice, value, knob, peak_fmax, duration, app_version``
-and the trial's engine health ``deadline_misses, underruns, faults,
-events_dropped``.
+then ``study, step, practice, value, knob, peak_fmax, duration, app_version``,
+the trial's engine health ``deadline_misses, underruns, faults,
+events_dropped``, and the session's ``experimenter, session_number,
+order_row``.
 
 - ``task`` names the task type; ``trial``, ``fmax``, ``time``, ``step`` and
   ``duration`` come from the response event, the rest from the task type's
@@ -32,6 +33,12 @@ events_dropped``.
   records of its step, summed over its attempts); empty for a session without
   a real-time engine (``studyapp run``).
 
+- ``experimenter``, ``session_number``, ``order_row``: from session.json
+  (``session_info``); empty when not given, or for a session stored before
+  they were. The experimenter's ``notes`` stay in session.json: free text of
+  up to 2000 characters and several lines, they would repeat on every
+  response row and break the table's one-line cells.
+
 Incomplete sessions are exported too: every confirmed response is data. A
 session that cannot be read is skipped, and a damaged line of a log left out
 (the valid lines after it are kept); each is reported, naming the file and
@@ -51,8 +58,10 @@ from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
 
 HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
+SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
-           "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS]
+           "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS,
+           *SESSION_COLUMNS]
 
 
 def _session_rows(folder, problems):
@@ -70,6 +79,7 @@ def _session_rows(folder, problems):
             "protocol_hash": info["protocol"]["sha256"],
             "study": info["study"],
             "app_version": info["app_version"],
+            **{column: info.get(column) for column in SESSION_COLUMNS},
         }
     except UserError as exc:
         problems.append(f"{folder}: skipped, {exc}")
@@ -152,8 +162,8 @@ def export_responses(results_dir, problems=None):
     frame["step"] = frame["step"].astype("int64")
     frame["knob"] = frame["knob"].astype("Int64")
     frame["value"] = frame["value"].astype("Int64")  # empty for a task without a knob answer
-    for column in HEALTH_COLUMNS:
-        frame[column] = frame[column].astype("Int64")  # empty without a real-time engine
+    for column in [*HEALTH_COLUMNS, "session_number", "order_row"]:
+        frame[column] = frame[column].astype("Int64")  # empty without a real-time engine, or when not stored
     return frame.reset_index(drop=True)
 
 

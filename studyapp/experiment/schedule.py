@@ -22,9 +22,10 @@ The session's procedure (paper Sec. 8.2), step by step:
 Pages (``studyapp.experiment.pages``) are steps of task ``page`` with the
 whole ``page`` stored in the step; ``trial`` numbers them from 1. Practice
 trials (``practice`` true, ``trial`` 1..N) are the first N trials the task
-type schedules for participants p + 1, p + 2, ...: the task's own
-conditions, deterministic from the study seed and p, and not the order of
-the participant's first real trials.
+type schedules for participants p + 1, p + 2, ... (p the enrolment index,
+or the session's ``order_row`` when set): the task's own conditions,
+deterministic from the study seed and p, and not the order of the
+participant's first real trials.
 """
 
 import itertools
@@ -86,8 +87,10 @@ def _practice(kind, spec, square, participant_index):
     return planned[:spec.practice]
 
 
-def build_schedule(protocol, participant_index):
+def build_schedule(protocol, participant_index, order_row=None):
     """The steps of the ``participant_index``-th participant (from 0) under ``protocol``.
+
+    ``order_row`` (``session_info``) picks the Latin-square rows in place of the enrolment index.
 
     Returns ``(trials, squares)``: ``squares`` records, per task, the number of
     rows of its Latin square and the rows used, for session.json.
@@ -116,11 +119,12 @@ def build_schedule(protocol, participant_index):
             show(*page_kinds.instructions_pages(pages, task, spec.instructions, k, n, pad))
         seed = task_seed(protocol.seed, task)
         square = balanced_latin_square(spec.conditions, seed)
-        for number, (_, conditions, condition) in enumerate(_practice(kind, spec, square, participant_index), 1):
+        row = participant_index if order_row is None else order_row
+        for number, (_, conditions, condition) in enumerate(_practice(kind, spec, square, row), 1):
             add(task, number, conditions, condition, practice=True)
         if spec.practice:
             show(page_kinds.practice_over_page(task, pad))
-        planned, used = kind.schedule(spec, square, participant_index)
+        planned, used = kind.schedule(spec, square, row)
         for done, (number, conditions, condition) in enumerate(planned):
             if spec.break_every and done and done % spec.break_every == 0:
                 show(page_kinds.break_page(pages, task, done, len(planned), pad))

@@ -15,6 +15,8 @@ from pathlib import Path
 from PySide6.QtWidgets import QApplication
 
 from studyapp.errors import UserError
+from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.session_info import check_order_row
 from studyapp.gui.setup_panel import find_protocols
 
 DEFAULT_PROTOCOL = "protocols/sinclair2014.toml"
@@ -41,6 +43,9 @@ def build(args):
     from studyapp.gui.console import Console
     from studyapp.session.controller import SessionController
 
+    protocol = getattr(args, "protocol", None) or default_protocol()
+    if protocol is not None and getattr(args, "order_row", None) is not None:
+        check_order_row(load_protocol(protocol), args.order_row)  # refused before any engine starts
     application()
     controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"))
     console = Console(controller)
@@ -53,6 +58,8 @@ def build(args):
     console.setup.results.setText(str(getattr(args, "results", "results")))
     console.setup.resume.setChecked(bool(getattr(args, "resume", False)))
     console.setup.simulated.setChecked(bool(getattr(args, "simulated_participant", False)))
+    console.setup.fill_session_info(**{key: getattr(args, key, None)
+                                       for key in ("experimenter", "session_number", "notes", "order_row")})
     return controller, console
 
 

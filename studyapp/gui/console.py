@@ -238,7 +238,8 @@ class Console(QMainWindow):
         try:
             session = self.controller.start_session(
                 self.setup.participant_id, self.setup.results_folder, resume=self.setup.resume.isChecked(),
-                seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"})
+                seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"},
+                details=self.setup.session_info)
         except (UserError, RuntimeError) as exc:
             self.setup.show_error(str(exc))
             return None

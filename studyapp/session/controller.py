@@ -52,6 +52,16 @@ Trial health. The engine's counters (``deadline_misses``, ``audio_underruns``,
 logged as a ``trial_health`` record (``underruns`` for the audio underruns),
 which export carries as columns.
 
+Audio kept with the data. Each time a session's engine comes up
+(``_log_engine``) the controller asks it to record what the participant hears
+into the session folder (``RecordAudio``: audio.wav, then audio-2.wav, ... for
+a restarted engine or a resumed session; the worker picks the free name), and
+stops it when the session ends. Each trial's start (right after its knob
+mapping, so at the same block boundary) and end is sent as an ``AudioCue``:
+the worker writes it to audio_cues.csv at its own audio frame counter
+(engine/audio_recorder.py), so no sample position crosses the process
+boundary.
+
 Engines. A protocol gets a *preview* engine with every condition it names.
 Starting a session starts a fresh engine seeded with the session's seed; once
 the session ends it stays as the preview engine.
@@ -98,6 +108,7 @@ from studyapp.errors import UserError
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.schedule import counted
 from studyapp.experiment.session import Session, check_participant
+from studyapp.experiment.session_info import order_text
 from studyapp.experiment.session_runner import SessionRunner
 from studyapp.experiment.tasks import task_type
 from studyapp.session.engine_host import EngineHost
@@ -105,6 +116,7 @@ from studyapp.session.engine_loop import EngineLoop
 from studyapp.session.evented import EventGroup
 from studyapp.session.knob_latency import KnobLatency
 
+AUDIO_FILE = "audio.wav"  # what the participant heard, in the session folder (audio-2.wav, ... per engine run)
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
 GESTURES = ("strokes", "hold", "live")
 # the engine's fault counters a trial_health record logs, and their names there
@@ -280,8 +292,11 @@ class SessionController:
                 engine.send(command)
 
     # session: the experimenter's buttons ---------------------------------------------
-    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None):
-        """Open the participant's session (``UserError`` when refused) and start its engine."""
+    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None):
+        """Open the participant's session (``UserError`` when refused) and start its engine.
+
+        ``details``: ``experimenter``, ``session_number``, ``notes``, ``order_row`` (experiment/session_info.py).
+        """
         if self.protocol is None:
             raise UserError("no protocol loaded: choose one first")
         if self.in_session:
@@ -290,10 +305,11 @@ class SessionController:
             raise UserError("the emergency stop is set: clear it (Resume) before starting a session")
         check_participant(participant)
         if resume:
-            session = Session.resume(self.protocol, participant, results, seed=seed)
+            session = Session.resume(self.protocol, participant, results, seed=seed, **(details or {}))
         else:
             described = {"device": self.device or "simulated", "engine": "real-time", **(apparatus or {})}
-            session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described)
+            session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
+                                     **(details or {}))
         self.session = session
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
@@ -328,7 +344,7 @@ class SessionController:
         self.runner = None
         self._replace_host(self._engine_config(self.session.seed, {}), f"session {self.session.folder}")
         self.message(f"session {self.session.folder}: {len(self.session.finished_steps())} of "
-                     f"{len(self.session.schedule)} trials done; starting the engine")
+                     f"{len(self.session.schedule)} trials done, {order_text(self.session.info)}; starting the engine")
         return State.STARTING
 
     def _begin(self):
@@ -394,6 +410,7 @@ class SessionController:
         self.runner = None
         self.rest = how
         self.events.bowing.emit(on=False)
+        self._send(cmd.RecordAudio(None))
         if self.state == State.EMERGENCY:
             return State.EMERGENCY  # the session is over, the stop still holds until cleared
         self._send(cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.InstallActions(self._preview_actions()))
@@ -484,14 +501,23 @@ class SessionController:
                          "note": "one real-time engine per session: its seed, not the trials' loop_seed, "
                                  "seeds the sensor noise"})
         self.fed = self.host.position
+        self._send(cmd.RecordAudio(str(self.session.folder / AUDIO_FILE)))  # one file per engine run
 
     def _make_loop(self, estimators, source, seed):
         self.trial_serial += 1
         task = self.runner.task
         actions = trial_actions(self.runner.trial, task)
         positions = {f"knob{i + 1}": int(v) for i, v in task.knob_positions().items() if v is not None}
-        return EngineLoop(self.host.engine, estimators, source, self.protocol.gesture, self.trial_serial, actions,
+        loop = EngineLoop(self.host.engine, estimators, source, self.protocol.gesture, self.trial_serial, actions,
                           positions)
+        self._cue_audio("start")  # at the block where the trial's mapping takes force
+        return loop
+
+    def _cue_audio(self, event):
+        """A row of the session's audio_cues.csv: the current trial starts or ends (engine/audio_recorder.py)."""
+        trial = self.runner.trial if self.runner is not None else None
+        if trial is not None:
+            self._send(cmd.AudioCue(trial.step, trial.task, trial.trial, event))
 
     def _counters(self):
         """The session engine and its fault counters now (None without a running engine)."""
@@ -506,6 +532,7 @@ class SessionController:
         started, self._health = self._health, None
         if started is None or self.runner is None or self.runner.trial is None:
             return
+        self._cue_audio("end")
         engine, before = started
         try:
             now = engine.status()
@@ -558,6 +585,7 @@ class SessionController:
         self.trial_serial += 1
         self._send(cmd.SetFmax(0.0), cmd.SetBowing(False),
                    cmd.InstallActions({}, trial=self.trial_serial))
+        self._cue_audio("start")  # a page's span in audio_cues.csv too (the level check's tone is recorded)
         self._reference_tone(page.kind == "calibration")
 
     def _reference_tone(self, on):

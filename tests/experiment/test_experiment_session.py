@@ -207,7 +207,7 @@ def test_export_carries_each_trials_engine_health_and_leaves_it_empty_headless(t
     headless.close()
     frame = export_responses(tmp_path)
     columns = ["deadline_misses", "underruns", "faults", "events_dropped"]
-    assert columns == COLUMNS[-4:]
+    assert columns == COLUMNS[COLUMNS.index("deadline_misses"):][:4]
     logged = frame[frame.participant == "H01"].set_index(["step", "knob"])[columns]
     assert logged.loc[0].to_numpy().tolist() == [[2, 1, 0, 4]] * 3  # the rating: one row per condition
     assert logged.loc[3].to_numpy().tolist() == [[6, 3, 0, 12]]

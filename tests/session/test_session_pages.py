@@ -90,7 +90,8 @@ def test_a_page_holds_the_loop_silent_and_the_pad_acknowledges_it(c):
     start(c)
     engine = c.host.engine
     assert page(c) == "welcome" and c.runner.loop is None
-    assert engine.sent[-3:] == [cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.InstallActions({}, trial=c.trial_serial)]
+    assert engine.sent[-4:] == [cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.InstallActions({}, trial=c.trial_serial),
+                                cmd.AudioCue(0, "page", 1, "start")]  # the page's span in the recording
     assert c.seen["page"] == [{"kind": "welcome", "title": "Welcome", "text": "Welcome, **reader**.",
                                "by": "participant", "step": 0, "tone_hz": None, "level_dbfs": None}]
     assert {k: c.seen["trial"][-1][k] for k in ("phase", "number", "of")} == {"phase": "page", "number": 1, "of": 7}
