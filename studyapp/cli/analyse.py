@@ -1,4 +1,5 @@
-"""``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] [--include-practice] -o REPORT_DIR``: the paper's Sec. 9-10.
+"""``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] [--include-practice] -o REPORT_DIR``:
+the paper's Sec. 9-10.
 
 RESULTS_DIR is a results folder or an exported responses .csv. Writes the
 paper's pooled Wilcoxon rank-sum tables, the within-subject Friedman and

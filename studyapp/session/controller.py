@@ -74,8 +74,9 @@ back). Each step is announced by the ``trial`` event with its ``phase``
 (``page``, ``practice`` or ``trial``) and its ``number`` ``of`` the steps of
 that phase (of its task, for trials: "Practice 1 of 2", "Trial 2 of 12");
 a page also by the ``page`` event (``kind``, ``title``, ``text`` in
-Markdown, ``by``: who acknowledges it, ``step``, ``tone_hz``, ``level_dbfs``). ``acknowledge_page(by)`` is the
-participant's Continue button or the experimenter's confirm. A calibration
+Markdown, ``by``: who acknowledges it, ``step``, ``tone_hz``,
+``level_dbfs``). ``acknowledge_page(by)`` is the participant's Continue
+button or the experimenter's confirm. A calibration
 page sends ``ReferenceTone(tone_hz, level_dbfs)`` when it starts and
 ``ReferenceTone(level_dbfs=None)`` when it ends (acknowledged, paused,
 stopped, or the session ended); its acknowledgement is logged with the tone,

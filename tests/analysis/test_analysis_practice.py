@@ -46,7 +46,8 @@ def test_practice_rows_enter_neither_the_rank_sums_nor_the_spearman_inputs(tmp_p
     # each participant's Spearman rho: scipy on their real medians against the real global medians
     global_median = real_adjustment.groupby("condition").fmax.median()
     for _, spearman_row in study.participant_spearman.iterrows():
-        own = real_adjustment[real_adjustment.participant == spearman_row.participant].groupby("condition").fmax.median()
+        mine = real_adjustment[real_adjustment.participant == spearman_row.participant]
+        own = mine.groupby("condition").fmax.median()
         rho = stats.spearmanr(own.to_numpy(), global_median[own.index].to_numpy()).statistic
         assert spearman_row.rho == pytest.approx(rho, abs=1e-12)
     assert study.missing.empty  # practice rows are not counted as extra trials either
