@@ -2,7 +2,8 @@
 
 Left: session set-up and the apparatus found, the session's buttons (Start,
 Pause/Resume, Abort, EMERGENCY STOP), and its progress (task, trial x of y,
-the current condition, which a tick hides for blinding). Right, in tabs: the
+the page the participant sees with the headphone level check's confirm
+(``PageControls``), the current condition, which a tick hides for blinding). Right, in tabs: the
 live scope with the on-screen knobs and pads and the bowing pad; the
 analysis view (``AnalysisView``) of a results folder; the session's log.
 Bottom: the status bar (loop rate, load, deadline misses, audio underruns,
@@ -40,6 +41,7 @@ from studyapp.gui.analysis_view import AnalysisView
 from studyapp.gui.bowing_pad import BowingPad
 from studyapp.gui.gui_thread import GuiThreadCaller
 from studyapp.gui.knobs import KnobPanel
+from studyapp.gui.page_controls import PageControls
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.scope import Scope
 from studyapp.gui.setup_panel import SetupPanel
@@ -102,6 +104,8 @@ class Console(QMainWindow):
         self.pickup_label = QLabel("")  # a physical knob waiting for pickup (engine/pickup.py)
         self.pickup_label.setStyleSheet("color: #06c; font-weight: bold;")
         self.response_label.setWordWrap(True)
+        self.page_controls = PageControls()  # the page the participant sees; the level check's confirm
+        self.page_controls.confirmed.connect(lambda: controller.acknowledge_page("experimenter"))
         self._condition_text = ""
 
         buttons = QHBoxLayout()
@@ -113,6 +117,7 @@ class Console(QMainWindow):
         p.addWidget(self.state_label)
         p.addWidget(self.task_label)
         p.addWidget(self.trial_label)
+        p.addWidget(self.page_controls)
         p.addWidget(self.progress_bar)
         p.addWidget(QLabel("Current condition:"))
         p.addWidget(self.condition_label)
@@ -185,6 +190,7 @@ class Console(QMainWindow):
         self.participant_window = ParticipantWindow(controller)
         self.participant_window.knobs.knob_turned.connect(controller.knob)
         self.participant_window.knobs.pad_pressed.connect(controller.pad)
+        self.participant_window.page_view.continued.connect(lambda: controller.acknowledge_page("participant"))
         self.show_participant = QAction("Participant window", self, checkable=True)
         self.show_participant.toggled.connect(self.participant_window.setVisible)
         analyse = QAction("Analyse the results folder", self)
@@ -207,6 +213,8 @@ class Console(QMainWindow):
         e.message.connect(self._on_message)
         e.response.connect(self._on_response)
         e.pickup.connect(self._on_pickup)
+        e.page.connect(self._on_page)
+        e.refused.connect(self.participant_window.show_refusal)
 
         self.timer = QTimer(self)
         self.timer.setInterval(POLL_PERIOD_MS)
@@ -315,16 +323,24 @@ class Console(QMainWindow):
         if state in REST:
             self.task_label.setText("")
             self.knobs.set_captions([])
+            self.page_controls.show_none()
             if state != State.IDLE:
                 self.trial_label.setText(STATE_WORDS[state])
 
-    def _on_trial(self, trial, step, total, instructions):
+    def _on_trial(self, trial, step, total, instructions, phase="trial", number=None, of=None):
         self.task_label.setText("Task: " + task_type(trial.task).heading(trial))
-        self.trial_label.setText(f"Trial {step + 1} of {total}")
+        counted = "" if phase == "page" else f"{'Practice' if phase == 'practice' else 'Trial'} {number} of {of}, "
+        self.trial_label.setText(f"{counted}step {step + 1} of {total}")
         self.progress_bar.setRange(0, total)
         self.progress_bar.setValue(step)
-        self.participant_window.show_trial(step, total, instructions)
+        self.participant_window.show_trial(step, total, instructions, phase, number, of)
+        if phase != "page":
+            self.page_controls.show_none()
         self._blinding(self.blind.isChecked())
+
+    def _on_page(self, kind, title, text, by, step, tone_hz, level_dbfs):
+        self.participant_window.show_page(kind, title, text, by)
+        self.page_controls.show_page(kind, title, by, tone_hz, level_dbfs)
 
     def _on_knob(self, index, value):
         self.knobs.show_knob(index, value)

@@ -25,6 +25,12 @@ arcmin; from 60 cm, 22 arcmin is a 3.8 mm capital, i.e. about 16 pt on a
 96-dpi screen. 22 pt (about 31 arcmin) keeps that margin on a laptop's
 denser pixels and for a participant leaning back. The instructions take
 whatever height is left.
+
+**Pages.** Between trials it shows the session's pages (welcome,
+instructions, breaks, ...: ``page_view.PageView``, Markdown) in place of the
+instructions and controls; its Continue button is ``page_view.continued``.
+Progress counts the current task's practice or real trials ("Practice 1 of
+2", "Trial 2 of 12").
 """
 
 import re
@@ -35,6 +41,7 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWi
 from studyapp.estimators import names as estimator_names
 from studyapp.experiment.tasks import task_type
 from studyapp.gui.knobs import KnobPanel
+from studyapp.gui.page_view import PageView
 
 BODY_PT = 22
 HEADING_PT = 28
@@ -126,12 +133,15 @@ class ParticipantWindow(QWidget):
         self.bow_row = QWidget()
         self.bow_row.setLayout(bow_row)
         bow_row.setContentsMargins(0, 0, 0, 0)
+        self.page_view = PageView()
+        self.page_view.hide()
         layout = QVBoxLayout(self)
         layout.setContentsMargins(40, 32, 40, 32)
         layout.setSpacing(12)
         layout.addWidget(self.title)
         layout.addWidget(self.progress)
         layout.addWidget(self.instructions, 1)
+        layout.addWidget(self.page_view, 1)
         layout.addWidget(self.notice)
         layout.addWidget(self.refusal)
         layout.addWidget(self.pickup)
@@ -151,10 +161,27 @@ class ParticipantWindow(QWidget):
     def show_title(self, title):
         self.title.setText(title)
 
-    def show_trial(self, step, total, instructions):
-        self.progress.setText(f"Trial {step + 1} of {total}")
+    def show_trial(self, step, total, instructions, phase="trial", number=None, of=None):
+        self._show_page_view(phase == "page")
+        if phase != "page":
+            word = "Practice" if phase == "practice" else "Trial"
+            self.progress.setText(f"{word} {number} of {of}" if number else f"Trial {step + 1} of {total}")
         self.instructions.setText(reflow(instructions))
         self.show_refusal("")
+
+    def show_page(self, kind, title, text, by):
+        """A page in place of the instructions and controls (``text`` in Markdown)."""
+        self._show_page_view(True)
+        self.progress.setText("")
+        self.page_view.show_page(kind, title, text, by)
+
+    def _show_page_view(self, on):
+        """A page replaces the instructions and the trial's controls (``show_controls`` gives them back)."""
+        self.page_view.setVisible(on)
+        self.instructions.setVisible(not on)
+        if on:
+            self.knobs.setVisible(False)
+            self.bow_row.setVisible(False)
 
     def show_pickup(self, text):
         """A physical knob waiting for pickup: say which way to turn it ("" once it acts)."""
@@ -166,6 +193,7 @@ class ParticipantWindow(QWidget):
         if state not in ACTIVE:
             self.progress.setText("")
             self.instructions.setText("")
+            self._show_page_view(False)
             self.show_controls([], [])
             self.show_refusal("")
         self.running = state == "running" and not emergency
@@ -228,7 +256,7 @@ class ParticipantWindow(QWidget):
         super().keyPressEvent(event)
 
     # the controller's events ------------------------------------------------------
-    def _on_trial(self, trial, step, total, instructions):
+    def _on_trial(self, trial, step, total, instructions, **_):
         runner = self.controller.runner
         knobs, pads, sounds = trial_controls(trial, runner.task)
         self.show_controls(knobs, pads, sounds)

@@ -66,6 +66,25 @@ Engines. A protocol gets a *preview* engine with every condition it names.
 Starting a session starts a fresh engine seeded with the session's seed; once
 the session ends it stays as the preview engine.
 
+Pages. A page step (welcome, instructions, a break, the headphone level
+check, ...: ``studyapp.experiment.pages``) holds the loop silent: F_max 0,
+the bow lifted, an empty knob mapping tagged with the step's own number, so
+the confirm pad still reaches the page (as a pad press the worker reports
+back). Each step is announced by the ``trial`` event with its ``phase``
+(``page``, ``practice`` or ``trial``) and its ``number`` ``of`` the steps of
+that phase (of its task, for trials: "Practice 1 of 2", "Trial 2 of 12");
+a page also by the ``page`` event (``kind``, ``title``, ``text`` in
+Markdown, ``by``: who acknowledges it, ``step``, ``tone_hz``,
+``level_dbfs``). ``acknowledge_page(by)`` is the participant's Continue
+button or the experimenter's confirm. A calibration
+page sends ``ReferenceTone(tone_hz, level_dbfs)`` when it starts and
+``ReferenceTone(level_dbfs=None)`` when it ends (acknowledged, paused,
+stopped, or the session ended); its acknowledgement is logged with the tone,
+the level and who confirmed it. A refused confirm (a pad press the task
+does not accept yet) is a console message and a ``refused`` event with the
+reason, which the participant window shows (reasons name knobs, never
+conditions).
+
 Pause holds the loop (F_max 0, bow lifted, no knob mapping), stops the task's
 clock and ignores the participant's controls; resume gives the settings back.
 Emergency stop: at once, the engine's ``force_enable`` word in shared memory
@@ -88,6 +107,7 @@ from studyapp.engine.config import EngineConfig
 from studyapp.engine.events import Learned
 from studyapp.errors import UserError
 from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.schedule import counted
 from studyapp.experiment.session import Session, check_participant
 from studyapp.experiment.session_info import order_text
 from studyapp.experiment.session_runner import SessionRunner
@@ -163,7 +183,8 @@ def scene_conditions(protocol):
 
 
 def instructions_for(protocol, task):
-    return protocol.task(task).instructions.strip()
+    """A task's instructions (none for a page: its text is the ``page`` event's)."""
+    return protocol.task(task).instructions.strip() if task in protocol.specs else ""
 
 
 def trial_actions(trial, task):
@@ -187,7 +208,7 @@ class SessionController:
         self.clock = clock
         self.make_host = make_host
         self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing", "gesture",
-                                 "telemetry", "status", "message", "response", "pickup")
+                                 "telemetry", "status", "message", "response", "pickup", "page", "refused")
         self.protocol = None
         self.host = None
         self.session = None
@@ -203,6 +224,7 @@ class SessionController:
         self._next_status = 0.0
         self._pickup = {}  # control -> messages ignored while it waits for pickup
         self._health = None  # the engine and its counters when the current trial started
+        self._tone = False  # a calibration page's reference tone is playing
 
     # the state machine ----------------------------------------------------------
     def fire(self, event):
@@ -351,14 +373,22 @@ class SessionController:
         return State.ABORTED
 
     def _pause(self):
-        self.runner.loop.hold(True)
+        self._hold(True)
         self.runner.log({"type": "pause"})
         return State.PAUSED
 
     def _resume(self):
         self.runner.log({"type": "resume"})
-        self.runner.loop.hold(False)
+        self._hold(False)
         return State.RUNNING
+
+    def _hold(self, on):
+        """Hold the current step (pause), or give it back: a trial's loop, or a page's silence and tone."""
+        if self.runner.loop is not None:
+            self.runner.loop.hold(on)
+            return
+        self._send(cmd.InstallActions({}, trial=-self.trial_serial if on else self.trial_serial))
+        self._reference_tone(not on)
 
     def _finish(self):
         return self._end(State.FINISHED)
@@ -370,6 +400,7 @@ class SessionController:
         return self._end(State.ABORTED)
 
     def _end(self, how):
+        self._reference_tone(False)
         self._log_latency()
         self._log_health()
         self._forget_pickups()
@@ -415,6 +446,7 @@ class SessionController:
         engine = self.engine
         if engine is not None:
             engine.status_block.force_enable = False
+        self._reference_tone(False)
         loop = self.runner.loop if self.runner is not None else None
         if loop is not None and engine is not None and loop.engine is engine:
             loop.hold(True)
@@ -520,6 +552,7 @@ class SessionController:
 
         Returns ``state``, or FINISHED when no trial is left. Outside RUNNING the new trial is held.
         """
+        self._reference_tone(False)
         self._log_latency()
         self._log_health()
         self._forget_pickups()
@@ -527,18 +560,45 @@ class SessionController:
         if trial is None:
             return self._end(State.FINISHED)
         self._health = self._counters()
+        if trial.page is not None:
+            self._show_page(trial.page)
         if state != State.RUNNING:
-            self.runner.loop.hold(True)
+            self._hold(True)
         task = self.runner.task
         values = task.knob_positions()
         for index in range(self.protocol.knobs):
             self.events.knob.emit(index=index, value=int(values.get(index, 0)))
+        phase, number, of = counted(self.session.schedule, trial)
         self.events.trial.emit(trial=trial, step=trial.step, total=len(self.session.schedule),
-                               instructions=instructions_for(self.protocol, trial.task))
+                               instructions=instructions_for(self.protocol, trial.task), phase=phase,
+                               number=number, of=of)
+        if trial.page is not None:
+            page = trial.page
+            self.events.page.emit(kind=page.kind, title=page.title, text=page.text, by=page.by, step=trial.step,
+                                  tone_hz=page.tone_hz, level_dbfs=page.level_dbfs)
         self._announce_selection()
         self.events.gesture.emit(name=self.runner.gesture)
         self.events.bowing.emit(on=self.runner.bowing)
         return state
+
+    def _show_page(self, page):
+        """A page holds the loop silent under its own step number; a calibration page plays its tone."""
+        self.trial_serial += 1
+        self._send(cmd.SetFmax(0.0), cmd.SetBowing(False),
+                   cmd.InstallActions({}, trial=self.trial_serial))
+        self._cue_audio("start")  # a page's span in audio_cues.csv too (the level check's tone is recorded)
+        self._reference_tone(page.kind == "calibration")
+
+    def _reference_tone(self, on):
+        """Start the current calibration page's reference tone (True), or end a playing one (False)."""
+        trial = self.runner.trial if self.runner is not None else None
+        page = trial.page if trial is not None else None
+        if on and page is not None and page.kind == "calibration" and not self._tone:
+            self._send(cmd.ReferenceTone(page.tone_hz, page.level_dbfs))
+            self._tone = True
+        elif not on and self._tone:
+            self._send(cmd.ReferenceTone(level_dbfs=None))
+            self._tone = False
 
     def _after_task_event(self):
         """A response ends the trial: the next one starts at once (or the session ends)."""
@@ -571,6 +631,13 @@ class SessionController:
             self.engine.send(cmd.Control(f"pad{index + 1}", 1.0))
             self.controls_sent += 1
 
+    def acknowledge_page(self, by="participant"):
+        """The current page acknowledged: the participant's Continue button, or the experimenter's
+        confirm (the only one a calibration page takes). Nothing happens outside a running page."""
+        runner = self.runner
+        if self.playing and runner.trial is not None and runner.trial.page is not None:
+            self._task_records(runner.acknowledge_page(by))
+
     def _control(self, record):
         """A control the worker took (``events.Applied``): show it; the current trial's go to the runner."""
         if isinstance(record, Learned):
@@ -585,7 +652,7 @@ class SessionController:
                 self.controls_taken += 1
 
     def _take_control(self, record, knob, pad):
-        ours = self.runner is not None and self.runner.loop is not None and record.trial == self.trial_serial
+        ours = self.runner is not None and self.runner.task is not None and record.trial == self.trial_serial
         live = record.trial == 0 and self.state in REST
         if not (ours or live):
             return  # a held trial's, a stale trial's, or the preview's while a session starts
@@ -597,7 +664,8 @@ class SessionController:
             self.events.knob.emit(index=knob, value=round(record.value * 127))
         if not ours:
             return
-        self.runner.loop.applied(record.commands)
+        if self.runner.loop is not None:
+            self.runner.loop.applied(record.commands)
         if knob is not None:
             self._task_records(self.runner.knob(knob, round(record.value * 127)))
         elif pad is not None and record.value > 0:
@@ -629,8 +697,9 @@ class SessionController:
 
     def _task_records(self, records):
         for record in records:
-            if record.get("type") == "pad" and record.get("accepted") is False:
+            if record.get("accepted") is False:
                 self.message(f"confirm refused: {record['reason']}")
+                self.events.refused.emit(reason=record["reason"])
             if record.get("type") == "response":
                 self.events.response.emit(response=record, step=self.runner.trial.step)
         self._announce_selection()
@@ -647,7 +716,8 @@ class SessionController:
         if not self.accepting:
             return
         if self.playing:
-            self.runner.set_bowing(on)
+            self.runner.set_bowing(on)  # on a page (no loop) the bow stays lifted
+            on = self.runner.bowing
         else:
             self.engine.send(cmd.SetBowing(bool(on)))
         self.events.bowing.emit(on=bool(on))
@@ -681,7 +751,7 @@ class SessionController:
 
     def _hand_target(self, x_m):
         if self.playing:
-            if self.runner.gesture == "live":
+            if self.runner.gesture == "live" and self.runner.loop is not None:
                 self.runner.loop.set_hand_target(x_m)
         else:
             self.engine.send(cmd.SetHandTarget(float(x_m)))

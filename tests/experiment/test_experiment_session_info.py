@@ -67,8 +67,8 @@ def test_an_order_row_picks_that_row_of_each_tasks_latin_square(tmp_path, row):
     protocol = load_protocol(SINCLAIR)
     session = Session.create(protocol, "P9", tmp_path, order_row=row)
     session.close()
-    rating = [t for t in session.schedule if t.task == "rating"]
-    adjustment = [t for t in session.schedule if t.task == "adjustment"]
+    rating = [t for t in session.schedule if t.task == "rating" and t.phase == "trial"]  # not practice
+    adjustment = [t for t in session.schedule if t.task == "adjustment" and t.phase == "trial"]
     square = balanced_latin_square(protocol.task("rating").conditions, task_seed(protocol.seed, "rating"))
     assert len(square) == 8 and list(rating[0].conditions) == participant_row(square, row)
     square = balanced_latin_square(protocol.task("adjustment").conditions, task_seed(protocol.seed, "adjustment"))
