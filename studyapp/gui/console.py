@@ -214,7 +214,6 @@ class Console(QMainWindow):
         e.response.connect(self._on_response)
         e.pickup.connect(self._on_pickup)
         e.page.connect(self._on_page)
-        e.refused.connect(self.participant_window.show_refusal)
 
         self.timer = QTimer(self)
         self.timer.setInterval(POLL_PERIOD_MS)

@@ -15,8 +15,7 @@ the "Bow" toggle or the space bar, through the controller's ``set_bowing``;
 "Bowing" / "Bow lifted" follows the controller's ``bowing`` event, so it is
 right whoever moved the bow (console, participant, protocol).
 
-**Refusals.** A refused confirm (the controller's message "confirm refused:
-...") is shown by ``show_refusal`` in the participant's words: a condition's
+**Refusals.** A refused confirm (the controller's ``refused`` event) is shown by ``show_refusal`` in the participant's words: a condition's
 name becomes the dial that plays it ("the second dial"), F_max "the level".
 
 **Legibility.** Body text is ``BODY_PT`` = 22 pt, headings 28 pt. ISO
@@ -154,7 +153,7 @@ class ParticipantWindow(QWidget):
             e = controller.events
             e.trial.connect(self._on_trial)
             e.bowing.connect(self.show_bowing)
-            e.message.connect(self._on_message)
+            e.refused.connect(lambda reason: self.show_refusal(reason))
         self.resize(1000, 700)
 
     # what the console (or the controller's events) tell it --------------------------
@@ -260,10 +259,6 @@ class ParticipantWindow(QWidget):
         runner = self.controller.runner
         knobs, pads, sounds = trial_controls(trial, runner.task)
         self.show_controls(knobs, pads, sounds)
-
-    def _on_message(self, text, level, topic):
-        if text.startswith(REFUSED):
-            self.show_refusal(text)
 
     def _hide_empty(self):
         for label in (self.notice, self.refusal, self.pickup):

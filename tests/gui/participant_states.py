@@ -27,7 +27,7 @@ class FakeController:
     """The controller's side the window sees: its events, the current trial's state, ``set_bowing``."""
 
     def __init__(self):
-        self.events = EventGroup("trial", "bowing", "message")
+        self.events = EventGroup("trial", "bowing", "refused")
         self.runner = SimpleNamespace(task=None)
         self.bowing_asked = []
 

@@ -121,12 +121,9 @@ def test_a_refused_confirm_is_said_in_plain_words(window):
     c = window.controller
     shown = c.start("demo.toml", "rating")
     conditions = c.runner.task.conditions  # dial j plays conditions[j], left to right
-    c.events.message.emit(text=f"confirm refused: not rated yet: {conditions[2]}, {conditions[0]}",
-                          level="info", topic="")
+    c.events.refused.emit(reason=f"not rated yet: {conditions[2]}, {conditions[0]}")
     assert window.refusal.text() == "Not rated yet: the third dial, the first dial."
     assert window.refusal.isVisibleTo(window)
-    c.events.message.emit(text="MIDI: knob1 bound to cc 1", level="info", topic="")
-    assert window.refusal.text().startswith("Not rated yet")
     window.show_trial(**shown)  # the next trial starts clean
     assert window.refusal.text() == "" and not window.refusal.isVisibleTo(window)
     c.start("sinclair2014.toml", "adjustment")
