@@ -119,6 +119,9 @@ from studyapp.session.knob_latency import KnobLatency
 
 AUDIO_FILE = "audio.wav"  # what the participant heard, in the session folder (audio-2.wav, ... per engine run)
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
+# s a page shows before the participant can end it: the second press of a double press on a trial's
+# confirm pad would otherwise end the page that follows it unread (logged, not announced)
+PAGE_SETTLE_S = 0.5
 GESTURES = ("strokes", "hold", "live")
 # the engine's fault counters a trial_health record logs, and their names there
 HEALTH = {"deadline_misses": "deadline_misses", "audio_underruns": "underruns", "faults": "faults",
@@ -224,6 +227,7 @@ class SessionController:
         self._next_status = 0.0
         self._pickup = {}  # control -> messages ignored while it waits for pickup
         self._health = None  # the engine and its counters when the current trial started
+        self._page_shown = 0.0  # self.clock() when the current page appeared
         self._tone = False  # a calibration page's reference tone is playing
 
     # the state machine ----------------------------------------------------------
@@ -583,6 +587,7 @@ class SessionController:
 
     def _show_page(self, page):
         """A page holds the loop silent under its own step number; a calibration page plays its tone."""
+        self._page_shown = self.clock()
         self.trial_serial += 1
         self._send(cmd.SetFmax(0.0), cmd.SetBowing(False),
                    cmd.InstallActions({}, trial=self.trial_serial))
@@ -636,7 +641,22 @@ class SessionController:
         confirm (the only one a calibration page takes). Nothing happens outside a running page."""
         runner = self.runner
         if self.playing and runner.trial is not None and runner.trial.page is not None:
+            if by == "participant" and self._page_settling("continue"):
+                return
             self._task_records(runner.acknowledge_page(by))
+
+    def page_age(self):
+        """Seconds since the current page appeared."""
+        return self.clock() - self._page_shown
+
+    def _page_settling(self, control):
+        """True (and logged) for the participant's press on a page shown less than PAGE_SETTLE_S ago."""
+        since = self.page_age()
+        if since >= PAGE_SETTLE_S:
+            return False
+        self.runner.log({"type": "acknowledge", "by": "participant", "control": control, "accepted": False,
+                         "reason": f"pressed {since:.2f} s after the page appeared: taken as a double press"})
+        return True
 
     def _control(self, record):
         """A control the worker took (``events.Applied``): show it; the current trial's go to the runner."""
@@ -669,6 +689,8 @@ class SessionController:
         if knob is not None:
             self._task_records(self.runner.knob(knob, round(record.value * 127)))
         elif pad is not None and record.value > 0:
+            if self.runner.trial.page is not None and self._page_settling(record.control):
+                return
             self._task_records(self.runner.pad(pad))
 
     def _picked_up(self, record, knob, ours):

@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 from studyapp.experiment.simulated_participant import SimulatedParticipant
+from studyapp.session.controller import PAGE_SETTLE_S
 
 WAIT_STEP = 0.004  # s between looks at the controller's progress
 ACTIVE = ("starting", "running", "paused", "emergency", "clearing", "engine_lost", "restarting")
@@ -117,6 +118,9 @@ class ParticipantProxy:
 
     def acknowledge_page(self, by):
         self._wait_running()
+        while by == "participant" and self.controller.page_age() < PAGE_SETTLE_S:  # a reader is not that quick
+            self._check()
+            time.sleep(WAIT_STEP)
         self.act(lambda: self.controller.acknowledge_page(by))
 
     def advance(self, seconds):

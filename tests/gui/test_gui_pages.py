@@ -14,7 +14,7 @@ from studyapp.experiment.pages import markdown
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.schedule import build_schedule
 from studyapp.gui.page_view import PageView
-from tests.session.fakes import FakeHost
+from tests.session.fakes import FakeHost, SteppingClock
 from tests.session.test_session_pages import PROTOCOL
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -73,7 +73,7 @@ def paged_console(qapp, tmp_path):
 
     path = tmp_path / "pages.toml"
     path.write_text(PROTOCOL)
-    controller = SessionController(audio="null", midi="none", make_host=FakeHost)
+    controller = SessionController(audio="null", midi="none", make_host=FakeHost, clock=SteppingClock())
     window = Console(controller)
     window.timer.stop()  # polled by hand
     controller.events.status.disconnect(window._on_status)  # the fake engine keeps no loop statistics

@@ -7,8 +7,8 @@ import pytest
 
 from studyapp.engine import commands as cmd
 from studyapp.experiment.session_log import read_events
-from studyapp.session.controller import SessionController, State
-from tests.session.fakes import FakeHost
+from studyapp.session.controller import PAGE_SETTLE_S, SessionController, State
+from tests.session.fakes import FakeHost, SteppingClock
 
 PROTOCOL = """
 [study]
@@ -51,7 +51,7 @@ level_dbfs = -12.0
 def c(tmp_path):
     path = tmp_path / "pages.toml"
     path.write_text(PROTOCOL)
-    controller = SessionController(audio="null", midi="none", make_host=FakeHost)
+    controller = SessionController(audio="null", midi="none", make_host=FakeHost, clock=SteppingClock())
     controller.load_protocol(str(path))
     controller.results = tmp_path / "results"
     up(controller)
@@ -182,3 +182,18 @@ def test_trials_are_counted_by_phase_and_task_and_bow_auto_and_listening_time_ho
     assert page(c) == "break"
     practice = [e for e in log(c) if e.get("practice")]
     assert practice and {e["step"] for e in practice} == {3}
+
+
+def test_a_press_just_after_a_page_appears_is_taken_as_a_double_press(c):
+    c.clock = SteppingClock(step=0.0)  # time stands still: every press comes at once
+    start(c)
+    assert page(c) == "welcome"
+    c.pad(0)  # the second press of a double press
+    c.poll()
+    c.acknowledge_page("participant")
+    assert page(c) == "welcome"
+    refused = [e for e in log(c) if e["type"] == "acknowledge"]
+    assert [(e["control"], e["accepted"]) for e in refused] == [("pad1", False), ("continue", False)]
+    c.clock.now += PAGE_SETTLE_S
+    c.acknowledge_page("participant")
+    assert page(c) == "calibration"
