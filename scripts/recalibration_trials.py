@@ -40,10 +40,13 @@ from scipy import signal
 
 RATE = 5000.0
 SEED = 0
+# the model before 2026-11-23: a 147 Hz string bowed at STK's beta, velocity scale 0.6, contact microphone 2e-3;
+# every trial is written as its changes to it
 BASE = dict(mass=1.0, s=0.6, f0=147.0, beta=0.127236, speed=0.04, accel=None, dwell=0.1, mic=2e-3)
-# (name, lever, changes against the shipped model)
+SHIPPED = dict(f0=440.0, beta=0.25, mic=0.02, s=1.2)  # calibration.py since 2026-11-23
+# (name, lever, changes against BASE)
 TRIALS = [
-    ("shipped", "none", {}),
+    ("147 Hz", "none: the model before 2026-11-23", {}),
     ("guettler", "onset at constant acceleration 50 m/s^2, 0.08 m/s", dict(speed=0.08, accel=50.0)),
     ("guettler-fast", "onset 80 m/s^2, 0.12 m/s", dict(speed=0.12, accel=80.0)),
     ("f0-98", "98 Hz string", dict(f0=98.0)),
@@ -55,7 +58,7 @@ TRIALS = [
     ("f0-440-beta-0.25", "440 Hz string, beta 0.25", dict(f0=440.0, beta=0.25)),
     ("f0-440-beta-0.25-mic-x10", "440 Hz string, beta 0.25, mic gain 0.02 (x10)", dict(f0=440.0, beta=0.25,
                                                                                          mic=0.02)),
-    ("a440-s1.2", "440 Hz, beta 0.25, mic x10, velocity scale 1.2", dict(f0=440.0, beta=0.25, mic=0.02, s=1.2)),
+    ("a440-s1.2", "440 Hz, beta 0.25, mic x10, velocity scale 1.2: shipped since 2026-11-23", SHIPPED),
     ("a440-s1.5", "440 Hz, beta 0.25, mic x10, velocity scale 1.5", dict(f0=440.0, beta=0.25, mic=0.02, s=1.5)),
     ("a440-m0.5", "440 Hz, beta 0.25, mic x10, 0.5 kg", dict(f0=440.0, beta=0.25, mic=0.02, mass=0.5)),
     ("a440-b0.2-s1.2", "440 Hz, beta 0.2, mic x10, velocity scale 1.2", dict(f0=440.0, beta=0.2, mic=0.02, s=1.2)),
