@@ -5,6 +5,9 @@ by the Xvfb screenshot test: for each size and state it prints one JSON line
 with the layout problems and every visible text of the rendered window.
 Trials are the real protocols' (sinclair2014's eight-condition rating and its
 adjustment, the demo's three-condition rating), started by their task types.
+Pages (``page-KIND``) are sinclair2014's own, as its schedule places them (the
+longest of each kind), shown as the console shows them (``show_trial`` in the
+page phase, then ``show_page``).
 """
 
 import json
@@ -20,7 +23,8 @@ from studyapp.session.controller import instructions_for
 from studyapp.session.evented import EventGroup
 
 ROOT = Path(__file__).resolve().parents[2]
-STATES = ("idle", "rating3", "rating8", "adjustment", "paused", "finished")
+PAGE_KINDS = ("welcome", "calibration", "instructions", "transition", "break", "goodbye")
+STATES = ("idle", "rating3", "rating8", "adjustment", "paused", "finished", *(f"page-{k}" for k in PAGE_KINDS))
 
 
 class FakeController:
@@ -47,11 +51,24 @@ class FakeController:
         return shown
 
 
+def longest_page(protocol, kind):
+    """The schedule's step showing the longest page of ``kind`` in ``protocol``, and the schedule's length."""
+    trials, _ = build_schedule(load_protocol(ROOT / "protocols" / protocol), 0)
+    step = max((t for t in trials if t.page is not None and t.page.kind == kind), key=lambda t: len(t.page.text))
+    return step, len(trials)
+
+
 def put_in_state(window, controller, state):
     """Show ``state`` (one of ``STATES``) in ``window``, as the console would."""
     window.show_title("Bowing a virtual string")
     if state == "idle":
         window.show_state("idle")
+        return
+    if state.startswith("page-"):
+        step, total = longest_page("sinclair2014.toml", state[len("page-"):])
+        window.show_state("running")
+        window.show_trial(step.step, total, "", "page", step.trial, None)
+        window.show_page(step.page.kind, step.page.title, step.page.text, step.page.by)
         return
     trial = {"rating3": ("demo.toml", "rating"), "rating8": ("sinclair2014.toml", "rating"),
              "adjustment": ("sinclair2014.toml", "adjustment")}.get(state, ("sinclair2014.toml", "rating"))
@@ -93,6 +110,8 @@ def render(size, state):
         app.processEvents()
     result = {"size": list(size), "state": state, "problems": layout_problems(window),
               "texts": visible_texts(window), "dials": len(window.knobs.visible_knobs()),
+              "page": window.page_view.isVisibleTo(window) and window.page_view.title.text(),
+              "page_scrolls": window.page_view.text.verticalScrollBar().maximum() > 0,
               "image_size": [window.grab().width(), window.grab().height()]}
     window.close()
     return result

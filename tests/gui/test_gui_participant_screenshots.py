@@ -1,6 +1,6 @@
 """The participant's window on a real X server (Xvfb, Qt's xcb platform) at a lab laptop's and a
-desktop's size, in every state a session shows it: nothing past the window, no clipped text, no
-knob value and no condition or estimator name; and ``--participant-screenshot`` with
+desktop's size, in every state a session shows it, each page too: nothing past the window, no clipped
+text (a page's whole text shown without scrolling), no knob value and no condition or estimator name; and ``--participant-screenshot`` with
 ``--participant-screen 0`` fills the screen and remembers it."""
 
 import json
@@ -13,12 +13,13 @@ import pytest
 
 from studyapp.estimators import names as estimator_names
 from tests.gui.conftest import DEMO, ROOT
-from tests.gui.participant_states import STATES
+from tests.gui.participant_states import PAGE_KINDS, STATES
 
 pytestmark = pytest.mark.gui
 
 SIZES = ((1366, 768), (1920, 1080))
-DIALS = {"idle": 0, "rating3": 3, "rating8": 8, "adjustment": 1, "paused": 8, "finished": 0}
+DIALS = {"idle": 0, "rating3": 3, "rating8": 8, "adjustment": 1, "paused": 8, "finished": 0,
+         **{f"page-{kind}": 0 for kind in PAGE_KINDS}}
 KNOB_LABEL = re.compile(r"\b[KP]\d+\b|knob \d|:\s*\d+$")
 
 
@@ -37,6 +38,8 @@ def test_every_state_fits_and_gives_nothing_away(xvfb_display, tmp_path):
         assert shot["image_size"] == shot["size"], where
         assert shot["problems"] == [], where
         assert shot["dials"] == DIALS[shot["state"]], where
+        # a page shows its whole text, without scrolling
+        assert bool(shot["page"]) == shot["state"].startswith("page-") and not shot["page_scrolls"], where
         for text in shot["texts"]:
             assert not KNOB_LABEL.search(text) and "75" not in text, (where, text)
             assert not any(re.search(rf"\b{name}\b", text) for name in estimator_names()), (where, text)
