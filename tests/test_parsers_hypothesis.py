@@ -54,6 +54,10 @@ def toml_document(doc):
         if isinstance(fields, dict):
             lines.append(f"[{json.dumps(table)}]")
             lines += [f"{json.dumps(k)} = {toml_value(v)}" for k, v in fields.items()]
+        elif isinstance(fields, list) and all(isinstance(item, dict) for item in fields):
+            for item in fields:  # an array of tables, e.g. [[pages]]
+                lines.append(f"[[{json.dumps(table)}]]")
+                lines += [f"{json.dumps(k)} = {toml_value(v)}" for k, v in item.items()]
         else:
             lines.insert(0, f"{json.dumps(table)} = {toml_value(fields)}")
     return "\n".join(lines) + "\n"
@@ -114,11 +118,25 @@ def test_protocol_text_is_parsed_or_refused(text):
         pass
 
 
+def field_paths(doc):
+    """(table, key) for a table's fields; (table, index, key) for an array of tables' (e.g. [[pages]])."""
+    paths = []
+    for table, fields in doc.items():
+        if isinstance(fields, dict):
+            paths += [(table, key) for key in fields]
+        elif isinstance(fields, list):
+            paths += [(table, i, key) for i, item in enumerate(fields) for key in item]
+    return paths
+
+
 @SETTINGS
-@given(st.sampled_from(sorted((t, k) for t, fields in tomllib.loads(DEMO).items() for k in fields)), values)
+@given(st.sampled_from(field_paths(tomllib.loads(DEMO))), values)
 def test_protocol_with_one_field_changed_is_parsed_or_refused(field, value):
     doc = tomllib.loads(DEMO)
-    doc[field[0]][field[1]] = value
+    target = doc
+    for key in field[:-1]:
+        target = target[key]
+    target[field[-1]] = value
     try:
         protocol = parse_protocol(toml_document(doc), "p.toml")
     except UserError:
