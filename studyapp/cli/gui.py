@@ -2,12 +2,28 @@
 
     studyapp gui [--protocol FILE] [--participant ID] [--results DIR] [--resume]
                  [--simulated-participant] [--start] [--seed N] [--audio SPEC] [--midi SPEC]
-                 [--participant-window] [--screenshot FILE] [--measure-scope SECONDS]
+                 [--participant-window] [--screenshot FILE] [--size WxH] [--measure-scope SECONDS]
 
 ``--screenshot FILE`` starts the console, lets it run, saves it as a PNG and
-exits; ``--measure-scope SECONDS`` prints the live scope's frame rate with
+exits; ``--size WxH`` sizes the console's window (e.g. 1366x768, a lab
+laptop's screen), so a screenshot shows it at that size; ``--measure-scope SECONDS`` prints the live scope's frame rate with
 every trace on and exits. See docs/gui.md.
 """
+
+import re
+
+SIZES = ((800, 600), (7680, 4320))  # px: the smallest and largest window --size allows
+
+
+def parse_size(text):
+    """``"1366x768"`` -> ``(1366, 768)``; ``UserError`` naming the value and what is allowed."""
+    from studyapp.errors import UserError
+
+    (w_min, h_min), (w_max, h_max) = SIZES
+    match = re.fullmatch(r"\s*(\d+)\s*[xX×]\s*(\d+)\s*", text or "")
+    if match is None or not (w_min <= int(match[1]) <= w_max and h_min <= int(match[2]) <= h_max):
+        raise UserError(f"--size {text}: allowed is WIDTHxHEIGHT in pixels, from {w_min}x{h_min} to {w_max}x{h_max}")
+    return int(match[1]), int(match[2])
 
 
 def register(sub):
@@ -26,6 +42,8 @@ def register(sub):
                         help="PORT | first | virtual | none (default: first, or the on-screen knobs if none is found)")
     parser.add_argument("--participant-window", action="store_true", help="open the participant's window too")
     parser.add_argument("--screenshot", metavar="FILE", help="save the running console as a PNG and exit")
+    parser.add_argument("--size", metavar="WxH",
+                        help="window size in pixels, e.g. 1366x768 (800x600 to 7680x4320)")
     parser.add_argument("--measure-scope", type=float, metavar="SECONDS",
                         help="measure the scope's frame rate with every trace on for SECONDS, print it and exit")
     parser.set_defaults(func=run)
@@ -42,6 +60,8 @@ def run(args):
         raise UserError(f"--measure-scope {args.measure_scope:g}: allowed is 0.5 to 600 seconds")
     if args.screenshot and not args.screenshot.lower().endswith(".png"):
         raise UserError(f"--screenshot {args.screenshot}: allowed is a file name ending in .png")
+    if args.size is not None:
+        args.size = parse_size(args.size)
     try:
         from studyapp.gui.app import main
     except ImportError as exc:

@@ -17,7 +17,8 @@ sentinel), so:
   called hung, so detection takes at most ``hang_timeout + POLL`` (< 100 ms).
 
 Either way the fault is reported (``faults``, ``on_fault``), the
-``force_enable`` word is cleared (a worker that was only slow zeroes its force
+``force_enable`` word is cleared, with the reason "watchdog" and how long the
+worker was silent beside it (``StatusBlock.disable_force``; a worker that was only slow zeroes its force
 at its next block and latches a fault) and ``force_output`` reads 0: the
 simulated device, which lives in the worker, stops with it. ``stop()`` asks
 the worker to finish, waits for it, kills it if it will not go, and unlinks
@@ -257,8 +258,8 @@ class Engine:
         if self.on_fault is not None:
             self.on_fault(text)
 
-    def _trip(self, text, when):
-        self.status_block.force_enable = False
+    def _trip(self, text, when, silence=0.0):
+        self.status_block.disable_force("watchdog", silence)
         self.tripped = True
         self._fault(text, when)
 
@@ -279,8 +280,10 @@ class Engine:
                 self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero", now)
                 return
             snap = self.status_block.read()
-            if snap["state"] == "running" and now - snap["heartbeat"] > timeout:
-                self._trip(f"watchdog: no heartbeat for {1e3 * timeout:.0f} ms; force disabled", now)
+            silence = now - snap["heartbeat"]
+            if snap["state"] == "running" and silence > timeout:
+                self._trip(f"watchdog: the engine stopped answering (no heartbeat for {1e3 * silence:.0f} ms, "
+                           f"{1e3 * timeout:.0f} ms allowed); force switched off for safety", now, silence)
 
     # shutting down ---------------------------------------------------------
     def stop(self, timeout=10.0):

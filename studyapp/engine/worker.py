@@ -63,7 +63,7 @@ from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, coalesce, open_input
 from studyapp.engine.pickup import LEVEL_ACTIONS, level_position, passes_through
 from studyapp.engine.ring import Ring
-from studyapp.engine.safety import Safety
+from studyapp.engine.safety import Safety, force_off_text
 from studyapp.engine.status import StatusBlock
 from studyapp.model.fmax_knob import KNOB_MAX
 
@@ -309,9 +309,11 @@ class Worker:
     def step(self, started):
         """One block; returns (finished, wall-clock compute, CPU time of this thread)."""
         cpu_started = time.thread_time()
-        self.safety.before_block(self.status.force_enable)
+        enabled = self.status.force_enable
+        self.safety.before_block(enabled, why=None if enabled else self._force_off_text())
         out = self.loop.run(self.block)
-        self.safety.check(out, force_enable=self.status.force_enable)
+        enabled = self.status.force_enable
+        self.safety.check(out, force_enable=enabled, why=None if enabled else self._force_off_text())
         if self.sink.render:
             self.sink.push(out["audio"])
         rows = self._rows
@@ -332,6 +334,10 @@ class Worker:
         if self.midi is not None:
             self.midi.new_block(self.k, finished)
         return finished, finished - started, cpu
+
+    def _force_off_text(self):
+        """Why the parent cleared ``force_enable``, in words (read only while it is cleared)."""
+        return force_off_text(self.status.force_off_reason, self.status.force_off_silence)
 
     def run(self):
         status = self.status

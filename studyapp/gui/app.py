@@ -5,7 +5,8 @@ pytest-qt), the ``SessionController`` (audio and MIDI as asked, falling back
 to no sound and the on-screen knobs when nothing is found), and the console;
 loads the protocol (``--protocol``, else ``protocols/sinclair2014.toml`` or the
 first protocol in ``protocols/``); fills in the participant; starts the
-session at once with ``--start``; and runs the event loop. ``--screenshot`` and
+session at once with ``--start``; sizes the window (``--size``, already
+parsed into pixels); and runs the event loop. ``--screenshot`` and
 ``--measure-scope`` run the console unattended and exit.
 """
 
@@ -60,6 +61,9 @@ def main(args):
     """Run the console until it is closed; returns the exit code."""
     app = application()
     controller, console = build(args)
+    size = getattr(args, "size", None)
+    if size is not None:
+        console.resize(*size)
     console.show()
     if getattr(args, "participant_window", False):
         console.show_participant.setChecked(True)

@@ -16,6 +16,7 @@ from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QDial, QGridLayout, QLabel, QPushButton, QSizePolicy, QVBoxLayout, QWidget
 
 KNOB_MAX = 127
+PAD_MIN_WIDTH = 36  # px
 
 
 class KnobPanel(QWidget):
@@ -57,7 +58,7 @@ class KnobPanel(QWidget):
             self.captions.append(caption)
         for i in range(pads):
             pad = QPushButton(f"P{i + 1}")
-            pad.setMinimumHeight(30)
+            pad.setMinimumSize(PAD_MIN_WIDTH, 30)  # not the style's ~80 px: eight of them fit a laptop's console
             pad.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
             pad.setToolTip(f"pad {i + 1}")
             pad.clicked.connect(lambda checked=False, i=i: self.pad_pressed.emit(i))

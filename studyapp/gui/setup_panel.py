@@ -41,6 +41,8 @@ class SetupPanel(QWidget):
         self.protocol = QComboBox()
         self.protocol.setEditable(False)
         self.protocol.setMinimumContentsLength(18)
+        # a long path must not widen the console: the list shows it whole, the box elides
+        self.protocol.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
         for path in find_protocols():
             self.protocol.addItem(path)
         self.protocol.activated.connect(lambda index: self.protocol_chosen.emit(self.protocol.itemText(index)))

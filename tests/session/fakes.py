@@ -17,6 +17,11 @@ LATENCY = 0.002  # s, what the fake worker reports for every applied control
 
 class FakeStatusBlock:
     force_enable = True
+    force_off_reason = "parent"
+
+    def disable_force(self, reason, silence=0.0):
+        self.force_off_reason = reason
+        self.force_enable = False
 
 
 class FakeEngine:
