@@ -117,6 +117,7 @@ class Safety:
         self._window.clear()
         self._window_samples = self._window_suspect = 0
         self.scale = 1.0
+        self._previous_force_scale = 1.0  # the next block runs at full scale: its clamp is F_max again
         self.loop.set_force_scale(1.0)
 
     def before_block(self, force_enable, why=WATCHDOG):

@@ -111,6 +111,8 @@ class Scope(QWidget):
         self.save_button = QPushButton("Save PNG…")
         self.save_button.clicked.connect(self._choose_png)
         self.fps_label = QLabel("")
+        # room for the widest reading from the start: the readout never nudges the layout
+        self.fps_label.setMinimumWidth(self.fps_label.fontMetrics().horizontalAdvance("999 fps") + 2)
         self.toggle_box = QWidget()
         self.toggles = FlowLayout(self.toggle_box)
 
