@@ -40,6 +40,10 @@ level acts only once it has passed through the level in force (soft takeover,
 changes nothing, so a knob left high never jumps F_max at a trial start or
 after a pause. On-screen knobs show the level itself and need no pickup.
 
+A MIDI input waiting for its controller (JACK hot-plug, ``midi.py``) is
+connected by the parent; a ``MidiPort`` command names the port (or says it
+went away), and the status block's ``midi`` text and a notice follow.
+
 The worker stops on a ``Stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
 """
@@ -211,6 +215,11 @@ class Worker:
     def _stop(self, c):
         self.stopping = True
 
+    def _midi_port(self, c):
+        if self.midi is not None and self.midi.inlet is not None:
+            self.notice(self.midi.connected(c.name), "info", "midi")
+            self.status.set(midi=self.midi.description)
+
     HANDLERS = {
         cmd.SetSource: _source,
         cmd.SetFmax: _fmax,
@@ -225,6 +234,7 @@ class Worker:
         cmd.Stall: lambda self, c: time.sleep(float(c.seconds)),
         cmd.Stop: _stop,
         cmd.InstallActions: _install,
+        cmd.MidiPort: _midi_port,
         cmd.Control: lambda self, c: self.control(c.control, c.value, c.sent, self.k, "screen"),
     }
 
@@ -347,7 +357,7 @@ class Worker:
         self.events.put(ev.Ready({
             "rate": self.loop.rate, "block": self.block, "names": list(self.loop.names),
             "audio": self.sink.description, "midi": self.midi.description if self.midi else "none",
-            "realtime": self.realtime, "paced": "audio" if self.sink.paced else "timer",
+            "midi_inlet": self.midi.inlet if self.midi else None, "realtime": self.realtime, "paced": "audio" if self.sink.paced else "timer",
         }))
         parent = multiprocessing.parent_process()
         audio_clock = self.sink.paced
