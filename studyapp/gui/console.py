@@ -78,6 +78,7 @@ class Console(QMainWindow):
         self.simulated = None
         self.notices = {}
         self.confirmation = None
+        self._midi_shown = None
         self.caller = GuiThreadCaller(self)
         self.setWindowTitle("studyapp — experimenter console")
 
@@ -331,6 +332,7 @@ class Console(QMainWindow):
     def _on_engine(self, state, info, config):
         if state == "starting":
             self.notices = {}
+            self._midi_shown = None
         self.setup.show_engine(state, info, config, self.notices)
         self.status.show_engine(state, info)
         if state == "running":
@@ -400,6 +402,10 @@ class Console(QMainWindow):
 
     def _on_status(self, status, lost, knob_latency):
         self.status.show_status(status, lost, knob_latency)
+        midi = (status.get("midi"), self.notices.get("midi"))
+        if midi[0] is not None and midi != self._midi_shown:  # a controller plugged in (or out)
+            self._midi_shown = midi
+            self.setup.show_midi(*midi)
 
     def _on_message(self, text, level, topic):
         if topic:

@@ -4,7 +4,9 @@ The apparatus lines say what the engine really opened, in words: the device
 (the simulated 1-DOF device unless a driver is configured), the audio output
 (a PortAudio device, a WAV file, or none, and why: the engine's own notice
 when it fell back to the null sink) and the MIDI input (a port, or none and
-why, in which case the on-screen knobs are the controls).
+why, in which case the on-screen knobs are the controls; or none yet, when
+the engine waits for a controller to be plugged in: ``show_midi`` follows
+the engine's status as it arrives).
 """
 
 from pathlib import Path
@@ -141,9 +143,7 @@ class SetupPanel(QWidget):
         if state == "running":
             audio = info.get("audio", "?")
             self.audio.setText(_with_notice(_audio_words(audio), notices.get("audio")))
-            midi = info.get("midi", "none")
-            self.midi.setText(_with_notice(f"input {midi}" if midi != "none" else "no MIDI input: on-screen knobs",
-                                           notices.get("midi")))
+            self.show_midi(info.get("midi", "none"), notices.get("midi"))
             self.engine.setText(f"{info['rate']:g} Hz, blocks of {info['block']}, paced by the {info['paced']}")
         elif state == "starting":
             for label in (self.audio, self.midi):
@@ -151,6 +151,17 @@ class SetupPanel(QWidget):
             self.engine.setText("starting…")
         else:
             self.engine.setText(state)
+
+
+    def show_midi(self, description, notice=None):
+        """The MIDI line for the engine's ``description`` of its input (and its latest MIDI notice)."""
+        if description == "none":
+            words = "no MIDI input: on-screen knobs"
+        elif description.startswith("none yet"):
+            words = f"{description}; the on-screen knobs work meanwhile"
+        else:
+            words = f"input {description}"
+        self.midi.setText(_with_notice(words, notice))
 
 
 def _audio_words(description):

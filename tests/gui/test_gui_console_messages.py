@@ -142,3 +142,16 @@ def test_scope_axes_never_read_finer_than_the_noise_floor(qapp, size, prefixes):
         low, high = plot.getViewBox().viewRange()[1]
         assert high - low >= 0.9 * {"v": 0.92e-3, "s": 0.92e-3, "f": 0.049}[where]  # 8 sigma of the floor
     scope.close()
+
+
+def test_the_apparatus_panel_follows_a_controller_plugged_in(idle_console, qapp):
+    console = idle_console
+    c = console.controller
+    status = c.engine.status()
+    waiting = "none yet (JACK): plugging a controller in is picked up within 2 s"
+    for midi, words in ((waiting, waiting), ("box:knobs (JACK)", "input box:knobs (JACK)"),
+                        (waiting, waiting)):
+        c.events.status.emit(status={**status, "midi": midi}, lost=0, knob_latency=(None, None))
+        assert console.setup.midi.text().startswith(words)
+    assert "on-screen knobs work meanwhile" in console.setup.midi.text()
+    c.events.status.emit(status=status, lost=0, knob_latency=(None, None))  # the engine's own again
