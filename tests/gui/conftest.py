@@ -35,6 +35,22 @@ def wait_until(app, predicate, timeout, step=0.01):
         time.sleep(step)
 
 
+def answer_question(console, qtbot, button):
+    """Click ``button`` (a ``QMessageBox.StandardButton``) of the console's next question once it is open.
+
+    The question (``Console.confirm``) runs its own event loop, so the click is scheduled before the
+    action that asks.
+    """
+    from PySide6.QtCore import Qt, QTimer
+
+    def click():
+        box = console.confirmation
+        assert box is not None, "no question was asked"
+        qtbot.mouseClick(box.button(button), Qt.MouseButton.LeftButton)
+
+    QTimer.singleShot(0, click)
+
+
 @pytest.fixture(scope="package")
 def console(qapp):
     from studyapp.gui.console import Console
@@ -48,6 +64,8 @@ def console(qapp):
     wait_until(qapp, lambda: controller.engine is not None or controller.host.state == "failed", ENGINE_START)
     assert controller.host.state == "running", controller.host.error
     yield window
+    if controller.in_session:
+        window.abort_session()  # closing mid-session would ask (Console.confirm)
     window.close()
 
 

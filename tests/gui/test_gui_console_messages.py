@@ -4,25 +4,15 @@ no question without a session; the scope's axes read in units the signals can sh
 
 import numpy as np
 import pytest
-from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QMessageBox
 
-from tests.gui.conftest import DEMO, wait_until
+from tests.gui.conftest import DEMO, answer_question, wait_until
 
 pytest.importorskip("pytestqt")
 
 pytestmark = pytest.mark.gui
 
 OPERATOR = "Emergency stop (operator): force off"
-
-
-def answer(console, qtbot, button):
-    """Click ``button`` of the console's question as soon as it is open (the dialog runs its own loop)."""
-    def click():
-        box = console.confirmation
-        assert box is not None, "no question was asked"
-        qtbot.mouseClick(box.button(button), Qt.MouseButton.LeftButton)
-    QTimer.singleShot(0, click)
 
 
 def refuse_questions(console, monkeypatch):
@@ -51,10 +41,10 @@ def test_abort_asks_first_no_keeps_the_session_yes_aborts_it(idle_console, qtbot
     console.setup.results.setText(str(tmp_path))
     console.start_session(seed=1)
     assert c.in_session, console.setup.error.text()
-    answer(console, qtbot, QMessageBox.StandardButton.No)
+    answer_question(console, qtbot, QMessageBox.StandardButton.No)
     console.abort_button.click()
     assert c.in_session and console.confirmation is None
-    answer(console, qtbot, QMessageBox.StandardButton.Yes)
+    answer_question(console, qtbot, QMessageBox.StandardButton.Yes)
     console.abort_button.click()
     assert not c.in_session and c.state == "aborted"
 
@@ -91,10 +81,10 @@ def test_closing_with_a_session_running_asks_first(fake_console, qtbot):
     c = console.controller
     console.start_session(seed=2)
     assert c.in_session, console.setup.error.text()
-    answer(console, qtbot, QMessageBox.StandardButton.No)
+    answer_question(console, qtbot, QMessageBox.StandardButton.No)
     console.close()
     assert console.isVisible() and c.in_session
-    answer(console, qtbot, QMessageBox.StandardButton.Yes)
+    answer_question(console, qtbot, QMessageBox.StandardButton.Yes)
     console.close()
     assert not console.isVisible() and not c.in_session
 
