@@ -11,6 +11,11 @@ newtons, ``trial`` 1..6). Rows of a task without a measure (``listen``) are
 checked and carried, but not analysed. The analysis needs ``participant,
 task, condition, trial, fmax, rating``.
 
+Practice trials (a ``practice`` column that is True, ``studyapp export``)
+are left out before anything is checked or counted, unless
+``include_practice``: the paper's statistics are of the real trials only. An
+export without the column (older versions) has no practice rows.
+
 A response whose value is empty (a trial begun but never confirmed) is kept
 out of the statistics but not forgotten: the missing-trials check counts it as
 missing. A value that is present but not a number, out of range, or a task that
@@ -32,8 +37,9 @@ MEASURED_TASKS = tuple(t for t in TASKS if task_type(t).measure is not None)
 _TEXT_COLUMNS = ["participant", "session", "task", "condition", "protocol_hash"]
 
 
-def load_responses(source, problems=None):
-    """Checked responses from ``source``: a ``.csv`` export or a results folder.
+def load_responses(source, problems=None, include_practice=False):
+    """Checked responses from ``source``: a ``.csv`` export or a results folder (practice rows left
+    out unless ``include_practice``).
 
     Returns ``(responses, label)``; ``label`` names the source in messages. A
     results folder is exported with ``studyapp.experiment.export.export_responses``,
@@ -48,7 +54,7 @@ def load_responses(source, problems=None):
             frame = pd.read_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
             raise InputDataError(f"{path}: not a readable CSV file ({_first_line(exc)})") from None
-        return check_responses(frame, str(path), csv_rows=True), str(path)
+        return check_responses(frame, str(path), csv_rows=True, include_practice=include_practice), str(path)
     if path.is_dir():
         try:
             from studyapp.experiment.export import export_responses
@@ -57,14 +63,16 @@ def load_responses(source, problems=None):
                 f"{path}: reading a results folder needs studyapp.experiment.export, which is not "
                 "installed; pass an exported responses.csv instead"
             ) from None
-        return check_responses(export_responses(path, problems), str(path)), str(path)
+        return check_responses(export_responses(path, problems), str(path),
+                               include_practice=include_practice), str(path)
     raise UserError(f"{path}: expected a results folder or an exported responses .csv file")
 
 
-def check_responses(frame, label, csv_rows=False):
+def check_responses(frame, label, csv_rows=False, include_practice=False):
     """A cleaned copy of ``frame``: text columns as str, numbers as float, tasks checked.
 
     ``csv_rows`` numbers rows as lines of the CSV file (header = line 1) in messages.
+    Practice rows are left out unless ``include_practice``.
     """
     missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
     if missing:
@@ -74,22 +82,32 @@ def check_responses(frame, label, csv_rows=False):
     if len(frame) == 0:
         where = "the file has a header but no rows" if csv_rows else "no session in it holds a response"
         raise InputDataError(f"{label}: no responses ({where})")
-    frame = frame.reset_index(drop=True).copy()
 
     def where(index):
         return f"line {index + 2}" if csv_rows else f"row {index + 1}"
+
+    frame = frame.reset_index(drop=True)
+    if "practice" in frame.columns:
+        practice = _practice_flags(frame["practice"], label, where)
+        if not include_practice:
+            # the original line numbers stay in the index for the messages below
+            frame = frame[~practice]
+            if len(frame) == 0:
+                raise InputDataError(f"{label}: no responses but practice ones (allowed: --include-practice)")
+        frame = frame.assign(practice=practice[frame.index])
+    frame = frame.copy()
 
     for column in ["participant", "task", "condition"]:
         text = frame[column].astype(object).where(frame[column].notna(), None)
         text = text.map(lambda v: None if v is None else str(v).strip())
         empty = text.isna() | (text == "")
         if empty.any():
-            raise InputDataError(f"{label}: column '{column}' is empty at {where(int(np.flatnonzero(empty)[0]))}")
+            raise InputDataError(f"{label}: column '{column}' is empty at {where(_first(empty))}")
         frame[column] = text.astype(object)
     frame["task"] = frame["task"].str.lower()
     bad_task = ~frame["task"].isin(TASKS)
     if bad_task.any():
-        i = int(np.flatnonzero(bad_task)[0])
+        i = _first(bad_task)
         raise InputDataError(
             f"{label}: column 'task' at {where(i)} is '{frame['task'][i]}'; allowed: {', '.join(TASKS)}"
         )
@@ -111,11 +129,11 @@ def check_responses(frame, label, csv_rows=False):
         values = frame[measure.column].where(frame["task"] == task)
         bad = values.notna() & ~(np.isfinite(values) & (values >= measure.low) & (values <= measure.high))
         if bad.any():
-            i = int(np.flatnonzero(bad)[0])
+            i = _first(bad)
             raise InputDataError(
                 f"{label}: column '{measure.column}' at {where(i)} is {values[i]:g}; allowed: {measure.allowed}"
             )
-    return frame
+    return frame.reset_index(drop=True)
 
 
 def response_values(responses, task):
@@ -133,9 +151,31 @@ def _numbers(series, column, label, where):
     numbers = pd.to_numeric(text.replace("", np.nan), errors="coerce")
     bad = numbers.isna() & (text != "")
     if bad.any():
-        i = int(np.flatnonzero(bad)[0])
+        i = _first(bad)
         raise InputDataError(f"{label}: column '{column}' at {where(i)} is '{text[i]}', not a number")
     return numbers.astype(float)
+
+
+def _first(mask):
+    """The index label of the first True of ``mask`` (labels are the rows' places in the source)."""
+    return int(mask.index[np.flatnonzero(mask.to_numpy())[0]])
+
+
+def _practice_flags(series, label, where):
+    """The ``practice`` column as bool: True/False (a CSV's text too); empty is False."""
+    def flag(v):
+        if isinstance(v, (bool, np.bool_)):
+            return bool(v)
+        if v is None or (isinstance(v, float) and np.isnan(v)):
+            return False
+        return {"true": True, "false": False, "": False}.get(str(v).strip().lower())
+
+    flags = series.map(flag)
+    bad = flags.isna()
+    if bad.any():
+        i = _first(bad)
+        raise InputDataError(f"{label}: column 'practice' at {where(i)} is '{series[i]}'; allowed: True, False")
+    return flags.astype(bool)
 
 
 def _first_line(exc):

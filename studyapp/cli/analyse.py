@@ -1,10 +1,12 @@
-"""``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] -o REPORT_DIR``: the paper's Sec. 9-10.
+"""``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] [--include-practice] -o REPORT_DIR``:
+the paper's Sec. 9-10.
 
 RESULTS_DIR is a results folder or an exported responses .csv. Writes the
 paper's pooled Wilcoxon rank-sum tables, the within-subject Friedman and
 signed-rank tables, the summary and Spearman tables, Figs. 7-9 (PNG and SVG)
 and report.html into REPORT_DIR (see studyapp/analysis/report_folder.py);
 with --evaluation, the numerical comparisons and perceptual_correlation.csv.
+Practice trials are left out unless --include-practice.
 Participants short of responses, and too few participants for a test, are
 listed on stderr and in the report. An unreadable session or damaged log line
 in RESULTS_DIR is skipped with a warning (refused with --strict).
@@ -29,6 +31,8 @@ def register(subparsers):
     parser.add_argument("--holm", action="store_true", help="Holm-correct the p-values of each task's pooled rank-sum tests (the signed-rank tests always are)")
     parser.add_argument("--alpha", type=float, default=0.05, help="significance threshold (default 0.05, the paper's)")
     parser.add_argument("--trials", type=int, metavar="N", help="adjustment trials each participant owes per condition (default: the most any participant has)")
+    parser.add_argument("--include-practice", action="store_true",
+                        help="analyse the practice trials too (by default their rows, practice = True, are left out)")
     parser.add_argument("--strict", action="store_true",
                         help="refuse (exit 2) a results folder with an unreadable session or log line; by default "
                              "such data is skipped with a warning")
@@ -54,7 +58,7 @@ def run(args):
     output_paths.check_folder(args.output)
     # read before saying anything: bad input is then the one line on stderr
     problems = []
-    responses, label = load_responses(args.results, problems)
+    responses, label = load_responses(args.results, problems, include_practice=args.include_practice)
     for problem in problems:
         say(f"warning: {problem}")
     if problems and args.strict:

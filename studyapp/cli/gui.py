@@ -2,15 +2,25 @@
 
     studyapp gui [--protocol FILE] [--participant ID] [--results DIR] [--resume]
                  [--simulated-participant] [--start] [--seed N] [--audio SPEC] [--midi SPEC]
-                 [--participant-window] [--screenshot FILE] [--size WxH] [--measure-scope SECONDS]
+                 [--experimenter NAME] [--session-number N] [--notes TEXT] [--order-row N]
+                 [--participant-window] [--participant-screen N] [--participant-screenshot FILE]
+                 [--screenshot FILE] [--size WxH] [--measure-scope SECONDS]
 
 ``--screenshot FILE`` starts the console, lets it run, saves it as a PNG and
 exits; ``--size WxH`` sizes the console's window (e.g. 1366x768, a lab
-laptop's screen), so a screenshot shows it at that size; ``--measure-scope SECONDS`` prints the live scope's frame rate with
-every trace on and exits. See docs/gui.md.
+laptop's screen), so a screenshot shows it at that size; ``--measure-scope
+SECONDS`` prints the live scope's frame rate with every trace on and exits.
+``--participant-screen N`` opens the participant's
+window full-screen on screen N (from 0), remembered for the next
+``--participant-window``; ``--participant-screenshot FILE`` saves that window
+as a PNG (with ``--start``, once the first trial shows) and exits. The
+session-info options fill the set-up panel's fields (checked as ``studyapp run``
+checks them). See docs/gui.md.
 """
 
 import re
+
+from studyapp.cli.session_info_options import add_session_info_options
 
 SIZES = ((800, 600), (7680, 4320))  # px: the smallest and largest window --size allows
 
@@ -41,11 +51,16 @@ def register(sub):
     parser.add_argument("--midi", default="first", metavar="SPEC",
                         help="PORT | first | virtual | none (default: first, or the on-screen knobs if none is found)")
     parser.add_argument("--participant-window", action="store_true", help="open the participant's window too")
+    parser.add_argument("--participant-screen", type=int, metavar="N",
+                        help="the participant's window full-screen on screen N (from 0; remembered on this machine)")
+    parser.add_argument("--participant-screenshot", metavar="FILE",
+                        help="save the participant's window as a PNG and exit")
     parser.add_argument("--screenshot", metavar="FILE", help="save the running console as a PNG and exit")
     parser.add_argument("--size", metavar="WxH",
                         help="window size in pixels, e.g. 1366x768 (800x600 to 7680x4320)")
     parser.add_argument("--measure-scope", type=float, metavar="SECONDS",
                         help="measure the scope's frame rate with every trace on for SECONDS, print it and exit")
+    add_session_info_options(parser)
     parser.set_defaults(func=run)
 
 
@@ -53,13 +68,20 @@ def run(args):
     from studyapp.errors import UserError
     from studyapp.gui.display import require_display
 
+    from studyapp.experiment.session_info import check_experimenter, check_notes, check_session_number
+
+    check_experimenter(args.experimenter)
+    check_session_number(args.session_number)
+    check_notes(args.notes)
     require_display()
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")
     if args.measure_scope is not None and not 0.5 <= args.measure_scope <= 600:
         raise UserError(f"--measure-scope {args.measure_scope:g}: allowed is 0.5 to 600 seconds")
-    if args.screenshot and not args.screenshot.lower().endswith(".png"):
-        raise UserError(f"--screenshot {args.screenshot}: allowed is a file name ending in .png")
+    for option in ("screenshot", "participant_screenshot"):
+        path = getattr(args, option)
+        if path and not path.lower().endswith(".png"):
+            raise UserError(f"--{option.replace('_', '-')} {path}: allowed is a file name ending in .png")
     if args.size is not None:
         args.size = parse_size(args.size)
     try:

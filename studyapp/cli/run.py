@@ -1,5 +1,10 @@
 """``studyapp run --protocol FILE --participant ID [--simulated-participant] [--headless]
-[--resume] [--results DIR] [--seed N]``: run one participant's session.
+[--resume] [--results DIR] [--seed N] [--experimenter NAME] [--session-number N] [--notes TEXT]
+[--order-row N]``: run one participant's session.
+
+The experimenter's fields and the order row are stored in session.json
+(``experiment.session_info`` says what is allowed); the order row in force is
+printed with the session folder's line.
 
 With ``--simulated-participant --headless`` the session runs in this process
 without a display: the closed loop is stepped directly and the simulated
@@ -8,6 +13,8 @@ pilot). Progress goes to stderr; the session folder is printed on stdout.
 Without ``--headless`` the session runs in the experimenter console
 (``studyapp.gui.run_session(args)``).
 """
+
+from studyapp.cli.session_info_options import add_session_info_options, session_info_of
 
 
 def register(sub):
@@ -23,6 +30,7 @@ def register(sub):
     parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
     parser.add_argument("--seed", type=int, default=None, metavar="N",
                         help="session seed (default: from the study seed and the participant's enrolment)")
+    add_session_info_options(parser)
     parser.set_defaults(func=run)
 
 
@@ -34,13 +42,18 @@ def run(args):
     from studyapp.errors import UserError
     from studyapp.experiment.protocol import load_protocol
     from studyapp.experiment.session import check_participant
+    from studyapp.experiment.session_info import check_experimenter, check_notes, check_order_row, check_session_number
 
     check_participant(args.participant)
+    check_experimenter(args.experimenter)
+    check_session_number(args.session_number)
+    check_notes(args.notes)
     if args.seed is not None and not 0 <= args.seed < 2**63:
         raise UserError(f"--seed {args.seed}: allowed is an integer from 0 to 2**63 - 1")
     if args.headless and not args.simulated_participant:
         raise UserError("--headless: allowed only with --simulated-participant (a person takes part through the GUI)")
     protocol = load_protocol(args.protocol)
+    check_order_row(protocol, args.order_row)
     output_paths.check_folder(args.results, "--results")
     if not args.headless:
         return _run_in_gui(args)
@@ -48,19 +61,22 @@ def run(args):
     from studyapp.experiment.session import Session
     from studyapp.experiment.session_log import LogWriteError
     from studyapp.experiment.session_runner import SessionRunner
+    from studyapp.experiment.session_info import order_text
     from studyapp.experiment.simulated_participant import SimulatedParticipant
 
     def progress(message):
         print(f"studyapp run: {message}", file=sys.stderr, flush=True)
 
     if args.resume:
-        session = Session.resume(protocol, args.participant, args.results, seed=args.seed)
+        session = Session.resume(protocol, args.participant, args.results, seed=args.seed, **session_info_of(args))
     else:
         session = Session.create(protocol, args.participant, args.results, seed=args.seed,
-                                 apparatus={"device": "simulated", "participant": "simulated", "audio": False})
+                                 apparatus={"device": "simulated", "participant": "simulated", "audio": False},
+                                 **session_info_of(args))
     for note in session.notes:
         progress(f"warning: {note}")
-    progress(f"session {session.folder} ({len(session.finished_steps())} of {len(session.schedule)} trials done)")
+    progress(f"session {session.folder} ({len(session.finished_steps())} of {len(session.schedule)} trials done, "
+             f"{order_text(session.info)})")
     runner = SessionRunner(session, progress=progress)
     try:
         runner.begin()

@@ -1,11 +1,15 @@
 """Audio sinks for the string's sound: a PortAudio device, a WAV file, or nothing.
 
 The closed loop renders audio at the haptic rate; a sink resamples it to its
-own rate (``resampler.Resampler``), applies volume and mute, and plays or
-stores it. Choose one with ``open_sink(spec, haptic_rate)``::
+own rate (``resampler.Resampler``), applies volume and mute, puts in the
+headphone check's reference tone when it is on (``reference_tone``: it
+replaces the string's sound and does not pass through the volume knob), tees
+the result to the session's recorder if one is attached (``audio_recorder``),
+and plays or stores it. Choose one with ``open_sink(spec, haptic_rate)``::
 
     "device" | "device:NAME"   PortAudio output (sounddevice), NAME a substring of the device name
-    "wav:FILE"                 16-bit mono WAV at 48 kHz, written atomically when the sink closes
+    "wav:FILE"                 16-bit mono WAV at 48 kHz, written atomically when the sink closes; never
+                               over an existing file: FILE taken, it is FILE-2, FILE-3, ... (a notice says which)
     "null"                     nothing rendered at all
     "discard"                  rendered and resampled, then dropped (what audio costs, for benchmarks)
 
@@ -25,13 +29,15 @@ that thread waits at most about half a millisecond.
 
 import contextlib
 import os
+import tempfile
 import threading
 import wave
 
 import numpy as np
 
-from studyapp.atomic import atomic_path
+from studyapp.engine.audio_recorder import numbered
 from studyapp.engine.native_stderr import captured_native_stderr
+from studyapp.engine.reference_tone import ReferenceTone
 from studyapp.engine.resampler import Resampler
 from studyapp.errors import ParameterError
 
@@ -144,6 +150,8 @@ class Sink:
 
     def __init__(self):
         self.gain = Gain()
+        self.tone = None  # a sink that renders makes its ReferenceTone at its own rate
+        self.recorder = None  # the session's AudioRecorder, fed every block this sink outputs
         self.underruns = 0  # device periods played with a gap, for whatever reason
         self.shortfalls = 0  # ... because the FIFO ran dry (the engine was late)
         self.xruns = 0  # ... because the device reported an underflow
@@ -170,6 +178,20 @@ class Sink:
 
     def set_mute(self, muted):
         self.gain.muted = bool(muted)
+        if self.tone is not None:
+            self.tone.set_muted(muted)
+
+    def set_reference_tone(self, hz, level_dbfs):
+        if self.tone is None:
+            raise ParameterError(f"reference tone: the {self.description} sink plays no sound")
+        self.tone.set(hz, level_dbfs)
+
+    def _heard(self, samples):
+        """What the listener hears of resampled ``samples``: volume and mute, the tone; teed to the recorder."""
+        out = self.tone.mix(self.gain.apply(samples))
+        if self.recorder is not None:
+            self.recorder.write(out)
+        return out
 
     def close(self):
         pass
@@ -184,27 +206,39 @@ class DiscardSink(Sink):
         super().__init__()
         self.rate = float(rate)
         self.resampler = Resampler(haptic_rate, self.rate)
+        self.tone = ReferenceTone(self.rate)
 
     @property
     def description(self):
         return f"discard ({self.rate:g} Hz)"
 
     def push(self, audio):
-        self.gain.apply(self.resampler.process(audio))
+        self._heard(self.resampler.process(audio))
 
 
 class WavSink(Sink):
-    """A 16-bit mono WAV file, complete or absent: it appears under its name only on ``close``."""
+    """A 16-bit mono WAV file, complete or absent: it appears under its name only on ``close``.
+
+    Never over an existing file: the name is the first free one of FILE, FILE-2, ... when the
+    sink opens (``say`` tells which, if not FILE) and again when it closes, reserved by an
+    exclusive create (two engines writing the same FILE at once both keep their take).
+    """
 
     render = True
 
-    def __init__(self, path, haptic_rate, rate=WAV_RATE):
+    def __init__(self, path, haptic_rate, rate=WAV_RATE, say=print):
         super().__init__()
-        self.path = path
+        self.say = say
+        self.path = str(_free_name(path))
+        if self.path != str(path):
+            say(f"audio: {path} exists; writing {self.path} (never over an earlier file)")
         self.rate = float(rate)
         self.resampler = Resampler(haptic_rate, self.rate)
-        self._atomic = atomic_path(path)
-        self._tmp = self._atomic.__enter__()
+        self.tone = ReferenceTone(self.rate)
+        folder, name = os.path.split(os.path.abspath(self.path))
+        fd, self._tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".wav", dir=folder)
+        os.fchmod(fd, 0o666 & ~_umask())  # an output's usual permissions, not mkstemp's private ones
+        os.close(fd)
         self._wav = wave.open(str(self._tmp), "wb")
         self._wav.setnchannels(1)
         self._wav.setsampwidth(2)
@@ -216,7 +250,7 @@ class WavSink(Sink):
         return f"wav:{self.path} ({self.rate:g} Hz)"
 
     def _write(self, samples):
-        pcm = np.round(self.gain.apply(samples) * 32767.0).astype("<i2")
+        pcm = np.round(self._heard(samples) * 32767.0).astype("<i2")
         self._wav.writeframesraw(pcm.tobytes())
         self.frames += pcm.shape[0]
 
@@ -229,7 +263,41 @@ class WavSink(Sink):
         self._write(self.resampler.flush())
         self._wav.close()
         self._wav = None
-        self._atomic.__exit__(None, None, None)
+        chosen = self.path
+        self.path = str(_move_free(self._tmp, self.path))
+        if self.path != chosen:
+            self.say(f"audio: {chosen} appeared meanwhile; wrote {self.path} (never over an earlier file)")
+
+
+def _umask():
+    umask = os.umask(0)
+    os.umask(umask)
+    return umask
+
+
+def _free_name(path):
+    """``path``, or the first of ``path-2``, ``path-3``, ... that does not exist."""
+    number = 1
+    while os.path.lexists(numbered(path, number)):
+        number += 1
+    return numbered(path, number)
+
+
+def _move_free(source, path):
+    """Move ``source`` to ``path`` or the first free numbered name after it; never replaces another's file.
+
+    The name is reserved by an exclusive create, then ``source`` renamed over that empty file of ours.
+    """
+    number = 1
+    while True:
+        target = numbered(path, number)
+        try:
+            os.close(os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+        except FileExistsError:
+            number += 1
+            continue
+        os.replace(source, target)
+        return target
 
 
 class DeviceSink(Sink):
@@ -259,6 +327,7 @@ class DeviceSink(Sink):
         self.name = info["name"]
         self.hostapi = sd.query_hostapis(info["hostapi"])["name"]
         self.resampler = Resampler(haptic_rate, self.rate)
+        self.tone = ReferenceTone(self.rate)
         self.lead_frames = int(lead * self.rate)
         self.fifo = Fifo(max(4 * self.lead_frames, int(self.rate)))
         self._wanted = threading.Event()
@@ -303,14 +372,14 @@ class DeviceSink(Sink):
             self.xruns += 1
         if short or status.output_underflow:
             self.underruns += 1
-        self.gain.apply(self._scratch)
         outdata[:] = self._scratch[:, None]
         self.callbacks += 1
         self.frames_played += frames
         self._wanted.set()
 
     def push(self, audio):
-        self.fifo.write(self.resampler.process(audio).astype(np.float32))
+        # volume, mute and tone before the FIFO: the FIFO holds what is heard, as the recorder gets it
+        self.fifo.write(self._heard(self.resampler.process(audio)).astype(np.float32))
 
     @property
     def target(self):
@@ -363,7 +432,7 @@ def open_sink(spec, haptic_rate, say=print, lead=0.03):
     if kind == "discard":
         return DiscardSink(haptic_rate)
     if kind == "wav":
-        return WavSink(arg, haptic_rate)
+        return WavSink(arg, haptic_rate, say=say)
     try:
         return DeviceSink(haptic_rate, device=arg, lead=lead)
     except AudioUnavailable as exc:

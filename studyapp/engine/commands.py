@@ -86,6 +86,24 @@ class ReferenceTone(Command):
 
 
 @dataclass(frozen=True)
+class RecordAudio(Command):
+    """Keep what the participant hears in the WAV file ``path`` (the first free of ``audio.wav``,
+    ``audio-2.wav``, ...: never overwritten; engine/audio_recorder.py); None stops recording."""
+
+    path: str | None
+
+
+@dataclass(frozen=True)
+class AudioCue(Command):
+    """A trial boundary in the recording (a row of ``audio_cues.csv``), at the block where it is applied."""
+
+    step: int
+    task: str
+    trial: int
+    event: str  # "start" or "end"
+
+
+@dataclass(frozen=True)
 class Learn(Command):
     control: str  # bind it to the next MIDI control that moves
 

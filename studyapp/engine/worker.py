@@ -63,6 +63,7 @@ import numpy as np
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine.audio import open_sink
+from studyapp.engine.audio_recorder import AudioRecorder
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, coalesce, open_input
 from studyapp.engine.pickup import LEVEL_ACTIONS, level_position, passes_through
@@ -138,6 +139,8 @@ class Worker:
         self.stopping = False
         self.midi = None
         self.sink = None
+        self.recorder = None  # the session's recording of what is heard (RecordAudio)
+        self.recordings = []  # every recorder of this run: closed, with what it wrote, in close()
         status.set(state="starting", rate=config.rate)
         status.publish()
         sys.setswitchinterval(0.0005)  # PortAudio's callback thread needs the GIL promptly
@@ -220,6 +223,24 @@ class Worker:
             self.notice(self.midi.connected(c.name), "info", "midi")
             self.status.set(midi=self.midi.description)
 
+    def _record(self, c):
+        """Stop the recording in progress (its writer finishes on its own), then start one at ``c.path``."""
+        if self.recorder is not None:
+            self.recorder.stop()
+            self.sink.recorder = self.recorder = None
+        if c.path is None:
+            return
+        if not self.sink.render:
+            self.notice(f"audio: the {self.sink.description} sink renders no audio: nothing to record", "warning", "audio")
+            return
+        self.recorder = self.sink.recorder = AudioRecorder(c.path, self.sink.rate)
+        self.recordings.append(self.recorder)
+        self.notice(f"audio: recording what is heard to {self.recorder.path}", "info", "audio")
+
+    def _cue(self, c):
+        if self.recorder is not None:
+            self.recorder.cue(c.step, c.task, c.trial, c.event)
+
     HANDLERS = {
         cmd.SetSource: _source,
         cmd.SetFmax: _fmax,
@@ -233,6 +254,9 @@ class Worker:
         cmd.ClearFault: _clear_fault,
         cmd.Stall: lambda self, c: time.sleep(float(c.seconds)),
         cmd.Stop: _stop,
+        cmd.ReferenceTone: lambda self, c: self.sink.set_reference_tone(c.hz, c.level_dbfs),
+        cmd.RecordAudio: _record,
+        cmd.AudioCue: _cue,
         cmd.InstallActions: _install,
         cmd.MidiPort: _midi_port,
         cmd.Control: lambda self, c: self.control(c.control, c.value, c.sent, self.k, "screen"),
@@ -449,11 +473,28 @@ class Worker:
             "load_max": float(np.max(self.loads)) if self.loads else 0.0, "realtime": self.realtime,
             "block": self.block, "paced": "audio" if self.sink.paced else "timer",
             "wake_late_max": self.wake_late_max, "overruns": self.overruns, "stalls": self.stalls,
+            "audio_recordings": [{"file": str(r.path), "frames": r.frames, "dropped": r.dropped, "error": r.error}
+                                 for r in self.recordings],
         }
+
+    def _close_recordings(self, timeout=5.0):
+        """Let every recording's writer finish; say what one could not write."""
+        if self.recorder is not None:
+            self.recorder.stop()
+            self.sink.recorder = self.recorder = None  # the sink's flush on close is not the session's
+        for recorder in self.recordings:
+            if not recorder.join(timeout):
+                self.notice(f"audio: {recorder.path}: the writer did not finish within {timeout:g} s", "warning", "audio")
+            if recorder.error:
+                self.notice(f"audio: recording stopped: {recorder.error}", "warning", "audio")
+            if recorder.dropped:
+                self.notice(f"audio: {recorder.path}: {recorder.dropped} frames dropped (the disk fell behind), "
+                            "written as silence", "warning", "audio")
 
     def close(self):
         """Release the devices and report; ``True`` if the process must leave by ``os._exit``."""
         stuck = False
+        self._close_recordings()
         if self.sink is not None:
             self.sink.close()
             stuck = getattr(self.sink, "stuck", False)

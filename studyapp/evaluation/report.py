@@ -43,7 +43,8 @@ def finite_median(values):
 
 def _percent(values, baseline):
     with np.errstate(divide="ignore", invalid="ignore"):
-        pct = 100.0 * np.asarray(values, dtype=np.float64) / np.asarray(baseline, dtype=np.float64)
+        # the ratio first: a value against itself is then exactly 100 (100 x / x need not be)
+        pct = 100.0 * (np.asarray(values, dtype=np.float64) / np.asarray(baseline, dtype=np.float64))
     return np.where(np.isfinite(pct), pct, np.nan)
 
 

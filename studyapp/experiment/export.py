@@ -4,8 +4,10 @@ One row per response, first the columns of the "Study results" contract:
 
     participant, session, task, condition, trial, fmax, rating, time, protocol_hash
 
-then ``study, step, value, knob, peak_fmax, duration, app_version`` and the
-trial's engine health ``deadline_misses, underruns, faults, events_dropped``.
+then ``study, step, practice, value, knob, peak_fmax, duration, app_version``,
+the trial's engine health ``deadline_misses, underruns, faults,
+events_dropped``, and the session's ``experimenter, session_number,
+order_row``.
 
 - ``task`` names the task type; ``trial``, ``fmax``, ``time``, ``step`` and
   ``duration`` come from the response event, the rest from the task type's
@@ -20,11 +22,22 @@ trial's engine health ``deadline_misses, underruns, faults, events_dropped``.
   ``peak_fmax`` the highest F_max reached in the trial.
 - Listen rows: ``fmax`` the F_max played (N), ``duration`` how long; ``rating``
   and ``value`` empty.
+- ``practice`` is True for a practice trial (its response logged with
+  ``"practice": true``), False otherwise; the analysis leaves practice rows
+  out by default.
+- Pages (task ``page``) are not responses of the study: their
+  acknowledgements stay in events.jsonl and make no row.
 - ``time`` is the ISO-8601 wall time of the response (the confirm).
 - ``deadline_misses``, ``underruns``, ``faults``, ``events_dropped``: what the
   real-time engine counted while the trial ran (the session's ``trial_health``
   records of its step, summed over its attempts); empty for a session without
   a real-time engine (``studyapp run``).
+
+- ``experimenter``, ``session_number``, ``order_row``: from session.json
+  (``session_info``); empty when not given, or for a session stored before
+  they were. The experimenter's ``notes`` stay in session.json: free text of
+  up to 2000 characters and several lines, they would repeat on every
+  response row and break the table's one-line cells.
 
 Incomplete sessions are exported too: every confirmed response is data. A
 session that cannot be read is skipped, and a damaged line of a log left out
@@ -45,8 +58,10 @@ from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
 
 HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
+SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
-           "study", "step", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS]
+           "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS,
+           *SESSION_COLUMNS]
 
 
 def _session_rows(folder, problems):
@@ -64,6 +79,7 @@ def _session_rows(folder, problems):
             "protocol_hash": info["protocol"]["sha256"],
             "study": info["study"],
             "app_version": info["app_version"],
+            **{column: info.get(column) for column in SESSION_COLUMNS},
         }
     except UserError as exc:
         problems.append(f"{folder}: skipped, {exc}")
@@ -91,7 +107,8 @@ def _session_rows(folder, problems):
             seq = event.get("seq") if isinstance(event, dict) else "?"
             raise InputDataError(f"{folder / EVENTS_FILE}: response event seq {seq}: {wrong}")
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
-                "time": event["wall"], "step": event["step"], "duration": event.get("duration")}
+                "time": event["wall"], "step": event["step"], "duration": event.get("duration"),
+                "practice": event.get("practice") is True}
         base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
@@ -141,11 +158,12 @@ def export_responses(results_dir, problems=None):
     frame = pd.DataFrame(rows, columns=COLUMNS)
     frame = frame.sort_values(["study", "participant", "session", "step", "knob"], kind="stable")
     frame["trial"] = frame["trial"].astype("int64")
+    frame["practice"] = frame["practice"].astype(bool)
     frame["step"] = frame["step"].astype("int64")
     frame["knob"] = frame["knob"].astype("Int64")
     frame["value"] = frame["value"].astype("Int64")  # empty for a task without a knob answer
-    for column in HEALTH_COLUMNS:
-        frame[column] = frame[column].astype("Int64")  # empty without a real-time engine
+    for column in [*HEALTH_COLUMNS, "session_number", "order_row"]:
+        frame[column] = frame[column].astype("Int64")  # empty without a real-time engine, or when not stored
     return frame.reset_index(drop=True)
 
 

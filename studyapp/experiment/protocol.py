@@ -6,7 +6,9 @@ the Latin squares, the tasks to run in order, and one table per task: its
 conditions, instructions and fields, which the task type reads and checks
 (``studyapp.experiment.tasks``; e.g. the rating task's constant F_max, 1 N in
 the paper, or the adjustment knob's F_max ceiling and how many decades its
-logarithmic map spans). ``docs/experiment.md`` lists every field.
+logarithmic map spans), and the pages the participant reads between trials
+(``[[pages]]``, ``studyapp.experiment.pages``). ``docs/experiment.md`` lists
+every field.
 
 Nothing starts on an invalid protocol, and nothing is enrolled:
 ``load_protocol`` raises one ``UserError`` whose single line names the file,
@@ -44,6 +46,7 @@ class Protocol:
     gesture: str
     estimators: dict = field(default_factory=dict)
     specs: dict = field(default_factory=dict)  # task name -> its validated spec (the task type's parse)
+    pages: tuple = ()  # the [[pages]] (studyapp.experiment.pages.Page), in file order
 
     def task(self, name):
         return self.specs[name]
@@ -64,6 +67,7 @@ class Protocol:
             "pads": self.pads,
             "gesture": self.gesture,
             "estimators": {k: dict(v) for k, v in self.estimators.items()},
+            "pages": [page.to_dict() for page in self.pages],
         }
         for name in self.tasks:
             spec = self.task(name)
@@ -74,14 +78,15 @@ class Protocol:
 class _Fields:
     """Reads one TOML table, turning each problem into one line naming file and field."""
 
-    def __init__(self, source, table, values):
+    def __init__(self, source, table, values, label=None):
         self.source = source
         self.table = table
+        self.label = label or f"[{table}]"  # how messages name it, e.g. "[[pages]] #2"
         self.values = values
         self.used = set()
 
     def fail(self, key, problem, allowed):
-        where = f"[{self.table}] {key}" if key else f"[{self.table}]"
+        where = f"{self.label} {key}" if key else self.label
         raise UserError(f"{self.source}: {where} {problem}: allowed is {allowed}")
 
     def get(self, key, allowed, default=...):
@@ -153,12 +158,14 @@ def parse_protocol(text, source="<protocol>"):
     from studyapp import estimators
     from studyapp.estimators.registry import spec as estimator_spec
     from studyapp.estimators.spec import RATE_MAX, RATE_MIN
+    from studyapp.experiment.pages import parse_pages
     from studyapp.experiment.task_type import Bounds
-    from studyapp.experiment.tasks import task_names, task_type
+    from studyapp.experiment.tasks import protocol_task_names as task_names
+    from studyapp.experiment.tasks import task_type
     from studyapp.model.loop import GESTURES
 
     document = parse_toml(text, source)
-    known_tables = ("study", "apparatus", "estimators", *task_names())
+    known_tables = ("study", "apparatus", "estimators", "pages", *task_names())
     for name in document:
         if name not in known_tables:
             raise UserError(f"{source}: [{name}] is not a known table: allowed are {', '.join(known_tables)}")
@@ -209,6 +216,8 @@ def parse_protocol(text, source="<protocol>"):
             raise UserError(f"{source}: [{task}] is given but [study] tasks does not list it: "
                             f"allowed is to list it in tasks or remove the table")
 
+    pages = parse_pages(source, document, tasks)
+
     return Protocol(
         path=source,
         text=text,
@@ -223,6 +232,7 @@ def parse_protocol(text, source="<protocol>"):
         gesture=gesture,
         estimators=overrides,
         specs=specs,
+        pages=pages,
     )
 
 

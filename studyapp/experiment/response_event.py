@@ -6,7 +6,8 @@ belongs, an unknown task. ``problem(event)`` names the first such field, so the
 reader can stop with one line naming the file, the event and the field, rather
 than with a ``KeyError`` deep in pandas. Fields common to every task: ``step``
 an integer >= 0, ``task`` a registered task, ``trial`` an integer >= 1,
-``fmax`` a finite number >= 0 (N), ``wall`` the time as text; the rest is the
+``fmax`` a finite number >= 0 (N), ``wall`` the time as text, ``practice``
+(when present) true or false; the rest is the
 task type's (``response_problem`` in ``studyapp.experiment.tasks``).
 """
 
@@ -24,6 +25,7 @@ def problem(event):
         ("trial", integer(event.get("trial"), 1), "an integer >= 1"),
         ("fmax", number(event.get("fmax")), "a finite number >= 0"),
         ("wall", text(event.get("wall")), "the time as ISO-8601 text"),
+        ("practice", isinstance(event.get("practice", False), bool), "true or false (absent: false)"),
     ]
     for name, ok, allowed in checks:
         if not ok:

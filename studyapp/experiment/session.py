@@ -7,8 +7,11 @@ Layout (DESIGN.md "Results layout"):
 
 ``session.json`` is written once, atomically, when the session is created:
 the protocol (its text, validated settings and SHA-256), the app version, the
-seed, the participant's enrolment index and Latin-square rows, the schedule,
-and the apparatus (device, rate). Everything that happens afterwards is an
+seed, the participant's enrolment index and Latin-square rows, the order row
+(``order_row``, ``order_rows``, ``order_row_source``), the schedule, the
+apparatus (device, rate), and what the experimenter tells (``experimenter``,
+``session_number``, ``notes``; ``session_info`` checks them, before anything
+is written). Everything that happens afterwards is an
 event in ``events.jsonl`` (see ``session_log``).
 
 A trial is finished when its ``response`` event is on disk. ``resume`` reopens
@@ -48,6 +51,13 @@ from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
+from studyapp.experiment.session_info import (
+    check_experimenter,
+    check_notes,
+    check_order_row,
+    check_session_number,
+    order_rows,
+)
 from studyapp.experiment.session_lock import LOCK_FILE, ParticipantLock, StudyLock
 from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
 
@@ -204,9 +214,16 @@ class Session:
             self.lock.release()
 
     @classmethod
-    def create(cls, protocol, participant, results, seed=None, apparatus=None):
-        """A new session of ``participant`` under ``results``; refused if they already have one."""
+    def create(cls, protocol, participant, results, seed=None, apparatus=None, experimenter=None,
+               session_number=None, notes=None, order_row=None):
+        """A new session of ``participant`` under ``results``; refused if they already have one.
+
+        ``order_row`` None: the enrolment index decides it (``session_info``).
+        """
         check_participant(participant)
+        told = {"experimenter": check_experimenter(experimenter), "session_number": check_session_number(session_number),
+                "notes": check_notes(notes)}
+        order_row = check_order_row(protocol, order_row)
         study_folder = Path(results) / protocol.study
         participant_folder = study_folder / participant
         try:
@@ -228,7 +245,8 @@ class Session:
                     "allowed is --resume to continue it, or another participant ID")
             with StudyLock(study_folder):
                 folder, info = cls._describe(protocol, participant, study_folder, participant_folder,
-                                             seed, apparatus)
+                                             seed, apparatus, order_row)
+                info.update(told)
                 make_folders(folder)
                 _write_description(folder, info)
             session = cls(folder, lock)
@@ -250,11 +268,14 @@ class Session:
             raise
 
     @staticmethod
-    def _describe(protocol, participant, study_folder, participant_folder, seed, apparatus):
-        """(the new session's folder, its description): enrolment index, seed, schedule, protocol."""
+    def _describe(protocol, participant, study_folder, participant_folder, seed, apparatus, order_row):
+        """(the new session's folder, its description): enrolment index, seed, order row, schedule, protocol."""
         index = len([p for p in enrolled_participants(study_folder) if p != participant])
         seed = default_seed(protocol.seed, index) if seed is None else int(seed)
-        schedule, squares = build_schedule(protocol, index)
+        rows = order_rows(protocol)
+        source = "enrolment" if order_row is None else "set"
+        order_row = index % rows if order_row is None else order_row  # the same orders as the index itself
+        schedule, squares = build_schedule(protocol, index, order_row=order_row)
         started = datetime.now().astimezone()
         folder = participant_folder / started.strftime("%Y-%m-%dT%H-%M-%S")
         suffix = 1
@@ -277,6 +298,9 @@ class Session:
                 "text": protocol.text,
             },
             "latin_squares": squares,
+            "order_row": order_row,
+            "order_rows": rows,
+            "order_row_source": source,
             "schedule": [t.to_dict() for t in schedule],
             "apparatus": {"rate": protocol.rate, "knobs": protocol.knobs, "pads": protocol.pads,
                           "gesture": protocol.gesture, **(apparatus or {})},
@@ -284,12 +308,18 @@ class Session:
         return folder, info
 
     @classmethod
-    def resume(cls, protocol, participant, results, seed=None):
+    def resume(cls, protocol, participant, results, seed=None, order_row=None, **told):
         """Reopen ``participant``'s unfinished session of ``protocol`` under ``results``.
 
         Everything is checked, read-only, before the log is opened (which may repair it).
+        ``order_row`` may only repeat the stored one; the experimenter's fields (``told``)
+        belong to the session's start and are refused.
         """
         check_participant(participant)
+        given = [key for key, value in told.items() if value not in (None, "")]
+        if given:
+            raise UserError(f"{given[0].replace('_', ' ')}: set when a session starts, not when it is resumed: "
+                            "allowed is to leave it empty with resume")
         participant_folder = Path(results) / protocol.study / participant
         if not session_folders(participant_folder):
             raise UserError(f"participant {participant!r} has no session to resume in {participant_folder}: "
@@ -305,6 +335,9 @@ class Session:
             if seed is not None and int(seed) != info["seed"]:
                 raise UserError(f"--seed {seed}: session {folder} has seed {info['seed']}: "
                                 "allowed is to leave out --seed when resuming")
+            if order_row is not None and check_order_row(protocol, order_row) != info.get("order_row"):
+                raise UserError(f"order row {order_row}: session {folder} has order row {info.get('order_row')}: "
+                                "allowed is to leave it out when resuming")
             done = {e.get("step") for e in read_events(folder / EVENTS_FILE) if e.get("type") == "response"}
             if all(t["step"] in done for t in info["schedule"]):
                 # resuming is the way to repair a session: its session.json too, when it is complete

@@ -4,9 +4,16 @@ logs them, and keeps the closed loop on the task's condition and F_max.
 Whoever plays the session (the simulated participant, or the GUI for a person
 with MIDI knobs) calls the same methods: ``start_trial``, ``knob``, ``pad``,
 ``set_bowing``, ``advance`` (run the loop for a while, which also ticks the
-task) and ``finish``. Every record a task returns is appended to the session
-log with the trial's ``step`` and ``task``. The loop's faults and the stability
-monitor's changes of verdict are logged too.
+task, telling it whether the bow is on: ``tick(dt, bowing)``),
+``acknowledge_page`` and ``finish``. Every record a task returns is appended
+to the session log with the trial's ``step`` and ``task`` (and ``practice``
+true for a practice trial). The loop's faults and the stability monitor's
+changes of verdict are logged too.
+
+A page step (task ``page``) has no loop: nothing sounds while the participant
+reads, and ``advance`` only ticks the page's clock. A task whose protocol
+table says ``bow = "auto"`` gets the bow on the string at each trial's start
+(logged as a ``bowing`` record).
 
 The current trial is the state machine its task type makes
 (``studyapp.experiment.tasks``). The loop is made per trial by
@@ -63,7 +70,8 @@ class SessionRunner:
 
     def log(self, event):
         if self.trial is not None:
-            event = {"step": self.trial.step, "task": self.trial.task, **event}
+            practice = {"practice": True} if self.trial.practice else {}
+            event = {"step": self.trial.step, "task": self.trial.task, **practice, **event}
         try:
             return self.session.log.append(event)
         except LogWriteError:
@@ -88,14 +96,16 @@ class SessionRunner:
             return None
         p = self.protocol
         kind = task_type(trial.task)
-        self.task = kind.start(p.task(trial.task), trial)
+        spec = p.specs.get(trial.task)  # None for a page
+        self.task = kind.start(spec, trial)
         conditions = kind.loop_conditions(trial)
         earlier = [e for e in self.session.events() if e.get("step") == trial.step]
         restored = self.task.restore(earlier)
         seed = int(np.random.SeedSequence([self.session.seed, trial.step]).generate_state(1)[0])
         estimators = {c: p.estimator_params(c) for c in conditions}
-        self.loop = self.make_loop(estimators, self.task.source or conditions[0], seed)
-        self._loop_source = self.task.source or conditions[0]
+        if conditions:
+            self.loop = self.make_loop(estimators, self.task.source or conditions[0], seed)
+        self._loop_source = self.task.source or (conditions[0] if conditions else None)
         self._loop_fmax = None
         self._broken = False
         self._fault = None
@@ -105,11 +115,15 @@ class SessionRunner:
                   "conditions": list(trial.conditions), "restart": bool(earlier),
                   "restored_knobs": restored, "loop_seed": seed})
         self._apply()
+        if getattr(spec, "bow", None) == "auto":
+            self.set_bowing(True)
         self.progress(f"[{trial.step + 1}/{len(self.session.schedule)}] {trial.describe()}")
         return trial
 
     def _apply(self):
         """Bring the loop to the task's condition and F_max (effective at the next block)."""
+        if self.loop is None:
+            return
         source = self.task.source
         if source is not None and source != self._loop_source:
             self.loop.set_source(source)
@@ -142,7 +156,13 @@ class SessionRunner:
         return self._handle(self.task.pad(index))
 
     def tick(self, dt):
-        return self._handle(self.task.tick(dt))
+        return self._handle(self.task.tick(dt, self.bowing))
+
+    def acknowledge_page(self, by):
+        """The current page acknowledged ``by`` the participant or the experimenter ([] on a trial)."""
+        if not hasattr(self.task, "acknowledge"):
+            return []
+        return self._handle(self.task.acknowledge(by))
 
     def set_bowing(self, on):
         on = bool(on)
@@ -159,7 +179,12 @@ class SessionRunner:
             self.log({"type": "gesture", "name": name})
 
     def advance(self, seconds):
-        """Run the loop for ``seconds`` (whole samples), tick the task, and return the loop's block."""
+        """Run the loop for ``seconds`` (whole samples), tick the task, and return the loop's block.
+
+        On a page (no loop) only the page's clock runs, and None is returned."""
+        if self.loop is None:
+            self.tick(seconds)
+            return None
         n = max(1, int(round(seconds * self.loop.rate)))
         block = self.loop.run(n)
         broken = bool(self.loop.monitor.broken)

@@ -8,11 +8,14 @@ seeded by the session seed and the trial's step, so a trial plays the same
 way whether or not the session was interrupted before it.
 
 How it plays a trial is its task type's ``simulate`` (``studyapp.experiment.tasks``:
-the rating and adjustment strategies are described there); this class holds
+the rating and adjustment strategies are described there; a page it
+acknowledges at once, and a headphone level check as the experimenter would,
+so a headless session runs through); this class holds
 the participant's traits (the times and jitters below, and a personal
 criterion of ``criterion_spread`` knob positions drawn once per session) and
 the hand's and ear's common moves: turning a knob as a hand does, measuring a
-condition's noise, listening for breakdown, resting the bow.
+condition's noise, listening for breakdown, listening long enough
+(``min_listen_s``), resting the bow.
 """
 
 import math
@@ -79,6 +82,13 @@ class SimulatedParticipant:
             if self.broken(runner):
                 return True
         return False
+
+    def listen_enough(self, runner):
+        """Bow on until the trial's ``min_listen_s`` is met: a person told to listen longer does so."""
+        short = runner.task.listen_short()
+        if short:
+            runner.set_bowing(True)
+            runner.advance(max(short.values()) + self.reaction_time)
 
     def rest(self, runner):
         """Lift the bow until the string is calm again (at most ``rest_time`` s), then bow again."""

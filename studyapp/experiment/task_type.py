@@ -1,7 +1,9 @@
 """What a task type is: the one interface every task of a study implements.
 
 A study session is a sequence of trials, each of one task type (the paper's
-rating and adjustment tasks, Sec. 8.1-8.2, or any other). Everything the app
+rating and adjustment tasks, Sec. 8.1-8.2, or any other; the pages between
+them are steps of the task type ``page``, which no protocol table names:
+``protocol_table = False``). Everything the app
 knows about a task type goes through ``TaskType``; nothing else in
 ``studyapp.experiment`` or ``studyapp.analysis`` names a task. A task type is
 one module in ``studyapp/experiment/tasks/`` with a module-level ``TASK_TYPE``,
@@ -13,7 +15,10 @@ registered by name in ``studyapp.experiment.tasks``:
 - **schedule**: ``schedule`` turns the spec and the participant's Latin-square
   row into trials;
 - **trial**: ``start`` makes the state machine of one trial (``TrialState``),
-  fed by knob, pad and tick events;
+  fed by knob, pad and tick events (``tick(dt, bowing)``: the time the loop
+  ran and whether the bow was on, which the listening time ``min_listen_s``
+  counts); a task with an empty ``loop_conditions`` (``page``) runs without a
+  loop, silent, and its state also takes ``acknowledge(by)``;
 - **live knobs**: ``knob_actions`` is the mapping the real-time worker applies
   during a trial (a knob acts once, in the worker: studyapp.session);
 - **captions**: ``heading``, ``knob_captions``, ``response_text`` are the text
@@ -78,7 +83,8 @@ class TrialState(Protocol):
 
     def pad(self, index: int) -> list: ...
 
-    def tick(self, dt: float) -> list: ...
+    def tick(self, dt: float, bowing: bool = False) -> list:
+        """``dt`` seconds of loop time passed, with the bow on the string (``bowing``) or lifted."""
 
     def restore(self, earlier: list) -> int:
         """Replay what may safely come back from this trial's ``earlier`` events; return how many."""
@@ -99,7 +105,7 @@ class TaskType(Protocol):
         """``(trials, rows_used)``: trials as ``(trial number, conditions, condition or None)``."""
 
     def loop_conditions(self, trial) -> tuple:
-        """The conditions the trial's loop must hold."""
+        """The conditions the trial's loop must hold (empty: no loop, nothing sounds)."""
 
     def start(self, spec, trial) -> TrialState: ...
 

@@ -6,8 +6,12 @@ to no sound and the on-screen knobs when nothing is found), and the console;
 loads the protocol (``--protocol``, else ``protocols/sinclair2014.toml`` or the
 first protocol in ``protocols/``); fills in the participant; starts the
 session at once with ``--start``; sizes the window (``--size``, already
-parsed into pixels); and runs the event loop. ``--screenshot`` and
-``--measure-scope`` run the console unattended and exit.
+parsed into pixels); and runs the event loop. ``--screenshot``,
+``--participant-screenshot`` and ``--measure-scope`` run the console
+unattended and exit. The participant's window opens with
+``--participant-window``, ``--participant-screen N`` or
+``--participant-screenshot``, full-screen on the chosen (or remembered)
+screen; a screen that does not exist is refused before anything starts.
 """
 
 import signal
@@ -16,6 +20,8 @@ from pathlib import Path
 from PySide6.QtWidgets import QApplication
 
 from studyapp.errors import UserError
+from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.session_info import check_order_row
 from studyapp.gui.setup_panel import find_protocols
 
 DEFAULT_PROTOCOL = "protocols/sinclair2014.toml"
@@ -42,6 +48,9 @@ def build(args):
     from studyapp.gui.console import Console
     from studyapp.session.controller import SessionController
 
+    protocol = getattr(args, "protocol", None) or default_protocol()
+    if protocol is not None and getattr(args, "order_row", None) is not None:
+        check_order_row(load_protocol(protocol), args.order_row)  # refused before any engine starts
     application()
     controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"))
     console = Console(controller)
@@ -54,20 +63,34 @@ def build(args):
     console.setup.results.setText(str(getattr(args, "results", "results")))
     console.setup.resume.setChecked(bool(getattr(args, "resume", False)))
     console.setup.simulated.setChecked(bool(getattr(args, "simulated_participant", False)))
+    console.setup.fill_session_info(**{key: getattr(args, key, None)
+                                       for key in ("experimenter", "session_number", "notes", "order_row")})
     return controller, console
 
 
 def main(args):
     """Run the console until it is closed; returns the exit code."""
+    from studyapp.gui.participant_screen import choose_screen
+
     app = application()
+    screen_choice = getattr(args, "participant_screen", None)
+    shot = getattr(args, "participant_screenshot", None)
+    participant = getattr(args, "participant_window", False) or screen_choice is not None or bool(shot)
+    screen = choose_screen(screen_choice) if participant else None
     controller, console = build(args)
     size = getattr(args, "size", None)
     if size is not None:
         console.resize(*size)
     console.show()
-    if getattr(args, "participant_window", False):
+    if screen is not None:
+        console.participant_window.show_full_screen(screen)
+    if participant:
         console.show_participant.setChecked(True)
-    if getattr(args, "screenshot", None):
+    if shot:
+        from studyapp.gui.participant_screenshot import ParticipantScreenshot
+
+        console.unattended = ParticipantScreenshot(console, shot, wait_for_trial=getattr(args, "start", False))
+    elif getattr(args, "screenshot", None):
         from studyapp.gui.screenshot import Screenshot
 
         console.unattended = Screenshot(console, args.screenshot)
@@ -75,7 +98,7 @@ def main(args):
         from studyapp.gui.scope_benchmark import ScopeBenchmark
 
         console.unattended = ScopeBenchmark(console, args.measure_scope)
-    elif getattr(args, "start", False):
+    if getattr(args, "start", False) and not (getattr(args, "screenshot", None) or getattr(args, "measure_scope", None)):
         _start_when_possible(console, getattr(args, "seed", None))
     # Ctrl-C in the terminal closes the console cleanly (Python sees signals between Qt events)
     signal.signal(signal.SIGINT, lambda *_: console.close())

@@ -1,10 +1,11 @@
 """The experimenter console: one window to set up, run, watch and stop a study session.
 
 Left: session set-up and the apparatus found, and the session's progress
-(task, trial x of y, the current condition, which a tick hides for blinding),
-in a scroll area; below them, always in view, the session's buttons (Start,
-Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live scope with the
-on-screen knobs and pads and the bowing pad; the analysis view
+(task, trial x of y, the page the participant sees with the headphone level
+check's confirm (``PageControls``), the current condition, which a tick hides
+for blinding), in a scroll area; below them, always in view, the session's
+buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
+scope with the on-screen knobs and pads and the bowing pad; the analysis view
 (``AnalysisView``) of a results folder; the session's log. Bottom: the status
 bar (loop rate, load, deadline misses, audio underruns, faults, scope frame
 rate). The two sides share a splitter, and no widget asks for width in
@@ -49,6 +50,7 @@ from studyapp.gui.analysis_view import AnalysisView
 from studyapp.gui.bowing_pad import BowingPad
 from studyapp.gui.gui_thread import GuiThreadCaller
 from studyapp.gui.knobs import KnobPanel
+from studyapp.gui.page_controls import PageControls
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.scope import Scope
 from studyapp.gui.setup_panel import SetupPanel
@@ -118,6 +120,8 @@ class Console(QMainWindow):
         self.pickup_label.setStyleSheet("color: #06c; font-weight: bold;")
         self.pickup_label.setWordWrap(True)
         self.response_label.setWordWrap(True)
+        self.page_controls = PageControls()  # the page the participant sees; the level check's confirm
+        self.page_controls.confirmed.connect(lambda: controller.acknowledge_page("experimenter"))
         self._condition_text = ""
 
         buttons = QHBoxLayout()
@@ -150,6 +154,7 @@ class Console(QMainWindow):
         left = QWidget()
         lv = QVBoxLayout(left)
         lv.addWidget(scroll, 1)
+        lv.addWidget(self.page_controls)  # the level check's confirm stays in view, as the buttons do
         lv.addLayout(buttons)
         lv.addWidget(self.stop_button)
 
@@ -208,9 +213,10 @@ class Console(QMainWindow):
         self.status = StatusBar()
         self.setStatusBar(self.status)
 
-        self.participant_window = ParticipantWindow()
+        self.participant_window = ParticipantWindow(controller)
         self.participant_window.knobs.knob_turned.connect(controller.knob)
         self.participant_window.knobs.pad_pressed.connect(controller.pad)
+        self.participant_window.page_view.continued.connect(lambda: controller.acknowledge_page("participant"))
         self.show_participant = QAction("Participant window", self, checkable=True)
         self.show_participant.toggled.connect(self.participant_window.setVisible)
         analyse = QAction("Analyse the results folder", self)
@@ -233,6 +239,7 @@ class Console(QMainWindow):
         e.message.connect(self._on_message)
         e.response.connect(self._on_response)
         e.pickup.connect(self._on_pickup)
+        e.page.connect(self._on_page)
 
         self.timer = QTimer(self)
         self.timer.setInterval(POLL_PERIOD_MS)
@@ -256,7 +263,8 @@ class Console(QMainWindow):
         try:
             session = self.controller.start_session(
                 self.setup.participant_id, self.setup.results_folder, resume=self.setup.resume.isChecked(),
-                seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"})
+                seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"},
+                details=self.setup.session_info)
         except (UserError, RuntimeError) as exc:
             self.setup.show_error(str(exc))
             return None
@@ -358,16 +366,24 @@ class Console(QMainWindow):
         if state in REST:
             self.task_label.setText("")
             self.knobs.set_captions([])
+            self.page_controls.show_none()
             if state != State.IDLE:
                 self.trial_label.setText(STATE_WORDS[state])
 
-    def _on_trial(self, trial, step, total, instructions):
+    def _on_trial(self, trial, step, total, instructions, phase="trial", number=None, of=None):
         self.task_label.setText("Task: " + task_type(trial.task).heading(trial))
-        self.trial_label.setText(f"Trial {step + 1} of {total}")
+        counted = "" if phase == "page" else f"{'Practice' if phase == 'practice' else 'Trial'} {number} of {of}, "
+        self.trial_label.setText(f"{counted}step {step + 1} of {total}")
         self.progress_bar.setRange(0, total)
         self.progress_bar.setValue(step)
-        self.participant_window.show_trial(step, total, instructions)
+        self.participant_window.show_trial(step, total, instructions, phase, number, of)
+        if phase != "page":
+            self.page_controls.show_none()
         self._blinding(self.blind.isChecked())
+
+    def _on_page(self, kind, title, text, by, step, tone_hz, level_dbfs):
+        self.participant_window.show_page(kind, title, text, by)
+        self.page_controls.show_page(kind, title, by, tone_hz, level_dbfs)
 
     def _on_knob(self, index, value):
         self.knobs.show_knob(index, value)

@@ -1,5 +1,10 @@
 """Session set-up: who, which protocol, where results go, and what apparatus was found.
 
+The session's information (experiment/session_info.py) is asked for here too:
+the experimenter, the session number (0 shows "none"), notes, and the
+Latin-square order row ("auto": from the participant's enrolment). They are
+checked when the session starts; a refusal shows in the panel's error line.
+
 The apparatus lines say what the engine really opened, in words: the device
 (the simulated 1-DOF device unless a driver is configured), the audio output
 (a PortAudio device, a WAV file, or none, and why: the engine's own notice
@@ -22,6 +27,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QPushButton,
+    QSpinBox,
     QVBoxLayout,
     QWidget,
 )
@@ -57,6 +63,19 @@ class SetupPanel(QWidget):
         results_browse.setFixedWidth(28)
         results_browse.setToolTip("choose the results folder")
         results_browse.clicked.connect(self._browse_results)
+        self.experimenter = QLineEdit()
+        self.experimenter.setPlaceholderText("who runs the session")
+        self.session_number = QSpinBox()
+        self.session_number.setRange(0, 999)
+        self.session_number.setSpecialValueText("none")
+        self.notes = QLineEdit()
+        self.notes.setMaxLength(2000)
+        self.notes.setPlaceholderText("notes on this session (optional)")
+        self.order_row = QSpinBox()
+        self.order_row.setRange(-1, 999)
+        self.order_row.setSpecialValueText("auto")
+        self.order_row.setValue(-1)
+        self.order_row.setToolTip("the Latin-square order row, from 0; auto: from the participant's enrolment")
         self.resume = QCheckBox("Resume the participant's unfinished session")
         self.simulated = QCheckBox("Simulated participant plays")
         self.error = QLabel("")
@@ -74,6 +93,14 @@ class SetupPanel(QWidget):
         form.addRow("Participant ID", self.participant)
         form.addRow("Protocol", protocol_row)
         form.addRow("Results", results_row)
+        form.addRow("Experimenter", self.experimenter)
+        numbers = QHBoxLayout()
+        numbers.addWidget(self.session_number)
+        numbers.addWidget(QLabel("Order row"))
+        numbers.addWidget(self.order_row)
+        numbers.addStretch(1)
+        form.addRow("Session no.", numbers)
+        form.addRow("Notes", self.notes)
         form.addRow(self.resume)
         form.addRow(self.simulated)
         form.addRow(self.error)
@@ -109,6 +136,20 @@ class SetupPanel(QWidget):
     def results_folder(self):
         return self.results.text().strip() or "results"
 
+    @property
+    def session_info(self):
+        """The session's information as ``Session.create`` takes it (None: not given)."""
+        number, row = self.session_number.value(), self.order_row.value()
+        return {"experimenter": self.experimenter.text().strip() or None, "session_number": number or None,
+                "notes": self.notes.text().strip(), "order_row": None if row < 0 else row}
+
+    def fill_session_info(self, experimenter=None, session_number=None, notes=None, order_row=None):
+        """Show what the command line gave (checked already)."""
+        self.experimenter.setText(experimenter or "")
+        self.session_number.setValue(int(session_number) if session_number not in (None, "") else 0)
+        self.notes.setText(notes or "")
+        self.order_row.setValue(int(order_row) if order_row not in (None, "") else -1)
+
     def select_protocol(self, path):
         """Show ``path`` as the chosen protocol (adding it to the list)."""
         index = self.protocol.findText(str(path))
@@ -129,7 +170,8 @@ class SetupPanel(QWidget):
             self.results.setText(folder)
 
     def set_editable(self, on):
-        for widget in (self.participant, self.protocol, self.results, self.resume, self.simulated):
+        for widget in (self.participant, self.protocol, self.results, self.resume, self.simulated, self.experimenter,
+                       self.session_number, self.notes, self.order_row):
             widget.setEnabled(on)
 
     def show_error(self, text):

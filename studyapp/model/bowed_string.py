@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from studyapp.model import bow_table
+from studyapp.model import bow_table, calibration
 
 # parameter vector layout
 P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET = range(6)
@@ -58,7 +58,7 @@ class StringDesign:
 
     rate: float
     f0: float
-    beta: float = 0.127236  # STK Bowed betaRatio_
+    beta: float = calibration.BOW_POSITION  # STK's Bowed has 0.127236; calibration.py says why not here
     slope: float = 3.0  # STK BowTable slope (bow pressure)
     offset: float = 0.0
     loss: float = 0.95  # STK stringFilter_ gain: the round trip's DC gain

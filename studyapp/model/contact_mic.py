@@ -12,11 +12,12 @@ if a contact microphone sat on the handle:
 with a_handle the handle's acceleration (m/s^2: the simulation's true one, or
 a real device's accelerometer), through the body's 60 Hz high-pass (no sound at
 DC, strokes and tremor inaudible). GAIN converts m/s^2 to the audio's units
-(the body filter's output, body.py): it is set so that the stick-slip ripple
-of healthy bowing stays well below the string's own sound in the 100-400 Hz
-band (the string still sounds like a string) while the buzz of a broken loop,
-saturated at +-F_max, rises above it (docs/model.md, "Hearing breakdown",
-measures both).
+(the body filter's output, body.py): with the string above the 100-400 Hz band
+(calibration.py), the band holds this channel, and GAIN is set so that the
+stick-slip ripple of healthy bowing stays well below the string's own sound
+(the string still sounds like a string) while the buzz of a broken loop,
+saturated at +-F_max, rises at least 10 dB above the ripple in the band
+(docs/model.md, "Hearing breakdown", measures both).
 """
 
 import numpy as np
@@ -24,10 +25,11 @@ from numba import njit
 
 from studyapp.estimators.biquad import butter_section
 from studyapp.estimators.spec import NYQUIST_FRACTION
+from studyapp.model.calibration import CONTACT_MIC_GAIN
 from studyapp.model.sensors import section_at
 
 HIGHPASS_HZ = 60.0
-GAIN = 2e-3  # audio units per m/s^2
+GAIN = CONTACT_MIC_GAIN  # audio units per m/s^2 (calibration.py gives the reason)
 
 
 def params(rate, gain=GAIN):

@@ -8,18 +8,21 @@ What breakdown is in this model. While the bow sticks, the string pushes on
 the handle through the junction (F = -G rho(v_delta) v_delta, with rho at its
 0.98 clip), and the string beyond the bow is a resonator: with the sticking
 bow as its fixed end, the nut-side segment rings at about f0 / (1 - beta)
-(168 Hz for the default 147 Hz string). A velocity source that lags the
-handle's true velocity turns this coupling from a brake into a drive, and past
-a gain the loop oscillates by itself: the force swings between +F_max and
--F_max at that frequency, the handle buzzes (mm/s) and the string
-near the bow rings with it (the sound distorts; the handle's buzz is heard
-too, control.py).
+(587 Hz for the default 440 Hz string bowed at beta = 0.25), and below that
+the stuck string is stiff. A velocity source that lags the handle's true
+velocity turns this coupling from a brake into a drive, and past a gain the
+loop oscillates by itself: the force swings between +F_max and -F_max, the
+handle buzzes (mm/s) and the string near the bow rings with it (the sound
+distorts; the handle's buzz is heard too, contact_mic.py). With TRUE it is
+the loop mode; with the tachometer and the estimators the handle bouncing on
+the stuck string comes first, at 30-130 Hz (docs/model.md).
 
 Criterion, on absolute quantities (pinned by tests/model/test_model_stability.py).
 The monitor watches the handle's velocity v (m/s: the simulation's true
-velocity, or a real device's tachometer), high-passed at f0 / 2 (73 Hz for the
+velocity, or a real device's tachometer), high-passed at f0 / 2 (220 Hz for the
 default string) so that strokes, their reversals and tremor do not count,
-while the loop mode, above f0, does:
+while the loop mode, above f0, does, and so do the harmonics of the lower
+bounce (saturated at +-F_max, it is nearly a square wave):
 
     level = RMS of v over the last WINDOW = 0.25 s                 (``score``, m/s)
     e(t)  = RMS of v over the last ENVELOPE = 12 ms (about one oscillation period)
@@ -27,18 +30,19 @@ while the loop mode, above f0, does:
     broken  = level > VIBRATION_MIN = 1 mm/s  and  cv < CV_MAX = 0.15
 
 A self-sustained oscillation is large and steady: the force saturates at
-+-F_max, so the handle's buzz is about F_max / (m w) (3 mm/s at 5 N on the
-1 kg of handle and hand) with an envelope that hardly moves (cv 0.01-0.1).
++-F_max, so the handle's buzz is of order F_max / (m w) (mm/s at a few newtons
+on the 1 kg of handle and hand) with an envelope that hardly moves (cv 0.01-0.1).
 What it must not be confused with: estimator noise, whose force is random and
 whose envelope fluctuates like a Rayleigh variable (cv 0.2-0.35) even when
 large; bowing, whose stick-slip ripple changes with every stroke; and, above
 all, anything at a low gain. An earlier criterion on F / F_max read estimator
 noise the same at every gain and flagged LEVANT and KALMAN "broken" at
 0.001 N on some seeds; in metres per second, a handle pushed by millinewtons
-cannot reach VIBRATION_MIN. VIBRATION_MIN sits 25 times above the held
-handle's band-passed velocity at low gain (0.04 mm/s: the tremor's leak
-through the high-pass) and below the buzz of the breakdowns (LOWPASS: 3 mm/s
-at 5 N; docs/breakdown.md). An oscillation that starts is itself
+cannot reach VIBRATION_MIN. VIBRATION_MIN sits far above the held handle's
+band-passed velocity at low gain (0.001 mm/s with the 440 Hz string, 0.04 mm/s
+with the former 147 Hz one: the tremor's leak through the high-pass) and below
+the buzz of the breakdowns (LOWPASS 1.9 mm/s at 9.8 N, LVT 3.2 mm/s at 13.3 N;
+scripts/model_figures.py prints them). An oscillation that starts is itself
 an envelope change: cv falls below CV_MAX some tenths of a second after the
 onset, so the verdict lags the onset by about that long (a participant also
 needs a moment).

@@ -52,9 +52,38 @@ Trial health. The engine's counters (``deadline_misses``, ``audio_underruns``,
 logged as a ``trial_health`` record (``underruns`` for the audio underruns),
 which export carries as columns.
 
+Audio kept with the data. Each time a session's engine comes up
+(``_log_engine``) the controller asks it to record what the participant hears
+into the session folder (``RecordAudio``: audio.wav, then audio-2.wav, ... for
+a restarted engine or a resumed session; the worker picks the free name), and
+stops it when the session ends. Each trial's start (right after its knob
+mapping, so at the same block boundary) and end is sent as an ``AudioCue``:
+the worker writes it to audio_cues.csv at its own audio frame counter
+(engine/audio_recorder.py), so no sample position crosses the process
+boundary.
+
 Engines. A protocol gets a *preview* engine with every condition it names.
 Starting a session starts a fresh engine seeded with the session's seed; once
 the session ends it stays as the preview engine.
+
+Pages. A page step (welcome, instructions, a break, the headphone level
+check, ...: ``studyapp.experiment.pages``) holds the loop silent: F_max 0,
+the bow lifted, an empty knob mapping tagged with the step's own number, so
+the confirm pad still reaches the page (as a pad press the worker reports
+back). Each step is announced by the ``trial`` event with its ``phase``
+(``page``, ``practice`` or ``trial``) and its ``number`` ``of`` the steps of
+that phase (of its task, for trials: "Practice 1 of 2", "Trial 2 of 12");
+a page also by the ``page`` event (``kind``, ``title``, ``text`` in
+Markdown, ``by``: who acknowledges it, ``step``, ``tone_hz``,
+``level_dbfs``). ``acknowledge_page(by)`` is the participant's Continue
+button or the experimenter's confirm. A calibration
+page sends ``ReferenceTone(tone_hz, level_dbfs)`` when it starts and
+``ReferenceTone(level_dbfs=None)`` when it ends (acknowledged, paused,
+stopped, or the session ended); its acknowledgement is logged with the tone,
+the level and who confirmed it. A refused confirm (a pad press the task
+does not accept yet) is a console message and a ``refused`` event with the
+reason, which the participant window shows (reasons name knobs, never
+conditions).
 
 Pause holds the loop (F_max 0, bow lifted, no knob mapping), stops the task's
 clock and ignores the participant's controls; resume gives the settings back.
@@ -79,7 +108,9 @@ from studyapp.engine.events import Learned
 from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
 from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.schedule import counted
 from studyapp.experiment.session import Session, check_participant
+from studyapp.experiment.session_info import order_text
 from studyapp.experiment.session_runner import SessionRunner
 from studyapp.experiment.tasks import task_type
 from studyapp.session.engine_host import EngineHost
@@ -87,7 +118,11 @@ from studyapp.session.engine_loop import EngineLoop
 from studyapp.session.evented import EventGroup
 from studyapp.session.knob_latency import KnobLatency
 
+AUDIO_FILE = "audio.wav"  # what the participant heard, in the session folder (audio-2.wav, ... per engine run)
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
+# s a page shows before the participant can end it: the second press of a double press on a trial's
+# confirm pad would otherwise end the page that follows it unread (logged, not announced)
+PAGE_SETTLE_S = 0.5
 GESTURES = ("strokes", "hold", "live")
 # the engine's fault counters a trial_health record logs, and their names there
 HEALTH = {"deadline_misses": "deadline_misses", "audio_underruns": "underruns", "faults": "faults",
@@ -152,7 +187,8 @@ def scene_conditions(protocol):
 
 
 def instructions_for(protocol, task):
-    return protocol.task(task).instructions.strip()
+    """A task's instructions (none for a page: its text is the ``page`` event's)."""
+    return protocol.task(task).instructions.strip() if task in protocol.specs else ""
 
 
 def trial_actions(trial, task):
@@ -176,7 +212,7 @@ class SessionController:
         self.clock = clock
         self.make_host = make_host
         self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing", "gesture",
-                                 "telemetry", "status", "message", "response", "pickup")
+                                 "telemetry", "status", "message", "response", "pickup", "page", "refused")
         self.protocol = None
         self.host = None
         self.session = None
@@ -192,6 +228,8 @@ class SessionController:
         self._next_status = 0.0
         self._pickup = {}  # control -> messages ignored while it waits for pickup
         self._health = None  # the engine and its counters when the current trial started
+        self._page_shown = 0.0  # self.clock() when the current page appeared
+        self._tone = False  # a calibration page's reference tone is playing
 
     # the state machine ----------------------------------------------------------
     def fire(self, event):
@@ -260,8 +298,11 @@ class SessionController:
                 engine.send(command)
 
     # session: the experimenter's buttons ---------------------------------------------
-    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None):
-        """Open the participant's session (``UserError`` when refused) and start its engine."""
+    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None):
+        """Open the participant's session (``UserError`` when refused) and start its engine.
+
+        ``details``: ``experimenter``, ``session_number``, ``notes``, ``order_row`` (experiment/session_info.py).
+        """
         if self.protocol is None:
             raise UserError("no protocol loaded: choose one first")
         if self.in_session:
@@ -270,10 +311,11 @@ class SessionController:
             raise UserError("the emergency stop is set: clear it (Resume) before starting a session")
         check_participant(participant)
         if resume:
-            session = Session.resume(self.protocol, participant, results, seed=seed)
+            session = Session.resume(self.protocol, participant, results, seed=seed, **(details or {}))
         else:
             described = {"device": self.device or "simulated", "engine": "real-time", **(apparatus or {})}
-            session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described)
+            session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
+                                     **(details or {}))
         self.session = session
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
@@ -308,7 +350,7 @@ class SessionController:
         self.runner = None
         self._replace_host(self._engine_config(self.session.seed, {}), f"session {self.session.folder}")
         self.message(f"session {self.session.folder}: {len(self.session.finished_steps())} of "
-                     f"{len(self.session.schedule)} trials done; starting the engine")
+                     f"{len(self.session.schedule)} trials done, {order_text(self.session.info)}; starting the engine")
         return State.STARTING
 
     def _begin(self):
@@ -336,14 +378,22 @@ class SessionController:
         return State.ABORTED
 
     def _pause(self):
-        self.runner.loop.hold(True)
+        self._hold(True)
         self.runner.log({"type": "pause"})
         return State.PAUSED
 
     def _resume(self):
         self.runner.log({"type": "resume"})
-        self.runner.loop.hold(False)
+        self._hold(False)
         return State.RUNNING
+
+    def _hold(self, on):
+        """Hold the current step (pause), or give it back: a trial's loop, or a page's silence and tone."""
+        if self.runner.loop is not None:
+            self.runner.loop.hold(on)
+            return
+        self._send(cmd.InstallActions({}, trial=-self.trial_serial if on else self.trial_serial))
+        self._reference_tone(not on)
 
     def _finish(self):
         return self._end(State.FINISHED)
@@ -355,6 +405,7 @@ class SessionController:
         return self._end(State.ABORTED)
 
     def _end(self, how):
+        self._reference_tone(False)
         self._log_latency()
         self._log_health()
         self._forget_pickups()
@@ -365,6 +416,7 @@ class SessionController:
         self.runner = None
         self.rest = how
         self.events.bowing.emit(on=False)
+        self._send(cmd.RecordAudio(None))
         if self.state == State.EMERGENCY:
             return State.EMERGENCY  # the session is over, the stop still holds until cleared
         self._send(cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.InstallActions(self._preview_actions()))
@@ -399,6 +451,7 @@ class SessionController:
         engine = self.engine
         if engine is not None:
             engine.status_block.disable_force("operator")
+        self._reference_tone(False)
         loop = self.runner.loop if self.runner is not None else None
         if loop is not None and engine is not None and loop.engine is engine:
             loop.hold(True)
@@ -454,14 +507,23 @@ class SessionController:
                          "note": "one real-time engine per session: its seed, not the trials' loop_seed, "
                                  "seeds the sensor noise"})
         self.fed = self.host.position
+        self._send(cmd.RecordAudio(str(self.session.folder / AUDIO_FILE)))  # one file per engine run
 
     def _make_loop(self, estimators, source, seed):
         self.trial_serial += 1
         task = self.runner.task
         actions = trial_actions(self.runner.trial, task)
         positions = {f"knob{i + 1}": int(v) for i, v in task.knob_positions().items() if v is not None}
-        return EngineLoop(self.host.engine, estimators, source, self.protocol.gesture, self.trial_serial, actions,
+        loop = EngineLoop(self.host.engine, estimators, source, self.protocol.gesture, self.trial_serial, actions,
                           positions)
+        self._cue_audio("start")  # at the block where the trial's mapping takes force
+        return loop
+
+    def _cue_audio(self, event):
+        """A row of the session's audio_cues.csv: the current trial starts or ends (engine/audio_recorder.py)."""
+        trial = self.runner.trial if self.runner is not None else None
+        if trial is not None:
+            self._send(cmd.AudioCue(trial.step, trial.task, trial.trial, event))
 
     def _counters(self):
         """The session engine and its fault counters now (None without a running engine)."""
@@ -476,6 +538,7 @@ class SessionController:
         started, self._health = self._health, None
         if started is None or self.runner is None or self.runner.trial is None:
             return
+        self._cue_audio("end")
         engine, before = started
         try:
             now = engine.status()
@@ -494,6 +557,7 @@ class SessionController:
 
         Returns ``state``, or FINISHED when no trial is left. Outside RUNNING the new trial is held.
         """
+        self._reference_tone(False)
         self._log_latency()
         self._log_health()
         self._forget_pickups()
@@ -501,18 +565,46 @@ class SessionController:
         if trial is None:
             return self._end(State.FINISHED)
         self._health = self._counters()
+        if trial.page is not None:
+            self._show_page(trial.page)
         if state != State.RUNNING:
-            self.runner.loop.hold(True)
+            self._hold(True)
         task = self.runner.task
         values = task.knob_positions()
         for index in range(self.protocol.knobs):
             self.events.knob.emit(index=index, value=int(values.get(index, 0)))
+        phase, number, of = counted(self.session.schedule, trial)
         self.events.trial.emit(trial=trial, step=trial.step, total=len(self.session.schedule),
-                               instructions=instructions_for(self.protocol, trial.task))
+                               instructions=instructions_for(self.protocol, trial.task), phase=phase,
+                               number=number, of=of)
+        if trial.page is not None:
+            page = trial.page
+            self.events.page.emit(kind=page.kind, title=page.title, text=page.text, by=page.by, step=trial.step,
+                                  tone_hz=page.tone_hz, level_dbfs=page.level_dbfs)
         self._announce_selection()
         self.events.gesture.emit(name=self.runner.gesture)
         self.events.bowing.emit(on=self.runner.bowing)
         return state
+
+    def _show_page(self, page):
+        """A page holds the loop silent under its own step number; a calibration page plays its tone."""
+        self._page_shown = self.clock()
+        self.trial_serial += 1
+        self._send(cmd.SetFmax(0.0), cmd.SetBowing(False),
+                   cmd.InstallActions({}, trial=self.trial_serial))
+        self._cue_audio("start")  # a page's span in audio_cues.csv too (the level check's tone is recorded)
+        self._reference_tone(page.kind == "calibration")
+
+    def _reference_tone(self, on):
+        """Start the current calibration page's reference tone (True), or end a playing one (False)."""
+        trial = self.runner.trial if self.runner is not None else None
+        page = trial.page if trial is not None else None
+        if on and page is not None and page.kind == "calibration" and not self._tone:
+            self._send(cmd.ReferenceTone(page.tone_hz, page.level_dbfs))
+            self._tone = True
+        elif not on and self._tone:
+            self._send(cmd.ReferenceTone(level_dbfs=None))
+            self._tone = False
 
     def _after_task_event(self):
         """A response ends the trial: the next one starts at once (or the session ends)."""
@@ -545,6 +637,28 @@ class SessionController:
             self.engine.send(cmd.Control(f"pad{index + 1}", 1.0))
             self.controls_sent += 1
 
+    def acknowledge_page(self, by="participant"):
+        """The current page acknowledged: the participant's Continue button, or the experimenter's
+        confirm (the only one a calibration page takes). Nothing happens outside a running page."""
+        runner = self.runner
+        if self.playing and runner.trial is not None and runner.trial.page is not None:
+            if by == "participant" and self._page_settling("continue"):
+                return
+            self._task_records(runner.acknowledge_page(by))
+
+    def page_age(self):
+        """Seconds since the current page appeared."""
+        return self.clock() - self._page_shown
+
+    def _page_settling(self, control):
+        """True (and logged) for the participant's press on a page shown less than PAGE_SETTLE_S ago."""
+        since = self.page_age()
+        if since >= PAGE_SETTLE_S:
+            return False
+        self.runner.log({"type": "acknowledge", "by": "participant", "control": control, "accepted": False,
+                         "reason": f"pressed {since:.2f} s after the page appeared: taken as a double press"})
+        return True
+
     def _control(self, record):
         """A control the worker took (``events.Applied``): show it; the current trial's go to the runner."""
         if isinstance(record, Learned):
@@ -559,7 +673,7 @@ class SessionController:
                 self.controls_taken += 1
 
     def _take_control(self, record, knob, pad):
-        ours = self.runner is not None and self.runner.loop is not None and record.trial == self.trial_serial
+        ours = self.runner is not None and self.runner.task is not None and record.trial == self.trial_serial
         live = record.trial == 0 and self.state in REST
         if not (ours or live):
             return  # a held trial's, a stale trial's, or the preview's while a session starts
@@ -571,10 +685,13 @@ class SessionController:
             self.events.knob.emit(index=knob, value=round(record.value * 127))
         if not ours:
             return
-        self.runner.loop.applied(record.commands)
+        if self.runner.loop is not None:
+            self.runner.loop.applied(record.commands)
         if knob is not None:
             self._task_records(self.runner.knob(knob, round(record.value * 127)))
         elif pad is not None and record.value > 0:
+            if self.runner.trial.page is not None and self._page_settling(record.control):
+                return
             self._task_records(self.runner.pad(pad))
 
     def _picked_up(self, record, knob, ours):
@@ -603,8 +720,9 @@ class SessionController:
 
     def _task_records(self, records):
         for record in records:
-            if record.get("type") == "pad" and record.get("accepted") is False:
+            if record.get("accepted") is False:
                 self.message(f"confirm refused: {record['reason']}")
+                self.events.refused.emit(reason=record["reason"])
             if record.get("type") == "response":
                 self.events.response.emit(response=record, step=self.runner.trial.step)
         self._announce_selection()
@@ -621,7 +739,8 @@ class SessionController:
         if not self.accepting:
             return
         if self.playing:
-            self.runner.set_bowing(on)
+            self.runner.set_bowing(on)  # on a page (no loop) the bow stays lifted
+            on = self.runner.bowing
         else:
             self.engine.send(cmd.SetBowing(bool(on)))
         self.events.bowing.emit(on=bool(on))
@@ -655,7 +774,7 @@ class SessionController:
 
     def _hand_target(self, x_m):
         if self.playing:
-            if self.runner.gesture == "live":
+            if self.runner.gesture == "live" and self.runner.loop is not None:
                 self.runner.loop.set_hand_target(x_m)
         else:
             self.engine.send(cmd.SetHandTarget(float(x_m)))

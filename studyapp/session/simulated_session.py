@@ -6,7 +6,9 @@ In a console it runs on its own thread against ``ParticipantProxy``, which acts
 out every call on the GUI thread (``act`` runs a function there and waits for
 it) through the console's widgets: ``knob`` turns the on-screen knob, ``pad``
 clicks the on-screen pad, ``set_bowing`` toggles the Bow button and
-``set_gesture`` picks the hand's gesture, just as a mouse would. A knob or
+``set_gesture`` picks the hand's gesture, and ``acknowledge_page`` presses a
+page's Continue (or, for the headphone level check, the experimenter's
+confirm), just as a mouse would. A knob or
 pad goes to the engine's worker, which applies its action and reports it
 back; ``knob`` and ``pad`` return once the controller has taken that report
 (as the runner's own methods return once the task has the event). The study logic stays in the runner, reached through the
@@ -27,6 +29,7 @@ import time
 import numpy as np
 
 from studyapp.experiment.simulated_participant import SimulatedParticipant
+from studyapp.session.controller import PAGE_SETTLE_S
 
 WAIT_STEP = 0.004  # s between looks at the controller's progress
 ACTIVE = ("starting", "running", "paused", "emergency", "clearing", "engine_lost", "restarting")
@@ -112,6 +115,13 @@ class ParticipantProxy:
     def set_gesture(self, name):
         self._wait_running()
         self.act(lambda: self.controls.set_gesture(name))
+
+    def acknowledge_page(self, by):
+        self._wait_running()
+        while by == "participant" and self.controller.page_age() < PAGE_SETTLE_S:  # a reader is not that quick
+            self._check()
+            time.sleep(WAIT_STEP)
+        self.act(lambda: self.controller.acknowledge_page(by))
 
     def advance(self, seconds):
         n = max(1, int(round(seconds * self.loop.rate)))

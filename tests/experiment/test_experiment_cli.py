@@ -129,6 +129,8 @@ def test_sigkill_mid_task_then_resume_loses_and_repeats_nothing(tmp_path):
     assert export.returncode == 0, err
     frame = pd.read_csv(csv)
     assert list(frame.columns) == COLUMNS
+    assert frame.practice.sum() == 1  # the demo's one adjustment practice trial
+    frame = frame[~frame.practice]
     assert len(frame) == 3 + 3 * 3
     assert not frame.duplicated(["participant", "task", "condition", "trial"]).any()
     assert sorted(frame[frame.task == "adjustment"].trial.unique()) == [1, 2, 3]

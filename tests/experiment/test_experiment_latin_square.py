@@ -48,9 +48,13 @@ def test_participants_cycle_through_rows():
 
 def test_schedule_of_the_paper_study():
     protocol = load_protocol(ROOT / "protocols" / "sinclair2014.toml")
-    trials, squares = build_schedule(protocol, participant_index=4)
+    steps, squares = build_schedule(protocol, participant_index=4)
+    assert [t.step for t in steps] == list(range(len(steps)))
+    # the paper's procedure around them: pages, and 1 rating and 2 adjustment practice trials
+    assert [t.task for t in steps if t.practice] == ["rating", "adjustment", "adjustment"]
+    assert [t.page.kind for t in steps if t.page][:3] == ["welcome", "calibration", "instructions"]
+    trials = [t for t in steps if t.phase == "trial"]
     assert len(trials) == 1 + 9 * 6
-    assert [t.step for t in trials] == list(range(len(trials)))
     rating = trials[0]
     assert rating.task == "rating" and sorted(rating.conditions) == sorted(protocol.task("rating").conditions)
     adjustment = trials[1:]
@@ -62,5 +66,5 @@ def test_schedule_of_the_paper_study():
     assert squares["rating"]["rows"] == 8 and squares["adjustment"]["rows"] == 18
     assert squares["adjustment"]["rows_used"] == [4, 5, 6, 7, 8, 9]
     other, _ = build_schedule(protocol, participant_index=5)
-    assert other[0].conditions != rating.conditions
+    assert next(t for t in other if t.phase == "trial").conditions != rating.conditions
     assert Trial.from_dict(adjustment[3].to_dict()) == adjustment[3]

@@ -22,15 +22,15 @@ from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import LogWriteError, SessionLog, read_log
 from studyapp.experiment.session_runner import closed_loop_factory
+from tests.experiment.demo_protocol import trials_only_demo
 from tests.experiment.experiment_fake_loop import run_simulated
 
 ROOT = Path(__file__).resolve().parents[2]
-DEMO = ROOT / "protocols" / "demo.toml"
 
 
 @pytest.fixture
-def protocol():
-    return load_protocol(DEMO)
+def protocol(tmp_path):
+    return load_protocol(trials_only_demo(tmp_path))
 
 
 def two_trials(results, protocol, participant="D01"):
@@ -138,7 +138,7 @@ def test_a_damaged_session_json_is_rebuilt_from_the_log_on_resume(tmp_path, prot
     events_file = folder / "events.jsonl"
     events_file.write_bytes(events_file.read_bytes() + b'{"seq":93,"ty')  # and a torn last line
     (folder / "session.json").write_text((folder / "session.json").read_text()[:100])  # truncated
-    code = main(["run", "--protocol", str(DEMO), "--participant", "D01", "--resume", "--headless",
+    code = main(["run", "--protocol", protocol.path, "--participant", "D01", "--resume", "--headless",
                  "--simulated-participant", "--results", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 0, err
@@ -170,7 +170,7 @@ def test_an_unreadable_session_is_refused_in_one_line_and_skipped_by_export(tmp_
     lines = (bad / "events.jsonl").read_bytes().split(b"\n")
     (bad / "events.jsonl").write_bytes(b"\n".join(lines[1:]))
     (bad / "session.json").write_bytes(b"\x00" * 10)
-    code = main(["run", "--protocol", str(DEMO), "--participant", "D02", "--resume", "--headless",
+    code = main(["run", "--protocol", protocol.path, "--participant", "D02", "--resume", "--headless",
                  "--simulated-participant", "--results", str(tmp_path)])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and "Traceback" not in err
@@ -227,7 +227,7 @@ def _limit_file_size(limit):
 def test_a_full_disk_stops_the_run_in_one_line_and_resume_continues(tmp_path, protocol):
     warm_numba_cache(protocol)
     results = tmp_path / "results"
-    argv = [sys.executable, "-m", "studyapp", "run", "--protocol", str(DEMO), "--participant", "F01",
+    argv = [sys.executable, "-m", "studyapp", "run", "--protocol", protocol.path, "--participant", "F01",
             "--headless", "--simulated-participant", "--results", str(results), "--seed", "3"]
     run = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=120,
                          preexec_fn=_limit_file_size(16_000))

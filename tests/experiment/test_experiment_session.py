@@ -16,16 +16,16 @@ from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import SessionLog, read_events
 from studyapp.experiment.session_runner import SessionRunner
+from tests.experiment.demo_protocol import trials_only_demo
 from tests.experiment.experiment_fake_loop import NOISE, THRESHOLD, factory, run_simulated
 
 ROOT = Path(__file__).resolve().parents[2]
-DEMO = ROOT / "protocols" / "demo.toml"
 CONTRACT = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash"]
 
 
 @pytest.fixture
-def protocol():
-    return load_protocol(DEMO)
+def protocol(tmp_path):
+    return load_protocol(trials_only_demo(tmp_path))
 
 
 def test_log_stamps_appends_and_repairs_a_torn_tail(tmp_path):
@@ -52,8 +52,8 @@ def test_create_writes_the_session_description(tmp_path, protocol):
     folder = session.folder
     assert folder.parent == tmp_path / "demo" / "P01"
     info = json.loads((folder / "session.json").read_text())
-    assert info["protocol"]["sha256"] == hashlib.sha256(DEMO.read_bytes()).hexdigest()
-    assert info["protocol"]["text"] == DEMO.read_text()
+    assert info["protocol"]["sha256"] == hashlib.sha256(Path(protocol.path).read_bytes()).hexdigest()
+    assert info["protocol"]["text"] == Path(protocol.path).read_text()
     assert info["seed"] == 5 and info["participant_index"] == 0 and info["participant"] == "P01"
     assert info["app_version"] and info["apparatus"]["rate"] == 5000.0 and info["apparatus"]["device"] == "simulated"
     assert len(info["schedule"]) == 4 and info["schedule"][0]["task"] == "rating"
@@ -73,7 +73,7 @@ def test_existing_participant_is_refused_and_resume_is_checked(tmp_path, protoco
     with pytest.raises(UserError, match="--seed 3"):
         Session.resume(protocol, "P01", tmp_path, seed=3)
     changed = tmp_path / "changed.toml"
-    changed.write_bytes(DEMO.read_bytes() + b"\n# edited\n")
+    changed.write_bytes(Path(protocol.path).read_bytes() + b"\n# edited\n")
     with pytest.raises(UserError, match="differs from the protocol of session"):
         Session.resume(load_protocol(changed), "P01", tmp_path)
     with pytest.raises(UserError, match="participant ID"):
@@ -173,7 +173,7 @@ def test_export_columns_and_content(tmp_path, protocol):
         assert rows.rating.min() == 0.0 and rows.rating.max() == 1.0
         assert sorted(rows.condition) == ["LEVANT", "LOWPASS", "LVT"]
     assert adjustment.rating.isna().all() and (adjustment.fmax > 0).all() and (adjustment.trial == 1).all()
-    assert (frame.protocol_hash == hashlib.sha256(DEMO.read_bytes()).hexdigest()).all()
+    assert (frame.protocol_hash == hashlib.sha256(Path(protocol.path).read_bytes()).hexdigest()).all()
     assert pd.to_datetime(frame.time, format="ISO8601").notna().all()
     out = tmp_path / "responses.csv"
     write_responses(tmp_path, out)
@@ -207,7 +207,7 @@ def test_export_carries_each_trials_engine_health_and_leaves_it_empty_headless(t
     headless.close()
     frame = export_responses(tmp_path)
     columns = ["deadline_misses", "underruns", "faults", "events_dropped"]
-    assert columns == COLUMNS[-4:]
+    assert columns == COLUMNS[COLUMNS.index("deadline_misses"):][:4]
     logged = frame[frame.participant == "H01"].set_index(["step", "knob"])[columns]
     assert logged.loc[0].to_numpy().tolist() == [[2, 1, 0, 4]] * 3  # the rating: one row per condition
     assert logged.loc[3].to_numpy().tolist() == [[6, 3, 0, 12]]

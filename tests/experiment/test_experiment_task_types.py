@@ -18,11 +18,12 @@ from studyapp.experiment.protocol import load_protocol, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
 from studyapp.experiment.session_log import read_events
 from studyapp.experiment.task_type import TaskType, TrialState
-from studyapp.experiment.tasks import task_names, task_type
+from studyapp.experiment.tasks import protocol_task_names, task_names, task_type
 from studyapp.experiment.tasks.adjustment import AdjustmentTrial
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial
 from studyapp.experiment.tasks.listen import ListenTrial
 from studyapp.experiment.tasks.rating import RatingTrial
+from tests.experiment.demo_protocol import trials_only
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "protocols" / "demo.toml"
@@ -38,7 +39,7 @@ instructions = "Bow the string and listen."
 
 def protocol_text(tasks):
     """The demo protocol with a listen table added, running ``tasks``."""
-    text = DEMO.read_text().replace('tasks = ["rating", "adjustment"]', f"tasks = {json.dumps(tasks)}") + LISTEN
+    text = trials_only(DEMO.read_text()).replace('tasks = ["rating", "adjustment"]', f"tasks = {json.dumps(tasks)}") + LISTEN
     if "adjustment" not in tasks:
         text = text[: text.index("[adjustment]")] + text[text.index("[listen]"):]
     return text
@@ -47,16 +48,17 @@ def protocol_text(tasks):
 def test_every_module_in_the_package_is_registered_and_implements_the_protocol():
     modules = {m.name for m in pkgutil.iter_modules(tasks.__path__)
                if hasattr(importlib.import_module(f"{tasks.__name__}.{m.name}"), "TASK_TYPE")}
-    assert modules == set(task_names()) == {"rating", "adjustment", "listen"}
+    assert modules == set(task_names()) == {"rating", "adjustment", "listen", "page"}
+    assert protocol_task_names() == ("rating", "adjustment", "listen")  # a page is no protocol table
     protocol = parse_protocol(protocol_text(["listen", "rating", "adjustment"]), "three.toml")
-    for name in task_names():
+    for name in protocol_task_names():
         kind = task_type(name)
         assert isinstance(kind, TaskType) and kind.name == name
         trials, _ = kind.schedule(protocol.task(name), [list(protocol.task(name).conditions)], 0)
         number, conditions, condition = trials[0]
         state = kind.start(protocol.task(name), Trial(0, name, number, tuple(conditions), condition))
         assert isinstance(state, TrialState) and state.task == name and not state.done
-    with pytest.raises(ValueError, match="task 'nope': allowed is one of rating, adjustment, listen"):
+    with pytest.raises(ValueError, match="task 'nope': allowed is one of rating, adjustment, listen, page"):
         task_type("nope")
 
 

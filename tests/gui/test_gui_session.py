@@ -61,7 +61,7 @@ def test_simulated_participant_plays_the_demo_through_the_console(idle_console, 
     # every logged knob turn and pad press came through the on-screen controls
     assert knob_events and len(knob_events) == len(turned)
     assert [(e["index"], e["value"]) for e in knob_events] == turned
-    assert len(pad_events) == len(pressed) == 4
+    assert len(pad_events) == len(pressed) == 5  # rating, the practice trial, 3 adjustment trials (pages: Continue)
     assert any(e["type"] == "gesture" and e["name"] == "hold" for e in events)  # picked in the console's combo
     # the participant's window never named a condition
     assert seen and all(name not in text for text in seen for name in conditions)
@@ -108,8 +108,8 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     console.setup.results.setText(str(results))
     qtbot.mouseClick(console.start_button, Qt.MouseButton.LeftButton)
     wait_until(qapp, lambda: c.playing, ENGINE_START)
-    assert console.trial_label.text() == "Trial 1 of 2"
-    assert console.participant_window.progress.text() == "Trial 1 of 2"
+    assert console.trial_label.text() == "Trial 1 of 1, step 1 of 2"
+    assert console.participant_window.progress.text() == "Trial 1 of 1"  # of the current task's trials
     pads = console.knobs.pads
 
     # rating: the confirm is refused until both knobs are rated
@@ -137,7 +137,7 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
         qtbot.mouseMove(pad, QPoint(x, y))
     qtbot.mouseRelease(pad, Qt.MouseButton.LeftButton, pos=QPoint(2 * pad.width() // 3, y))
     qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
-    wait_until(qapp, lambda: console.trial_label.text() == "Trial 2 of 2", 10)
+    wait_until(qapp, lambda: console.trial_label.text() == "Trial 1 of 1, step 2 of 2", 10)
 
     # abort (answering its question); starting the participant again is refused; resuming continues at trial 2
     answer_question(console, qtbot, QMessageBox.StandardButton.Yes)
@@ -149,7 +149,7 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     qtbot.mouseClick(console.start_button, Qt.MouseButton.LeftButton)
     wait_until(qapp, lambda: c.playing, ENGINE_START)
     console.setup.resume.setChecked(False)
-    assert console.trial_label.text() == "Trial 2 of 2" and console.setup.error.text() == ""
+    assert console.trial_label.text() == "Trial 1 of 1, step 2 of 2" and console.setup.error.text() == ""
 
     # adjustment: up to knob 60, emergency stop, the trial starts again from 0
     dial = console.knobs.dials[0]

@@ -15,6 +15,17 @@ from studyapp.engine.events import Applied
 LATENCY = 0.002  # s, what the fake worker reports for every applied control
 
 
+class SteppingClock:
+    """A clock for the controller that moves ``step`` s at every reading (pages settle at once)."""
+
+    def __init__(self, step=1.0):
+        self.now, self.step = 0.0, step
+
+    def __call__(self):
+        self.now += self.step
+        return self.now
+
+
 class FakeStatusBlock:
     force_enable = True
     force_off_reason = "parent"

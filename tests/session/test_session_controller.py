@@ -391,3 +391,32 @@ def test_each_trial_logs_the_engine_faults_counted_while_it_ran(controller):
         {"step": 1, "task": "adjustment", "type": "trial_health", "trial": 1,
          "deadline_misses": 1, "underruns": 0, "faults": 1, "events_dropped": 3},
     ]
+
+
+def test_each_session_engine_records_the_audio_with_a_cue_at_each_trial_start_and_end(controller):
+    c = controller
+    start(c)
+    folder = c.session.folder
+    up(c)
+    first = c.host.engine
+    recording = (cmd.RecordAudio, cmd.AudioCue, cmd.InstallActions)
+    sent = [x for x in first.sent if isinstance(x, recording)]
+    # recording starts as the engine comes up; the trial's cue follows its mapping, at the same block
+    assert sent[0] == cmd.RecordAudio(str(folder / "audio.wav"))
+    assert isinstance(sent[1], cmd.InstallActions) and sent[1].trial == 1
+    assert sent[2:] == [cmd.AudioCue(0, "rating", 1, "start")]
+    play_rating(c)  # the rating trial ends, the adjustment trial starts
+    fail(c)
+    c.restart_engine()
+    up(c)  # a new engine: a new recording (the worker picks audio-2.wav), the trial starts again
+    second = c.host.engine
+    c.knob(0, 30)
+    c.pad(0)
+    c.poll()
+    assert c.state == S.FINISHED
+    cues = [(x.step, x.task, x.trial, x.event) for x in first.sent_of(cmd.AudioCue)]
+    assert cues == [(0, "rating", 1, "start"), (0, "rating", 1, "end"), (1, "adjustment", 1, "start")]
+    assert first.sent_of(cmd.RecordAudio) == [cmd.RecordAudio(str(folder / "audio.wav"))]
+    assert [x for x in second.sent if isinstance(x, (cmd.RecordAudio, cmd.AudioCue))] == [
+        cmd.RecordAudio(str(folder / "audio.wav")), cmd.AudioCue(1, "adjustment", 1, "start"),
+        cmd.AudioCue(1, "adjustment", 1, "end"), cmd.RecordAudio(None)]

@@ -46,12 +46,13 @@ from studyapp.experiment.event_fields import integer, text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
+from studyapp.experiment.tasks.phases import PhaseFields, read_phases
 from studyapp.model.fmax_knob import KNOB_MAX, fmax_from_knob
 from studyapp.model.loop import FMAX_LIMIT
 
 
 @dataclass(frozen=True)
-class AdjustmentSpec:
+class AdjustmentSpec(PhaseFields):
     conditions: tuple
     trials: int
     ceiling: float
@@ -64,8 +65,8 @@ class AdjustmentSpec:
 class AdjustmentTrial(ConfirmPadTrial):
     task = "adjustment"
 
-    def __init__(self, condition, trial, ceiling, decades, knob=0, confirm_pad=0):
-        super().__init__(trial, confirm_pad)
+    def __init__(self, condition, trial, ceiling, decades, knob=0, confirm_pad=0, min_listen_s=0.0):
+        super().__init__(trial, confirm_pad, (condition,), min_listen_s)
         self.condition = condition
         self.ceiling = float(ceiling)
         self.decades = float(decades)
@@ -91,6 +92,9 @@ class AdjustmentTrial(ConfirmPadTrial):
 
     def refusal(self):
         return "F_max is 0: turn the knob up first" if self.value == 0 else None
+
+    def listen_label(self, condition):
+        return "the string"
 
     def answer(self):
         return {
@@ -122,6 +126,7 @@ class Adjustment:
             knob=table.integer("knob", 0, bounds.knobs - 1, default=0),
             confirm_pad=pad,
             instructions=instructions,
+            **read_phases(table),
         )
 
     def schedule(self, spec, square, participant_index):
@@ -136,7 +141,8 @@ class Adjustment:
         return (trial.condition,)
 
     def start(self, spec, trial):
-        return AdjustmentTrial(trial.condition, trial.trial, spec.ceiling, spec.decades, spec.knob, spec.confirm_pad)
+        return AdjustmentTrial(trial.condition, trial.trial, spec.ceiling, spec.decades, spec.knob, spec.confirm_pad,
+                               spec.min_listen_s)
 
     def describe(self, trial):
         return f"adjustment {trial.condition} trial {trial.trial}"
@@ -190,6 +196,7 @@ class Adjustment:
         if broken:
             value = round(value + participant.criterion + rng.normal(0.0, participant.hand_jitter))
         participant.turn(runner, knob, int(np.clip(value, 1, KNOB_MAX)), rng)
+        participant.listen_enough(runner)
         runner.pad(runner.task.confirm_pad)
 
 

@@ -18,13 +18,14 @@ from dataclasses import dataclass
 from studyapp.experiment.event_fields import text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.tasks.confirm_pad import check_knob_value
+from studyapp.experiment.tasks.phases import PhaseFields, read_phases
 from studyapp.model.loop import FMAX_LIMIT
 
 DURATION_RANGE = (0.1, 600.0)  # s
 
 
 @dataclass(frozen=True)
-class ListenSpec:
+class ListenSpec(PhaseFields):
     conditions: tuple
     fmax: float
     duration_s: float
@@ -65,7 +66,7 @@ class ListenTrial:
     def pad(self, index):
         return [{"type": "pad", "index": index}]
 
-    def tick(self, dt):
+    def tick(self, dt, bowing=False):
         if self.done:
             return []
         self.elapsed += dt
@@ -92,6 +93,7 @@ class Listen:
             fmax=table.number("fmax", 0.0, FMAX_LIMIT, "N", low_open=True),
             duration_s=table.number("duration_s", *DURATION_RANGE, "s"),
             instructions=table.string("instructions"),
+            **read_phases(table, confirmed=False),
         )
 
     def schedule(self, spec, square, participant_index):

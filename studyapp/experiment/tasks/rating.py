@@ -42,12 +42,13 @@ from studyapp.experiment.event_fields import integer, number, text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
+from studyapp.experiment.tasks.phases import PhaseFields, read_phases
 from studyapp.model.fmax_knob import KNOB_MAX
 from studyapp.model.loop import FMAX_LIMIT
 
 
 @dataclass(frozen=True)
-class RatingSpec:
+class RatingSpec(PhaseFields):
     conditions: tuple
     fmax: float
     confirm_pad: int
@@ -65,8 +66,8 @@ def normalise_ratings(knob_values):
 class RatingTrial(ConfirmPadTrial):
     task = "rating"
 
-    def __init__(self, conditions, fmax, confirm_pad=0, trial=1):
-        super().__init__(trial, confirm_pad)
+    def __init__(self, conditions, fmax, confirm_pad=0, trial=1, min_listen_s=0.0):
+        super().__init__(trial, confirm_pad, conditions, min_listen_s)
         self.conditions = tuple(conditions)
         self.rating_fmax = float(fmax)
         self.values = {c: None for c in self.conditions}
@@ -91,7 +92,7 @@ class RatingTrial(ConfirmPadTrial):
         return [{"type": "knob", "index": index, "value": value, "condition": condition}]
 
     def refusal(self):
-        unrated = [c for c, v in self.values.items() if v is None]
+        unrated = [self.listen_label(c) for c, v in self.values.items() if v is None]
         if unrated:
             return "not rated yet: " + ", ".join(unrated)
         if len(set(self.values.values())) == 1:
@@ -110,10 +111,13 @@ class RatingTrial(ConfirmPadTrial):
             ],
         }
 
-    def tick(self, dt):
+    def listen_label(self, condition):
+        return f"knob {self.conditions.index(condition) + 1}"
+
+    def tick(self, dt, bowing=False):
         if self.selected is not None:
             self.dwell[self.selected] += dt
-        return super().tick(dt)
+        return super().tick(dt, bowing)
 
     def restore(self, earlier):
         knobs = [e for e in earlier if e.get("type") == "knob"]
@@ -138,6 +142,7 @@ class Rating:
             fmax=table.number("fmax", 0.0, FMAX_LIMIT, "N", low_open=True),
             confirm_pad=pad,
             instructions=instructions,
+            **read_phases(table),
         )
 
     def schedule(self, spec, square, participant_index):
@@ -147,7 +152,7 @@ class Rating:
         return tuple(trial.conditions)
 
     def start(self, spec, trial):
-        return RatingTrial(trial.conditions, spec.fmax, spec.confirm_pad, trial.trial)
+        return RatingTrial(trial.conditions, spec.fmax, spec.confirm_pad, trial.trial, spec.min_listen_s)
 
     def describe(self, trial):
         return f"rating of {len(trial.conditions)} conditions"
@@ -188,7 +193,7 @@ class Rating:
         runner.set_bowing(True)
         for j in range(len(conditions)):
             participant.turn(runner, j, int(rng.integers(40, 88)), rng)
-            block = runner.advance(participant.bow_time)
+            block = runner.advance(max(participant.bow_time, runner.task.min_listen_s))
             noise = participant.noise(runner, block)
             judged.append(math.log10(max(noise, 1e-12)) + rng.normal(0.0, participant.rating_jitter))
         runner.set_bowing(False)

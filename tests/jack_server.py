@@ -1,4 +1,4 @@
-"""A JACK server with its dummy driver: a real, clock-paced PortAudio device and JACK MIDI, no sound card.
+"""The ``jack_server`` fixture (registered in tests/conftest.py for every folder): a JACK server with its dummy driver: a real, clock-paced PortAudio device and JACK MIDI, no sound card.
 
 The server gets its own name (JACK_DEFAULT_SERVER, inherited by the engine's
 worker), so it never meets another JACK server on the machine. PortAudio in
