@@ -4,11 +4,13 @@
                  [--simulated-participant] [--start] [--seed N] [--audio SPEC] [--midi SPEC]
                  [--experimenter NAME] [--session-number N] [--notes TEXT] [--order-row N]
                  [--participant-window] [--participant-screen N] [--participant-screenshot FILE]
-                 [--screenshot FILE] [--measure-scope SECONDS]
+                 [--screenshot FILE] [--size WxH] [--measure-scope SECONDS]
 
 ``--screenshot FILE`` starts the console, lets it run, saves it as a PNG and
-exits; ``--measure-scope SECONDS`` prints the live scope's frame rate with
-every trace on and exits. ``--participant-screen N`` opens the participant's
+exits; ``--size WxH`` sizes the console's window (e.g. 1366x768, a lab
+laptop's screen), so a screenshot shows it at that size; ``--measure-scope
+SECONDS`` prints the live scope's frame rate with every trace on and exits.
+``--participant-screen N`` opens the participant's
 window full-screen on screen N (from 0), remembered for the next
 ``--participant-window``; ``--participant-screenshot FILE`` saves that window
 as a PNG (with ``--start``, once the first trial shows) and exits. The
@@ -16,7 +18,22 @@ session-info options fill the set-up panel's fields (checked as ``studyapp run``
 checks them). See docs/gui.md.
 """
 
+import re
+
 from studyapp.cli.session_info_options import add_session_info_options
+
+SIZES = ((800, 600), (7680, 4320))  # px: the smallest and largest window --size allows
+
+
+def parse_size(text):
+    """``"1366x768"`` -> ``(1366, 768)``; ``UserError`` naming the value and what is allowed."""
+    from studyapp.errors import UserError
+
+    (w_min, h_min), (w_max, h_max) = SIZES
+    match = re.fullmatch(r"\s*(\d+)\s*[xX×]\s*(\d+)\s*", text or "")
+    if match is None or not (w_min <= int(match[1]) <= w_max and h_min <= int(match[2]) <= h_max):
+        raise UserError(f"--size {text}: allowed is WIDTHxHEIGHT in pixels, from {w_min}x{h_min} to {w_max}x{h_max}")
+    return int(match[1]), int(match[2])
 
 
 def register(sub):
@@ -39,6 +56,8 @@ def register(sub):
     parser.add_argument("--participant-screenshot", metavar="FILE",
                         help="save the participant's window as a PNG and exit")
     parser.add_argument("--screenshot", metavar="FILE", help="save the running console as a PNG and exit")
+    parser.add_argument("--size", metavar="WxH",
+                        help="window size in pixels, e.g. 1366x768 (800x600 to 7680x4320)")
     parser.add_argument("--measure-scope", type=float, metavar="SECONDS",
                         help="measure the scope's frame rate with every trace on for SECONDS, print it and exit")
     add_session_info_options(parser)
@@ -63,6 +82,8 @@ def run(args):
         path = getattr(args, option)
         if path and not path.lower().endswith(".png"):
             raise UserError(f"--{option.replace('_', '-')} {path}: allowed is a file name ending in .png")
+    if args.size is not None:
+        args.size = parse_size(args.size)
     try:
         from studyapp.gui.app import main
     except ImportError as exc:

@@ -70,6 +70,13 @@ class SetMute(Command):
 
 
 @dataclass(frozen=True)
+class MidiPort(Command):
+    """The parent connected the controller ``name`` to the worker's waiting MIDI inlet ("" when it went away)."""
+
+    name: str
+
+
+@dataclass(frozen=True)
 class ReferenceTone(Command):
     """The headphone level check's sine tone (issue 15): ``hz`` at ``level_dbfs`` (peak, dB re full scale)
     in place of the string's sound; ``level_dbfs`` None ends it and gives the string back."""

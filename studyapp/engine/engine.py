@@ -17,7 +17,8 @@ sentinel), so:
   called hung, so detection takes at most ``hang_timeout + POLL`` (< 100 ms).
 
 Either way the fault is reported (``faults``, ``on_fault``), the
-``force_enable`` word is cleared (a worker that was only slow zeroes its force
+``force_enable`` word is cleared, with the reason "watchdog" and how long the
+worker was silent beside it (``StatusBlock.disable_force``; a worker that was only slow zeroes its force
 at its next block and latches a fault) and ``force_output`` reads 0: the
 simulated device, which lives in the worker, stops with it. ``stop()`` asks
 the worker to finish, waits for it, kills it if it will not go, and unlinks
@@ -28,6 +29,10 @@ devices that has said nothing for ``CLOSE_GRACE``, is stalled (stopped by
 SIGSTOP, hung in native code) and gets SIGKILL at once: a stopped process
 handles neither the stop command nor SIGTERM, and waiting out the polite
 timeout kept the parent 12 s behind a stalled worker.
+
+An engine whose MIDI input waits for its controller (JACK, ``--midi first``
+or a port name, none there at the start) gets a ``MidiHotplug`` thread that
+connects the controller once it is plugged in (``midi_hotplug.py``).
 
 The worker's events (control events, notices, faults) pass through a ring of
 ``event_ring.SLOTS`` slots; should the watchdog fall a whole ring behind, the
@@ -43,6 +48,7 @@ from multiprocessing.connection import wait as wait_for
 
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
+from studyapp.engine import midi_hotplug
 from studyapp.engine.audio import parse as parse_audio
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.event_ring import EventRing
@@ -78,6 +84,7 @@ class Engine:
         self._event_lock = threading.Lock()
         self._stop_watch = threading.Event()
         self._watchdog = None
+        self._hotplug = None
         self._stopping = False
         self.events_dropped = 0  # events the worker wrote that the ring overwrote before we read them
 
@@ -137,6 +144,9 @@ class Engine:
                 raise EngineError(f"engine: the worker did not start within {timeout:g} s")
         self._watchdog = threading.Thread(target=self._watch, name="studyapp-watchdog", daemon=True)
         self._watchdog.start()
+        inlet = self.info.get("midi_inlet")
+        if inlet and midi_hotplug.available():
+            self._hotplug = midi_hotplug.MidiHotplug(c.midi.strip(), inlet, self._midi_port).start()
         return self
 
     def __enter__(self):
@@ -155,6 +165,10 @@ class Engine:
             if command.name not in allowed:
                 raise ParameterError(f"source {command.name!r}: allowed are {', '.join(allowed)}")
         self._commands.put(command)
+
+    def _midi_port(self, port):
+        with contextlib.suppress(EngineError):
+            self.send(cmd.MidiPort(port or ""))
 
     def clear_fault(self):
         """Unlatch a safety fault in the worker; after a watchdog trip only a restart helps."""
@@ -257,8 +271,8 @@ class Engine:
         if self.on_fault is not None:
             self.on_fault(text)
 
-    def _trip(self, text, when):
-        self.status_block.force_enable = False
+    def _trip(self, text, when, silence=0.0):
+        self.status_block.disable_force("watchdog", silence)
         self.tripped = True
         self._fault(text, when)
 
@@ -279,8 +293,10 @@ class Engine:
                 self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero", now)
                 return
             snap = self.status_block.read()
-            if snap["state"] == "running" and now - snap["heartbeat"] > timeout:
-                self._trip(f"watchdog: no heartbeat for {1e3 * timeout:.0f} ms; force disabled", now)
+            silence = now - snap["heartbeat"]
+            if snap["state"] == "running" and silence > timeout:
+                self._trip(f"watchdog: the engine stopped answering (no heartbeat for {1e3 * silence:.0f} ms, "
+                           f"{1e3 * timeout:.0f} ms allowed); force switched off for safety", now, silence)
 
     # shutting down ---------------------------------------------------------
     def stop(self, timeout=10.0):
@@ -288,6 +304,9 @@ class Engine:
         if self.process is None:
             return self.summary
         self._stopping = True
+        if self._hotplug is not None:
+            self._hotplug.stop()
+            self._hotplug = None
         if self.process.is_alive():
             with contextlib.suppress(Exception):
                 self._commands.put(cmd.Stop())

@@ -11,7 +11,17 @@ value in [0, 1]:
 
 ``open_input(spec)`` opens an input: ``"virtual"`` makes a port others connect
 to, ``"first"`` takes the first source found, any other text picks the first
-port whose name contains it, ``"none"`` opens nothing. No Python runs on
+port whose name contains it, ``"none"`` opens nothing.
+
+**Hot-plug.** When JACK runs but no port matches yet (``"first"`` or a
+name), ``open_input`` opens an input port of its own that nothing feeds yet
+(``MidiInput.waiting``, its ``inlet`` named by a client unique to the
+process) and the parent connects the controller to it once one appears
+(``midi_hotplug.MidiHotplug``); ``connected(port)`` then names it. The worker
+never looks for ports itself: python-rtmidi holds the GIL for the whole of
+a call, and a JACK request (listing or connecting ports) took 36 us typically
+but up to 14-240 ms on a loaded machine (measured on a dummy server), long
+enough to miss many blocks and trip the watchdog. ALSA is not rescanned. No Python runs on
 rtmidi's thread: it puts each message on its own C++ queue
 (``queue_size_limit`` = ``QUEUE`` messages, 3.3 s at 10,000 messages/s) and the
 engine polls that queue at block boundaries (``MidiInput.poll``), then
@@ -43,6 +53,7 @@ messages (it prints a line on stderr, the only sign it gives), so a poll
 that finds ``QUEUE`` messages or more counts one ``overflow``.
 """
 
+import os
 import time
 
 import mido
@@ -55,6 +66,7 @@ VIRTUAL_PORT = "studyapp MIDI in"
 APIS = ("UNIX_JACK", "LINUX_ALSA")
 CONTROL_CHANGE = 0xB0  # status byte's high nibble
 QUEUE = 2**15  # rtmidi's queue, messages: seconds at 10,000/s, beyond any stall the watchdog lets pass
+RESCAN = 2.0  # s between two looks for a controller plugged in (or out), midi_hotplug.py
 
 
 def _key(kind, channel, number):
@@ -194,9 +206,11 @@ class MidiInput:
     each new block with ``new_block(k, time)``.
     """
 
-    def __init__(self, port, api, rt=None, queue_size=QUEUE):
+    def __init__(self, port, api, rt=None, queue_size=QUEUE, spec=None, inlet=None):
         self.port = port
         self.api = api
+        self.spec = spec  # what the controller's port must match ("first" or part of a name)
+        self.inlet = inlet  # our own port a controller is connected to from outside (hot-plug), or None
         self.queue_size = queue_size
         self.received = 0
         self.overflows = 0
@@ -231,14 +245,45 @@ class MidiInput:
         return [(raw, at, k if at >= since else k - 1) for (raw, _), at in zip(messages, times)]
 
     @property
+    def waiting(self):
+        """No controller connected yet (hot-plug: ``inlet`` waits for one)."""
+        return self.port is None
+
+    def connected(self, port):
+        """The parent connected ``port`` to our ``inlet`` (None: it went away); returns a sentence saying so."""
+        gone, self.port = self.port, port or None
+        self._polled = time.monotonic()  # nothing arrived from it before now
+        if self.port is not None:
+            return f"MIDI: {self.port} plugged in; its knobs and pads act now"
+        return f"MIDI: {gone} was unplugged; plugging it in again is picked up within {RESCAN:g} s"
+
+    @property
     def description(self):
-        return f"{self.port} ({'JACK' if self.api == 'UNIX_JACK' else 'ALSA'})"
+        api = "JACK" if self.api == "UNIX_JACK" else "ALSA"
+        if self.port is None:
+            return f"none yet ({api}): plugging a controller in is picked up within {RESCAN:g} s"
+        return f"{self.port} ({api})"
 
     def close(self):
         if self._rt is not None:
             self._rt.close_port()
             self._rt.delete()
             self._rt = None
+
+
+def match_port(spec, names):
+    """The port ``spec`` picks among ``names`` ("first": the first one), or ``None``."""
+    if spec == "first":
+        return names[0] if names else None
+    return next((n for n in names if spec.lower() in n.lower()), None)
+
+
+class NoPortYet(MidiUnavailable):
+    """JACK runs but no port matches; ``waiting`` is an input whose ``inlet`` the parent connects later."""
+
+    def __init__(self, text, waiting):
+        super().__init__(text)
+        self.waiting = waiting
 
 
 def _open(spec, api, client):
@@ -256,15 +301,19 @@ def _open(spec, api, client):
             midi.port = f"{client}:{VIRTUAL_PORT}" if api == "UNIX_JACK" else VIRTUAL_PORT
         else:
             names = rt.get_ports()
-            if spec == "first":
-                match = names[:1]
-            else:
-                match = [n for n in names if spec.lower() in n.lower()]
-            if not match:
-                have = ", ".join(names) or "none"
-                raise MidiUnavailable(f"no MIDI input matches {spec!r} (inputs: {have})")
-            rt.open_port(names.index(match[0]))
-            midi.port = match[0]
+            match = match_port(spec, names)
+            midi.spec = spec
+            if match is None:
+                reason = f"no MIDI input matches {spec!r} (inputs: {', '.join(names) or 'none'})"
+                if api != "UNIX_JACK":
+                    raise MidiUnavailable(reason)
+                rt.open_virtual_port(VIRTUAL_PORT)
+                midi._rt, midi.inlet = rt, f"{client}:{VIRTUAL_PORT}"
+                raise NoPortYet(reason, midi)
+            rt.open_port(names.index(match))
+            midi.port = match
+    except NoPortYet:
+        raise
     except BaseException:
         rt.delete()
         raise
@@ -278,14 +327,32 @@ def open_input(spec, say=print, client=CLIENT):
     if spec == "none":
         return None
     reasons = []
+    waiting = None  # JACK runs but has no such port yet: an inlet the parent connects a controller to
     for api in APIS:
         with captured_native_stderr():
             try:
-                return _open(spec, api, client)
+                # a client name of our own: the parent connects to the inlet by its full name
+                midi = _open(spec, api, f"{client}-{os.getpid()}" if spec != "virtual" and api == "UNIX_JACK"
+                             else client)
+            except NoPortYet as exc:
+                if waiting is None:
+                    waiting = exc.waiting
+                else:
+                    exc.waiting.close()
+                reasons.append(f"{'JACK' if api == 'UNIX_JACK' else 'ALSA'}: {exc}")
+                continue
             except (OSError, MidiUnavailable, ValueError, RuntimeError) as exc:
                 reasons.append(f"{'JACK' if api == 'UNIX_JACK' else 'ALSA'}: {str(exc).strip() or type(exc).__name__}")
+                continue
             except ImportError as exc:
                 reasons.append(f"python-rtmidi missing ({exc})")
                 break
+        if waiting is not None:
+            waiting.close()
+        return midi
+    if waiting is not None:
+        say(f"MIDI: no controller yet ({'; '.join(reasons)}); plugging one in is picked up within {RESCAN:g} s, "
+            "the on-screen knobs work meanwhile")
+        return waiting
     say(f"MIDI: no input opened ({'; '.join(reasons)}); use the on-screen knobs")
     return None

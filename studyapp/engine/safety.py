@@ -9,7 +9,8 @@ Three layers keep a fault from leaving the device pushing:
 2. Latched faults. A non-finite value anywhere in a block (the loop latches
    its own fault the moment one appears and zeroes the force from that sample
    on), a clamp found violated, or the parent's watchdog clearing the
-   ``force_enable`` word: the force scale goes to 0 and stays there until
+   ``force_enable`` word (the experimenter's emergency stop or the watchdog:
+   the fault says which, ``force_off_text``): the force scale goes to 0 and stays there until
    ``clear()`` (an experimenter's decision, never automatic). The word is read
    twice per block: before the block runs (``before_block``), so a worker
    that was stopped or starved while the watchdog tripped computes its next
@@ -46,7 +47,18 @@ import numpy as np
 from studyapp.errors import ParameterError
 
 
-WATCHDOG = "watchdog: the parent disabled the force (worker not answering in time)"
+WATCHDOG = "watchdog: the parent switched the force off"
+CLEAR_HINT = "press Resume to clear"
+
+
+def force_off_text(reason, silence=0.0):
+    """The fault, in plain words, for ``force_enable`` cleared for ``reason`` (status.FORCE_OFF_REASONS)."""
+    if reason == "operator":
+        return f"Emergency stop (operator): force off — {CLEAR_HINT}"
+    if reason == "watchdog":
+        return (f"watchdog: the engine stopped answering for {1e3 * silence:.0f} ms; force switched off for "
+                f"safety — {CLEAR_HINT}")
+    return WATCHDOG
 
 
 @dataclass(frozen=True)
@@ -105,21 +117,23 @@ class Safety:
         self._window.clear()
         self._window_samples = self._window_suspect = 0
         self.scale = 1.0
+        self._previous_force_scale = 1.0  # the next block runs at full scale: its clamp is F_max again
         self.loop.set_force_scale(1.0)
 
-    def before_block(self, force_enable):
+    def before_block(self, force_enable, why=WATCHDOG):
         """Just before a block runs: a cleared ``force_enable`` zeroes that block's force already."""
         if not force_enable:
-            self.latch(WATCHDOG)
+            self.latch(why)
 
-    def check(self, block, force_enable=True):
+    def check(self, block, force_enable=True, why=WATCHDOG):
         """Inspect one block just run, before its force is written; returns the fault it raised, or ``None``.
 
-        With ``force_enable`` cleared the block's force is withheld: set to 0 in place.
+        With ``force_enable`` cleared the block's force is withheld: set to 0 in place, and the fault
+        latched is ``why`` (``force_off_text``).
         """
         before = len(self.faults)
         if not force_enable:
-            self.latch(WATCHDOG)
+            self.latch(why)
             block["force"][:] = 0.0
         loop_fault = getattr(self.loop, "fault", None)
         if loop_fault:

@@ -5,9 +5,14 @@ then makes it even again; a reader copies the fields between two reads of the
 sequence number and keeps the copy only when both reads are equal and even.
 (x86-64 keeps stores and loads in program order; see ring.py.)
 
-Beside the locked record sits one word the parent writes and the worker reads:
-``force_enable``. The watchdog clears it when the worker stops answering, so a
-worker that is merely slow, not dead, zeroes its force at its next block.
+Beside the locked record sit words the parent writes and the worker reads:
+``force_enable``, and why it was last cleared (``force_off_reason``, one of
+``FORCE_OFF_REASONS``, and for the watchdog ``force_off_silence``, the seconds
+the worker had not answered). The watchdog clears it when the worker stops
+answering, so a worker that is merely slow, not dead, zeroes its force at its
+next block; the experimenter's emergency stop clears it too. The reason is
+written before the word is cleared, so the worker's fault text says which
+(``safety.force_off_text``) instead of blaming the watchdog for an operator's stop.
 """
 
 import time
@@ -42,9 +47,10 @@ NUMBERS = (
 TEXTS = {"source": 32, "fault": 200, "audio": 120, "midi": 120}
 
 STATES = ("starting", "running", "stopping", "stopped", "failed")
+FORCE_OFF_REASONS = ("parent", "operator", "watchdog")  # "parent": cleared without a reason given
 
 _SEQ = 8
-_ENABLE = 8
+_ENABLE = 3 * 8  # force_enable, force_off_reason, force_off_silence
 
 
 class StatusBlock:
@@ -55,7 +61,7 @@ class StatusBlock:
         self._owner = owner
         buf = shm.buf
         self._seq = np.ndarray((1,), dtype=np.int64, buffer=buf)
-        self._enable = np.ndarray((1,), dtype=np.float64, buffer=buf, offset=_SEQ)
+        self._enable = np.ndarray((3,), dtype=np.float64, buffer=buf, offset=_SEQ)
         offset = _SEQ + _ENABLE
         self._numbers = np.ndarray((len(NUMBERS),), dtype=np.float64, buffer=buf, offset=offset)
         offset += 8 * len(NUMBERS)
@@ -78,7 +84,7 @@ class StatusBlock:
         shm = shared_memory.SharedMemory(create=True, size=cls.size())
         block = cls(shm, owner=True)
         block._seq[0] = 0
-        block._enable[0] = 1.0
+        block._enable[:] = (1.0, 0.0, 0.0)
         block._numbers[:] = 0.0
         block._texts[:] = 0
         return block
@@ -150,7 +156,23 @@ class StatusBlock:
 
     @force_enable.setter
     def force_enable(self, on):
+        if on:
+            self._enable[1:] = 0.0
         self._enable[0] = 1.0 if on else 0.0
+
+    def disable_force(self, reason, silence=0.0):
+        """Clear ``force_enable``, saying why (``FORCE_OFF_REASONS``; the watchdog gives the silence in s)."""
+        self._enable[1] = FORCE_OFF_REASONS.index(reason)
+        self._enable[2] = float(silence)
+        self._enable[0] = 0.0
+
+    @property
+    def force_off_reason(self):
+        return FORCE_OFF_REASONS[int(self._enable[1])]
+
+    @property
+    def force_off_silence(self):
+        return float(self._enable[2])
 
     def close(self):
         self._seq = self._enable = self._numbers = self._texts = None

@@ -40,6 +40,10 @@ level acts only once it has passed through the level in force (soft takeover,
 changes nothing, so a knob left high never jumps F_max at a trial start or
 after a pause. On-screen knobs show the level itself and need no pickup.
 
+A MIDI input waiting for its controller (JACK hot-plug, ``midi.py``) is
+connected by the parent; a ``MidiPort`` command names the port (or says it
+went away), and the status block's ``midi`` text and a notice follow.
+
 The worker stops on a ``Stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
 """
@@ -64,7 +68,7 @@ from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, coalesce, open_input
 from studyapp.engine.pickup import LEVEL_ACTIONS, level_position, passes_through
 from studyapp.engine.ring import Ring
-from studyapp.engine.safety import Safety
+from studyapp.engine.safety import Safety, force_off_text
 from studyapp.engine.status import StatusBlock
 from studyapp.model.fmax_knob import KNOB_MAX
 
@@ -214,6 +218,11 @@ class Worker:
     def _stop(self, c):
         self.stopping = True
 
+    def _midi_port(self, c):
+        if self.midi is not None and self.midi.inlet is not None:
+            self.notice(self.midi.connected(c.name), "info", "midi")
+            self.status.set(midi=self.midi.description)
+
     def _record(self, c):
         """Stop the recording in progress (its writer finishes on its own), then start one at ``c.path``."""
         if self.recorder is not None:
@@ -249,6 +258,7 @@ class Worker:
         cmd.RecordAudio: _record,
         cmd.AudioCue: _cue,
         cmd.InstallActions: _install,
+        cmd.MidiPort: _midi_port,
         cmd.Control: lambda self, c: self.control(c.control, c.value, c.sent, self.k, "screen"),
     }
 
@@ -333,9 +343,11 @@ class Worker:
     def step(self, started):
         """One block; returns (finished, wall-clock compute, CPU time of this thread)."""
         cpu_started = time.thread_time()
-        self.safety.before_block(self.status.force_enable)
+        enabled = self.status.force_enable
+        self.safety.before_block(enabled, why=None if enabled else self._force_off_text())
         out = self.loop.run(self.block)
-        self.safety.check(out, force_enable=self.status.force_enable)
+        enabled = self.status.force_enable
+        self.safety.check(out, force_enable=enabled, why=None if enabled else self._force_off_text())
         if self.sink.render:
             self.sink.push(out["audio"])
         rows = self._rows
@@ -357,6 +369,10 @@ class Worker:
             self.midi.new_block(self.k, finished)
         return finished, finished - started, cpu
 
+    def _force_off_text(self):
+        """Why the parent cleared ``force_enable``, in words (read only while it is cleared)."""
+        return force_off_text(self.status.force_off_reason, self.status.force_off_silence)
+
     def run(self):
         status = self.status
         self.prime()
@@ -365,7 +381,7 @@ class Worker:
         self.events.put(ev.Ready({
             "rate": self.loop.rate, "block": self.block, "names": list(self.loop.names),
             "audio": self.sink.description, "midi": self.midi.description if self.midi else "none",
-            "realtime": self.realtime, "paced": "audio" if self.sink.paced else "timer",
+            "midi_inlet": self.midi.inlet if self.midi else None, "realtime": self.realtime, "paced": "audio" if self.sink.paced else "timer",
         }))
         parent = multiprocessing.parent_process()
         audio_clock = self.sink.paced

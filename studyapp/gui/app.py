@@ -5,7 +5,8 @@ pytest-qt), the ``SessionController`` (audio and MIDI as asked, falling back
 to no sound and the on-screen knobs when nothing is found), and the console;
 loads the protocol (``--protocol``, else ``protocols/sinclair2014.toml`` or the
 first protocol in ``protocols/``); fills in the participant; starts the
-session at once with ``--start``; and runs the event loop. ``--screenshot``,
+session at once with ``--start``; sizes the window (``--size``, already
+parsed into pixels); and runs the event loop. ``--screenshot``,
 ``--participant-screenshot`` and ``--measure-scope`` run the console
 unattended and exit. The participant's window opens with
 ``--participant-window``, ``--participant-screen N`` or
@@ -77,6 +78,9 @@ def main(args):
     participant = getattr(args, "participant_window", False) or screen_choice is not None or bool(shot)
     screen = choose_screen(screen_choice) if participant else None
     controller, console = build(args)
+    size = getattr(args, "size", None)
+    if size is not None:
+        console.resize(*size)
     console.show()
     if screen is not None:
         console.participant_window.show_full_screen(screen)

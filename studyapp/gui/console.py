@@ -1,13 +1,19 @@
 """The experimenter console: one window to set up, run, watch and stop a study session.
 
-Left: session set-up and the apparatus found, the session's buttons (Start,
-Pause/Resume, Abort, EMERGENCY STOP), and its progress (task, trial x of y,
-the page the participant sees with the headphone level check's confirm
-(``PageControls``), the current condition, which a tick hides for blinding). Right, in tabs: the
-live scope with the on-screen knobs and pads and the bowing pad; the
-analysis view (``AnalysisView``) of a results folder; the session's log.
-Bottom: the status bar (loop rate, load, deadline misses, audio underruns,
-faults, scope frame rate).
+Left: session set-up and the apparatus found, and the session's progress
+(task, trial x of y, the page the participant sees with the headphone level
+check's confirm (``PageControls``), the current condition, which a tick hides
+for blinding), in a scroll area; below them, always in view, the session's
+buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
+scope with the on-screen knobs and pads and the bowing pad; the analysis view
+(``AnalysisView``) of a results folder; the session's log. Bottom: the status
+bar (loop rate, load, deadline misses, audio underruns, faults, scope frame
+rate). The two sides share a splitter, and no widget asks for width in
+proportion to what it says (long texts wrap or elide, ``ElidedLabel``), so
+the console fits a 1,366 x 768 screen.
+
+Abort, and closing the console, while a session runs ask first (``confirm``;
+``abort_session(confirm=False)``, the default, is the programmatic abort).
 
 Every widget is a view of the ``SessionController`` (``studyapp.session``, no
 Qt in it): widgets call its methods, and its events update the widgets.
@@ -26,15 +32,18 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QMainWindow,
+    QMessageBox,
     QPlainTextEdit,
     QProgressBar,
     QPushButton,
+    QScrollArea,
     QSplitter,
     QTabWidget,
     QVBoxLayout,
     QWidget,
 )
 
+from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
 from studyapp.experiment.tasks import task_type
 from studyapp.gui.analysis_view import AnalysisView
@@ -55,11 +64,13 @@ STOP_STYLE = ("QPushButton { background: #c00; color: white; font-weight: bold; 
 LOG_LINES = 2000
 STATE_WORDS = {
     State.IDLE: "No session", State.STARTING: "Starting the session's engine…", State.RUNNING: "Running",
-    State.PAUSED: "Paused", State.EMERGENCY: "EMERGENCY STOP — force zeroed",
+    State.PAUSED: "Paused", State.EMERGENCY: force_off_text("operator"),
     State.CLEARING: "Clearing the emergency stop…", State.ENGINE_LOST: "Paused: the engine stopped",
     State.RESTARTING: "Starting a new engine…", State.FINISHED: "Session complete", State.ABORTED: "Session aborted",
 }
 COLOURS = {"error": "#c00", "warning": "#a60"}
+MESSAGE_MS = 8000  # how long a warning stays in the status bar
+LEFT_WIDTH = 360  # px: the set-up side's share of the splitter at first
 
 
 class Console(QMainWindow):
@@ -68,6 +79,8 @@ class Console(QMainWindow):
         self.controller = controller
         self.simulated = None
         self.notices = {}
+        self.confirmation = None
+        self._midi_shown = None
         self.caller = GuiThreadCaller(self)
         self.setWindowTitle("studyapp — experimenter console")
 
@@ -79,7 +92,7 @@ class Console(QMainWindow):
         self.pause_button = QPushButton("Pause")
         self.pause_button.clicked.connect(self._pause_or_resume)
         self.abort_button = QPushButton("Abort")
-        self.abort_button.clicked.connect(self.abort_session)
+        self.abort_button.clicked.connect(lambda: self.abort_session(confirm=True))
         self.stop_button = QPushButton("EMERGENCY STOP")
         self.stop_button.setStyleSheet(STOP_STYLE)
         self.stop_button.setToolTip("zero the force now (Esc)")
@@ -94,6 +107,8 @@ class Console(QMainWindow):
         self.state_label.setStyleSheet("font-weight: bold;")
         self.task_label = QLabel("")
         self.trial_label = QLabel("")
+        for label in (self.state_label, self.task_label, self.trial_label):
+            label.setWordWrap(True)
         self.progress_bar = QProgressBar()
         self.progress_bar.setTextVisible(True)
         self.condition_label = QLabel("")
@@ -103,6 +118,7 @@ class Console(QMainWindow):
         self.response_label = QLabel("")
         self.pickup_label = QLabel("")  # a physical knob waiting for pickup (engine/pickup.py)
         self.pickup_label.setStyleSheet("color: #06c; font-weight: bold;")
+        self.pickup_label.setWordWrap(True)
         self.response_label.setWordWrap(True)
         self.page_controls = PageControls()  # the page the participant sees; the level check's confirm
         self.page_controls.confirmed.connect(lambda: controller.acknowledge_page("experimenter"))
@@ -117,22 +133,30 @@ class Console(QMainWindow):
         p.addWidget(self.state_label)
         p.addWidget(self.task_label)
         p.addWidget(self.trial_label)
-        p.addWidget(self.page_controls)
         p.addWidget(self.progress_bar)
         p.addWidget(QLabel("Current condition:"))
         p.addWidget(self.condition_label)
         p.addWidget(self.blind)
         p.addWidget(self.response_label)
         p.addWidget(self.pickup_label)
+        details = QWidget()
+        dv = QVBoxLayout(details)
+        dv.setContentsMargins(0, 0, 0, 0)
+        dv.addWidget(self.setup)
+        dv.addWidget(progress)
+        dv.addStretch(1)
+        scroll = QScrollArea()
+        scroll.setWidget(details)
+        scroll.setWidgetResizable(True)
+        scroll.setFrameShape(QScrollArea.Shape.NoFrame)
+        scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        scroll.setMinimumWidth(details.minimumSizeHint().width() + scroll.verticalScrollBar().sizeHint().width())
         left = QWidget()
         lv = QVBoxLayout(left)
-        lv.addWidget(self.setup)
+        lv.addWidget(scroll, 1)
+        lv.addWidget(self.page_controls)  # the level check's confirm stays in view, as the buttons do
         lv.addLayout(buttons)
         lv.addWidget(self.stop_button)
-        lv.addWidget(progress)
-        lv.addStretch(1)
-        left.setMinimumWidth(340)
-        left.setMaximumWidth(440)
 
         self.scope = Scope()
         self.scope.saved.connect(lambda path: controller.message(f"scope saved to {path}"))
@@ -183,6 +207,8 @@ class Console(QMainWindow):
         splitter.addWidget(left)
         splitter.addWidget(self.tabs)
         splitter.setStretchFactor(1, 1)
+        splitter.setChildrenCollapsible(False)
+        splitter.setSizes([LEFT_WIDTH, 1000])
         self.setCentralWidget(splitter)
         self.status = StatusBar()
         self.setStatusBar(self.status)
@@ -247,9 +273,26 @@ class Console(QMainWindow):
             self.simulated = SimulatedSession(self.controller, self, self.caller, session.seed).start()
         return session
 
-    def abort_session(self):
+    def abort_session(self, confirm=False):
+        """Abort the session; ``confirm=True`` (the Abort button) asks first. Returns whether it aborted."""
+        if confirm and self.controller.in_session and not self.confirm(
+                "Abort the session?", "Abort the session now? The trials done so far are kept; the rest are not run."):
+            return False
         self._stop_simulated()
         self.controller.abort()
+        return True
+
+    def confirm(self, title, question):
+        """Ask the experimenter a yes/no question (No is the default); ``confirmation`` is the open dialog."""
+        box = QMessageBox(QMessageBox.Icon.Warning, title, question,
+                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No, self)
+        box.setDefaultButton(QMessageBox.StandardButton.No)
+        self.confirmation = box
+        try:
+            return box.exec() == QMessageBox.StandardButton.Yes
+        finally:
+            self.confirmation = None
+            box.deleteLater()
 
     def _pause_or_resume(self):
         c = self.controller
@@ -297,6 +340,7 @@ class Console(QMainWindow):
     def _on_engine(self, state, info, config):
         if state == "starting":
             self.notices = {}
+            self._midi_shown = None
         self.setup.show_engine(state, info, config, self.notices)
         self.status.show_engine(state, info)
         if state == "running":
@@ -374,13 +418,17 @@ class Console(QMainWindow):
 
     def _on_status(self, status, lost, knob_latency):
         self.status.show_status(status, lost, knob_latency)
+        midi = (status.get("midi"), self.notices.get("midi"))
+        if midi[0] is not None and midi != self._midi_shown:  # a controller plugged in (or out)
+            self._midi_shown = midi
+            self.setup.show_midi(*midi)
 
     def _on_message(self, text, level, topic):
         if topic:
             self.notices[topic] = text
         self.log.appendPlainText(("[fault] " if level == "error" else "") + text)
         if level in COLOURS:
-            self.statusBar().showMessage(text, 8000)
+            self.status.show_message(text, MESSAGE_MS, COLOURS[level])
 
     def _on_pickup(self, control, index, pending, text):
         self.pickup_label.setText(f"{control}: {text}" if pending else "")
@@ -397,6 +445,10 @@ class Console(QMainWindow):
             self.simulated = None
 
     def closeEvent(self, event):
+        if self.controller.in_session and not self.confirm(
+                "Close the console?", "A session is running. Abort it and close the console?"):
+            event.ignore()
+            return
         self.timer.stop()
         self._stop_simulated()
         self.controller.close()

@@ -32,6 +32,7 @@ from PySide6.QtWidgets import (
 )
 
 KNOB_MAX = 127
+PAD_MIN_WIDTH = 36  # px
 PARTICIPANT_DIAL = 110  # px: a large target for the mouse, eight of them fit in 1,366 px
 
 
@@ -84,7 +85,7 @@ class KnobPanel(QWidget):
             self.values.append(value)
             self.captions.append(caption)
         for i, pad in enumerate(self.pads):
-            pad.setMinimumHeight(30)
+            pad.setMinimumSize(PAD_MIN_WIDTH, 30)  # not the style's ~80 px: eight of them fit a laptop's console
             pad.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
             pad.setToolTip(f"pad {i + 1}")
             grid.addWidget(pad, 1, i)

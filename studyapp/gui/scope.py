@@ -9,6 +9,14 @@ than flattening the estimates. The force on the handle. The ticks above the
 plots, in the traces' colours, are the legend. A window of 0.1 to 5 s ends
 at the newest sample.
 
+Axes show what the signals can resolve, not the arithmetic's leftovers: after
+a stop the string decays towards 1e-33 m/s, and an axis that autoscales to
+that read "2e-33" or "pm/s". Each plot's y span is at least ``FLOOR_SIGMAS``
+times its noise floor (``NOISE_FLOORS``: the LVT's 0.115 mm/s RMS, SensorSpec,
+for both velocity plots, which are in the handle's m/s; for the force one step
+of a 16-bit output over the motor's +-200 N, 6.1 mN, as the LVDT's 16 bits),
+and an axis's SI prefix is never finer than milli (``ScopeAxis``: mm/s, mN).
+
 The scope is a view: ``add(block)`` takes the telemetry the session
 controller announces (its ``telemetry`` event) into a ``ScopeBuffer``; a
 timer repaints at most every ``FRAME_PERIOD`` seconds from the buffer's
@@ -34,7 +42,10 @@ from PySide6.QtWidgets import (
 )
 
 from studyapp.atomic import atomic_path
+from studyapp.gui.flow_layout import FlowLayout
 from studyapp.gui.frame_rate import FrameRateMeter
+from studyapp.model.device import DeviceLimits
+from studyapp.model.sensors import SensorSpec
 from studyapp.session.scope_buffer import MAX_SECONDS, ScopeBuffer
 
 FRAME_PERIOD = 0.015  # s: aim above 60 fps; the measured rate is what counts
@@ -51,10 +62,29 @@ LAST_TRACES = (
     ("string_velocity", "string velocity", "#2ca02c", "s", True),
     ("force", "force", "#ff7f0e", "f", True),
 )
+FORCE_BITS = 16
+NOISE_FLOORS = {"v": SensorSpec().lvt_noise, "s": SensorSpec().lvt_noise,
+                "f": 2 * DeviceLimits().impulsive / 2**FORCE_BITS}
+FLOOR_SIGMAS = 8  # a still signal's noise spans about +-4 sigma
+FINEST_PREFIX = 1e-3  # milli: no axis reads in micro, nano or pico
+
 ESTIMATE_COLOURS = ("#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf", "#393b79", "#637939", "#8c6d31",
                     "#843c39", "#7b4173")
 
 pg.setConfigOptions(antialias=False, foreground="k", background="w")
+
+
+class ScopeAxis(pg.AxisItem):
+    """An axis whose automatic SI prefix is never finer than ``FINEST_PREFIX``."""
+
+    def updateAutoSIPrefix(self):
+        scale, prefix = 1.0, ""
+        if self.label.isVisible():
+            largest = max(abs(self.range[0]), abs(self.range[1])) * self.scale
+            scale, prefix = pg.siScale(max(largest, FINEST_PREFIX), power=self.unitPower)
+        self.autoSIPrefixScale = scale
+        self.labelUnitPrefix = prefix
+        self._updateLabel()
 
 
 class Scope(QWidget):
@@ -81,19 +111,23 @@ class Scope(QWidget):
         self.save_button = QPushButton("Save PNG…")
         self.save_button.clicked.connect(self._choose_png)
         self.fps_label = QLabel("")
-        self.toggles = QHBoxLayout()
-        self.toggles.setSpacing(8)
+        # room for the widest reading from the start: the readout never nudges the layout
+        self.fps_label.setMinimumWidth(self.fps_label.fontMetrics().horizontalAdvance("999 fps") + 2)
+        self.toggle_box = QWidget()
+        self.toggles = FlowLayout(self.toggle_box)
 
         self.view = pg.GraphicsLayoutWidget()
-        self.velocity_plot = self.view.addPlot(row=0, col=0)
-        self.string_plot = self.view.addPlot(row=1, col=0)
-        self.force_plot = self.view.addPlot(row=2, col=0)
+        self.velocity_plot = self.view.addPlot(row=0, col=0, axisItems={"left": ScopeAxis("left")})
+        self.string_plot = self.view.addPlot(row=1, col=0, axisItems={"left": ScopeAxis("left")})
+        self.force_plot = self.view.addPlot(row=2, col=0, axisItems={"left": ScopeAxis("left")})
         self.plots = {"v": self.velocity_plot, "s": self.string_plot, "f": self.force_plot}
         for row, stretch in enumerate((3, 2, 2)):
             self.view.ci.layout.setRowStretchFactor(row, stretch)
-        for plot, label, unit in ((self.velocity_plot, "handle velocity", "m/s"),
-                                  (self.string_plot, "string velocity", "m/s"), (self.force_plot, "force", "N")):
+        for where, label, unit in (("v", "handle velocity", "m/s"), ("s", "string velocity", "m/s"),
+                                   ("f", "force", "N")):
+            plot = self.plots[where]
             plot.setLabel("left", label, units=unit)
+            plot.setLimits(minYRange=FLOOR_SIGMAS * NOISE_FLOORS[where])
             plot.setMouseEnabled(x=False, y=True)
             plot.enableAutoRange(axis="y")
             plot.setAutoVisible(y=True)
@@ -116,7 +150,7 @@ class Scope(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addLayout(top)
-        layout.addLayout(self.toggles)
+        layout.addWidget(self.toggle_box)
         layout.addWidget(self.view, 1)
 
         self.timer = QTimer(self)
@@ -132,8 +166,6 @@ class Scope(QWidget):
             plot.removeItem(curve)
             self.toggles.removeWidget(box)
             box.deleteLater()
-        while self.toggles.count():
-            self.toggles.takeAt(0)
         self.traces = {}
         specs = list(BASE_TRACES)
         specs += [(f"estimate:{name}", name, ESTIMATE_COLOURS[i % len(ESTIMATE_COLOURS)], "v", False)
@@ -152,7 +184,6 @@ class Scope(QWidget):
             curve.setVisible(on)
             self.toggles.addWidget(box)
             self.traces[channel] = (curve, box, plot)
-        self.toggles.addStretch(1)
         self.buffer = ScopeBuffer(rate, [c for c in self.traces])
         self._dirty = True
 

@@ -9,7 +9,9 @@ The apparatus lines say what the engine really opened, in words: the device
 (the simulated 1-DOF device unless a driver is configured), the audio output
 (a PortAudio device, a WAV file, or none, and why: the engine's own notice
 when it fell back to the null sink) and the MIDI input (a port, or none and
-why, in which case the on-screen knobs are the controls).
+why, in which case the on-screen knobs are the controls; or none yet, when
+the engine waits for a controller to be plugged in: ``show_midi`` follows
+the engine's status as it arrives).
 """
 
 from pathlib import Path
@@ -47,6 +49,8 @@ class SetupPanel(QWidget):
         self.protocol = QComboBox()
         self.protocol.setEditable(False)
         self.protocol.setMinimumContentsLength(18)
+        # a long path must not widen the console: the list shows it whole, the box elides
+        self.protocol.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
         for path in find_protocols():
             self.protocol.addItem(path)
         self.protocol.activated.connect(lambda index: self.protocol_chosen.emit(self.protocol.itemText(index)))
@@ -181,9 +185,7 @@ class SetupPanel(QWidget):
         if state == "running":
             audio = info.get("audio", "?")
             self.audio.setText(_with_notice(_audio_words(audio), notices.get("audio")))
-            midi = info.get("midi", "none")
-            self.midi.setText(_with_notice(f"input {midi}" if midi != "none" else "no MIDI input: on-screen knobs",
-                                           notices.get("midi")))
+            self.show_midi(info.get("midi", "none"), notices.get("midi"))
             self.engine.setText(f"{info['rate']:g} Hz, blocks of {info['block']}, paced by the {info['paced']}")
         elif state == "starting":
             for label in (self.audio, self.midi):
@@ -191,6 +193,17 @@ class SetupPanel(QWidget):
             self.engine.setText("starting…")
         else:
             self.engine.setText(state)
+
+
+    def show_midi(self, description, notice=None):
+        """The MIDI line for the engine's ``description`` of its input (and its latest MIDI notice)."""
+        if description == "none":
+            words = "no MIDI input: on-screen knobs"
+        elif description.startswith("none yet"):
+            words = f"{description}; the on-screen knobs work meanwhile"
+        else:
+            words = f"input {description}"
+        self.midi.setText(_with_notice(words, notice))
 
 
 def _audio_words(description):

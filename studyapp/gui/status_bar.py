@@ -9,17 +9,32 @@ overwrote before the console read them), plus telemetry samples the GUI lost
 (it fell more than the ring behind), the knob-to-effect latency (a control's
 arrival to the first block run with its effect, measured by the worker: the
 last and the largest) and the scope's painted frame rate. Trouble shows in red.
+
+The readouts whose text has no fixed length (the engine's state, the latched
+fault, the knob latency) and the latest warning (``show_message``, left) are
+``ElidedLabel`` widgets: they shrink to a few characters and end in "…"
+rather than widen the window; the whole text is in their tooltip. The short
+numeric readouts keep their width.
 """
 
+from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QLabel, QStatusBar
 
+from studyapp.gui.elided_label import ElidedLabel
+
 RED = "color: #c00; font-weight: bold;"
+ELIDED = ("engine", "faults", "knob")
 
 
 class StatusBar(QStatusBar):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.labels = {}
+        self.message = ElidedLabel("")
+        self.addWidget(self.message, 1)
+        self._message_timer = QTimer(self)
+        self._message_timer.setSingleShot(True)
+        self._message_timer.timeout.connect(lambda: self.message.setText(""))
         for key, tip in (
             ("engine", "the real-time engine"),
             ("rate", "samples per second achieved over the last second / nominal haptic rate"),
@@ -32,11 +47,17 @@ class StatusBar(QStatusBar):
             ("knob", "knob to effect: from a control's arrival to the first block run with it (last, largest)"),
             ("fps", "scope frames painted per second"),
         ):
-            label = QLabel("")
+            label = ElidedLabel("") if key in ELIDED else QLabel("")
             label.setToolTip(tip)
             self.addPermanentWidget(label)
             self.labels[key] = label
         self.show_engine("stopped")
+
+    def show_message(self, text, milliseconds, colour=""):
+        """Show ``text`` (elided to the room left) for ``milliseconds``."""
+        self.message.setText(text)
+        self.message.setStyleSheet(f"color: {colour};" if colour else "")
+        self._message_timer.start(milliseconds)
 
     def show_engine(self, state, info=None):
         info = info or {}

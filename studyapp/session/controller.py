@@ -88,7 +88,7 @@ conditions).
 Pause holds the loop (F_max 0, bow lifted, no knob mapping), stops the task's
 clock and ignores the participant's controls; resume gives the settings back.
 Emergency stop: at once, the engine's ``force_enable`` word in shared memory
-is cleared (the worker latches a fault and zeroes its force scale at its next
+is cleared, with the reason "operator" (the worker latches a fault and zeroes its force scale at its next
 block, ``studyapp.engine.safety``), F_max is set to 0, the bow lifted, the
 knobs unmapped. ``clear_emergency`` unlatches it and, once the engine reports
 it cleared, starts the current trial again from its beginning (as a resumed
@@ -105,6 +105,7 @@ from enum import StrEnum
 from studyapp.engine import commands as cmd
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.events import Learned
+from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.schedule import counted
@@ -449,7 +450,7 @@ class SessionController:
     def _emergency(self):
         engine = self.engine
         if engine is not None:
-            engine.status_block.force_enable = False
+            engine.status_block.disable_force("operator")
         self._reference_tone(False)
         loop = self.runner.loop if self.runner is not None else None
         if loop is not None and engine is not None and loop.engine is engine:
@@ -458,7 +459,7 @@ class SessionController:
             self._send(cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.InstallActions({}))
         if self.runner is not None and self.state != State.EMERGENCY:
             self.runner.log({"type": "emergency_stop"})
-        self.message("EMERGENCY STOP: force zeroed; press Resume to clear it", level="error")
+        self.message(force_off_text("operator"), level="error")
         self.events.bowing.emit(on=False)
         return State.EMERGENCY
 

@@ -77,6 +77,14 @@ def test_a_nan_anywhere_in_a_block_latches_until_cleared(key):
     assert loop.force_scale == 1.0 and safety.latched is None
 
 
+def test_after_a_clear_the_next_blocks_force_is_clamped_at_fmax_not_at_the_latched_scale_zero():
+    loop = FakeLoop(fmax=1.0)
+    safety = Safety(loop, motor_limits=(200.0, 60.0))
+    assert "operator" in safety.check(_block(0.5), force_enable=False, why="Emergency stop (operator): force off")
+    safety.clear()
+    assert safety.check(_block(0.5)) is None and safety.latched is None  # 0.5 N is within F_max = 1 N
+
+
 def test_a_force_beyond_its_clamp_latches():
     loop = FakeLoop(fmax=1.0)
     safety = Safety(loop, motor_limits=(200.0, 60.0))

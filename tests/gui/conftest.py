@@ -35,6 +35,31 @@ def wait_until(app, predicate, timeout, step=0.01):
         time.sleep(step)
 
 
+def answer_question(console, qtbot, button):
+    """Click ``button`` (a ``QMessageBox.StandardButton``) of the console's next question once it is open.
+
+    The question (``Console.confirm``) runs its own event loop, so the answer is set up before the
+    action that asks: a timer looks for the open question every 10 ms (for at most 10 s) and clicks.
+    """
+    from PySide6.QtCore import Qt, QTimer
+
+    timer = QTimer(console)
+    timer.setInterval(10)
+    deadline = time.monotonic() + 10.0
+
+    def click():
+        box = console.confirmation
+        if box is None and time.monotonic() < deadline:
+            return
+        timer.stop()
+        timer.deleteLater()
+        assert box is not None, "no question was asked"
+        qtbot.mouseClick(box.button(button), Qt.MouseButton.LeftButton)
+
+    timer.timeout.connect(click)
+    timer.start()
+
+
 @pytest.fixture(scope="package")
 def console(qapp):
     from studyapp.gui.console import Console
@@ -48,6 +73,8 @@ def console(qapp):
     wait_until(qapp, lambda: controller.engine is not None or controller.host.state == "failed", ENGINE_START)
     assert controller.host.state == "running", controller.host.error
     yield window
+    if controller.in_session:
+        window.abort_session()  # closing mid-session would ask (Console.confirm)
     window.close()
 
 

@@ -134,7 +134,7 @@ def test_emergency_stop_zeroes_force(idle_console, qapp):
     engine = c.host.engine
     pressed_at = engine.ring.committed  # samples written before the click
     console.stop_button.click()
-    assert c.emergency and console.state_label.text().startswith("EMERGENCY STOP")
+    assert c.emergency and console.state_label.text().startswith("Emergency stop (operator): force off")
     assert engine.force_output == 0.0
     wait_until(qapp, lambda: engine.status()["fault_latched"], 2)
     assert engine.status()["force_scale"] == 0.0

@@ -167,6 +167,8 @@ def session_console(qapp, jack_server):
     window.show()
     window.participant_window.show()
     yield window
+    if controller.in_session:
+        window.abort_session()  # closing mid-session would ask (Console.confirm)
     window.close()
 
 

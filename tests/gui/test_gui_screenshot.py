@@ -38,3 +38,23 @@ def test_screenshot_of_the_running_console(xvfb_display, tmp_path):
     force_orange = np.all(np.abs(pixels.astype(int) - (255, 127, 14)) <= 1, axis=1)
     assert force_orange.sum() > 500  # the scope drew the force of the bowing
     assert not (tmp_path / "results").exists()  # a screenshot runs no session
+
+
+def test_screenshot_at_a_lab_laptops_size_with_the_papers_protocol(xvfb_display, tmp_path):
+    from matplotlib.image import imread
+
+    path = tmp_path / "console-1366x768.png"
+    env = {**os.environ, "QT_QPA_PLATFORM": "xcb", "DISPLAY": xvfb_display}
+    done = subprocess.run(
+        [sys.executable, "-m", "studyapp", "gui", "--protocol", str(ROOT / "protocols" / "sinclair2014.toml"),
+         "--screenshot", str(path), "--size", "1366x768", "--audio", "null", "--midi", "none",
+         "--results", str(tmp_path / "results")],
+        cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    image = imread(path)[:, :, :3]
+    assert image.shape[:2] == (768, 1366)  # the window at the asked size: nothing forced it wider
+    pixels = (image.reshape(-1, 3) * 255).round().astype(np.uint8)
+    stop_red = np.all(pixels == (204, 0, 0), axis=1)
+    assert stop_red.mean() > 0.005  # the EMERGENCY STOP button is in the picture
+    force_orange = np.all(np.abs(pixels.astype(int) - (255, 127, 14)) <= 1, axis=1)
+    assert force_orange.sum() > 500  # the scope drew the force

@@ -5,10 +5,11 @@ from pathlib import Path
 
 import pytest
 from PySide6.QtCore import QPoint, Qt
+from PySide6.QtWidgets import QMessageBox
 
 from studyapp.experiment.export import export_responses
 from studyapp.model.fmax_knob import fmax_from_knob
-from tests.gui.conftest import DEMO, ENGINE_START, wait_until
+from tests.gui.conftest import DEMO, ENGINE_START, answer_question, wait_until
 
 pytest.importorskip("pytestqt")
 
@@ -138,7 +139,8 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
     wait_until(qapp, lambda: console.trial_label.text() == "Trial 1 of 1, step 2 of 2", 10)
 
-    # abort; starting the participant again is refused; resuming continues at trial 2
+    # abort (answering its question); starting the participant again is refused; resuming continues at trial 2
+    answer_question(console, qtbot, QMessageBox.StandardButton.Yes)
     qtbot.mouseClick(console.abort_button, Qt.MouseButton.LeftButton)
     assert c.state == "aborted" and console.start_button.isEnabled()
     qtbot.mouseClick(console.start_button, Qt.MouseButton.LeftButton)

@@ -28,6 +28,11 @@ class SteppingClock:
 
 class FakeStatusBlock:
     force_enable = True
+    force_off_reason = "parent"
+
+    def disable_force(self, reason, silence=0.0):
+        self.force_off_reason = reason
+        self.force_enable = False
 
 
 class FakeEngine:
