@@ -101,7 +101,7 @@ def run(app, protocol, out, size, results):
         if wanted:
             raise RuntimeError(f"the session showed no {', '.join(sorted(wanted))}")
     finally:
-        console.close()
+        console.shut_down()
     return written
 
 

@@ -117,7 +117,7 @@ def one_run(app, protocol, audio, results, participant):
                 "ack_to_sound": seen["sound"] - acknowledged if acknowledged is not None else None,
                 "start_to_sound": seen["sound"] - start if acknowledged is None else None}
     finally:
-        console.close()
+        console.shut_down()
 
 
 def summary(values):

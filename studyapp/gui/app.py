@@ -101,9 +101,9 @@ def main(args):
     if getattr(args, "start", False) and not (getattr(args, "screenshot", None) or getattr(args, "measure_scope", None)):
         _start_when_possible(console, getattr(args, "seed", None))
     # Ctrl-C in the terminal closes the console cleanly (Python sees signals between Qt events)
-    signal.signal(signal.SIGINT, lambda *_: console.close())
+    signal.signal(signal.SIGINT, lambda *_: console.shut_down())
     code = app.exec()
-    console.close()
+    console.shut_down()  # an unattended run may leave a session running: no one to ask
     return code
 
 

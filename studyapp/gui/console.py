@@ -13,7 +13,8 @@ proportion to what it says (long texts wrap or elide, ``ElidedLabel``), so
 the console fits a 1,366 x 768 screen.
 
 Abort, and closing the console, while a session runs ask first (``confirm``;
-``abort_session(confirm=False)``, the default, is the programmatic abort).
+``abort_session(confirm=False)``, the default, is the programmatic abort, and
+``shut_down()`` closes without asking).
 
 Every widget is a view of the ``SessionController`` (``studyapp.session``, no
 Qt in it): widgets call its methods, and its events update the widgets.
@@ -443,6 +444,12 @@ class Console(QMainWindow):
         if self.simulated is not None:
             self.simulated.stop()
             self.simulated = None
+
+    def shut_down(self):
+        """Close without asking: a running session is aborted first (Ctrl-C, unattended runs, scripts)."""
+        if self.controller.in_session:
+            self.abort_session()
+        self.close()
 
     def closeEvent(self, event):
         if self.controller.in_session and not self.confirm(

@@ -73,9 +73,7 @@ def console(qapp):
     wait_until(qapp, lambda: controller.engine is not None or controller.host.state == "failed", ENGINE_START)
     assert controller.host.state == "running", controller.host.error
     yield window
-    if controller.in_session:
-        window.abort_session()  # closing mid-session would ask (Console.confirm)
-    window.close()
+    window.shut_down()  # close() mid-session would ask (Console.confirm)
 
 
 @pytest.fixture

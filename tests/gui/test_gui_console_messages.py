@@ -145,3 +145,12 @@ def test_the_apparatus_panel_follows_a_controller_plugged_in(idle_console, qapp)
         assert console.setup.midi.text().startswith(words)
     assert "on-screen knobs work meanwhile" in console.setup.midi.text()
     c.events.status.emit(status=status, lost=0, knob_latency=(None, None))  # the engine's own again
+
+
+def test_shut_down_closes_mid_session_without_asking(fake_console, monkeypatch):
+    console = fake_console
+    console.start_session(seed=3)
+    assert console.controller.in_session
+    refuse_questions(console, monkeypatch)
+    console.shut_down()  # Ctrl-C, an unattended run, a script: no one to ask
+    assert not console.isVisible() and not console.controller.in_session

@@ -167,9 +167,7 @@ def session_console(qapp, jack_server):
     window.show()
     window.participant_window.show()
     yield window
-    if controller.in_session:
-        window.abort_session()  # closing mid-session would ask (Console.confirm)
-    window.close()
+    window.shut_down()  # close() mid-session would ask (Console.confirm)
 
 
 def test_a_participant_runs_a_whole_session_with_a_midi_controller(session_console, qapp, qtbot, tmp_path):

@@ -79,9 +79,7 @@ def paged_console(qapp, tmp_path):
     controller.events.status.disconnect(window._on_status)  # the fake engine keeps no loop statistics
     assert window.choose_protocol(str(path))
     yield window
-    if controller.in_session:
-        window.abort_session()  # closing mid-session would ask (Console.confirm)
-    window.close()
+    window.shut_down()  # close() mid-session would ask (Console.confirm)
 
 
 def up(controller):
