@@ -186,13 +186,19 @@ def test_bad_participant_options_are_one_line(qapp, settings_in, argv, words, ca
     assert err.startswith(f"studyapp: error: {words}") and "\n" not in err
 
 
-def test_participant_screenshot_waits_for_the_first_trial_then_saves(qapp, tmp_path, capsys):
+def test_participant_screenshot_waits_for_the_first_trial_then_saves(qapp, tmp_path, capsys, monkeypatch):
     from types import SimpleNamespace
 
     from PySide6.QtWidgets import QWidget
 
+    from studyapp.gui import participant_screenshot
     from studyapp.gui.participant_screenshot import ParticipantScreenshot
     from studyapp.gui.participant_window import ParticipantWindow
+
+    # no event loop runs here: a real exit() would make every later dialog's exec() return at once
+    exits = []
+    monkeypatch.setattr(participant_screenshot, "QApplication",
+                        SimpleNamespace(instance=lambda: SimpleNamespace(exit=exits.append)))
 
     now = [0.0]
     controller = SimpleNamespace(host=SimpleNamespace(state="starting", error=None), state="starting",
@@ -218,3 +224,4 @@ def test_participant_screenshot_waits_for_the_first_trial_then_saves(qapp, tmp_p
     err = capsys.readouterr().err.strip()
     assert err == "studyapp gui: error: nothing to show after 30 s (engine running, session starting)"
     assert not (tmp_path / "late.png").exists()
+    assert exits == [0, 1]
