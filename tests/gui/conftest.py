@@ -49,7 +49,7 @@ def answer_question(console, qtbot, button):
 
     def click():
         box = console.confirmation
-        if box is None and time.monotonic() < deadline:
+        if (box is None or not box.isVisible()) and time.monotonic() < deadline:
             return
         timer.stop()
         timer.deleteLater()

@@ -86,10 +86,11 @@ CONTROLLER = textwrap.dedent("""
     out = rtmidi.MidiOut(rtmidi.API_UNIX_JACK, "lpd8")
     for line in sys.stdin:
         word, *args = line.split()
-        if word == "connect":   # the one engine's port (a replaced engine's may still be closing)
+        if word == "connect":   # the engine's virtual port (a replaced engine's may still be closing;
+            # another console's engine waiting for a controller has a port of its own, "studyapp-PID:...")
             end = time.monotonic() + 30
             while True:
-                ports = [i for i, name in enumerate(out.get_ports()) if "studyapp MIDI in" in name]
+                ports = [i for i, name in enumerate(out.get_ports()) if name == "studyapp:studyapp MIDI in"]
                 if len(ports) == 1 or time.monotonic() > end:
                     break
                 time.sleep(0.05)
