@@ -1,6 +1,7 @@
 """``studyapp run --protocol FILE --participant ID [--simulated-participant] [--headless]
 [--resume] [--results DIR] [--seed N] [--experimenter NAME] [--session-number N] [--notes TEXT]
-[--order-row N]``: run one participant's session.
+[--order-row N] [--audio SPEC] [--midi SPEC] [--participant-screen N] [--replay-gesture EVENTS]``:
+run one participant's session.
 
 The experimenter's fields and the order row are stored in session.json
 (``experiment.session_info`` says what is allowed); the order row in force is
@@ -11,7 +12,14 @@ without a display: the closed loop is stepped directly and the simulated
 participant plays every trial (the demo, the end-to-end check, an in-silico
 pilot). Progress goes to stderr; the session folder is printed on stdout.
 Without ``--headless`` the session runs in the experimenter console
-(``studyapp.gui.run_session(args)``).
+(``studyapp.gui.run_session(args)``), with ``--audio``, ``--midi`` and
+``--participant-screen`` as ``studyapp gui`` takes them; the participant's
+window opens full-screen on the chosen screen, or on the screen this machine
+remembers (a resumed session after a crash gets its participant screen back).
+
+``--replay-gesture EVENTS`` (a session's events.jsonl, or its folder): the
+simulated participant's hand moves as that session's participant bowed
+(its ``hand_trace`` records, experiment/hand_trace.py), trial by trial.
 """
 
 from studyapp.cli.session_info_options import add_session_info_options, session_info_of
@@ -30,8 +38,32 @@ def register(sub):
     parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
     parser.add_argument("--seed", type=int, default=None, metavar="N",
                         help="session seed (default: from the study seed and the participant's enrolment)")
+    parser.add_argument("--audio", default=None, metavar="SPEC",
+                        help="the console's sound: device | device:NAME | wav:FILE | null (default: device)")
+    parser.add_argument("--midi", default=None, metavar="SPEC",
+                        help="the console's MIDI input: PORT | first | virtual | none (default: first)")
+    parser.add_argument("--participant-screen", type=int, metavar="N",
+                        help="the participant's window full-screen on screen N (from 0; remembered on this machine)")
+    parser.add_argument("--replay-gesture", metavar="EVENTS",
+                        help="the simulated participant bows as logged in EVENTS (a session's events.jsonl "
+                             "or folder; needs --simulated-participant)")
     add_session_info_options(parser)
     parser.set_defaults(func=run)
+
+
+def replay_traces(path):
+    """{step: hand_trace record} from ``path`` (a session's events.jsonl, or its folder); ``UserError`` if none."""
+    from pathlib import Path
+
+    from studyapp.errors import UserError
+    from studyapp.experiment.hand_trace import load_traces
+    from studyapp.experiment.session_log import read_events
+
+    path = Path(path)
+    events = path / "events.jsonl" if path.is_dir() else path
+    if not events.is_file():
+        raise UserError(f"--replay-gesture {path}: not found: allowed is a session's events.jsonl or its folder")
+    return load_traces(read_events(events), f"--replay-gesture {events}")
 
 
 def run(args):
@@ -52,12 +84,22 @@ def run(args):
         raise UserError(f"--seed {args.seed}: allowed is an integer from 0 to 2**63 - 1")
     if args.headless and not args.simulated_participant:
         raise UserError("--headless: allowed only with --simulated-participant (a person takes part through the GUI)")
+    if args.headless:
+        for option in ("midi", "participant_screen"):
+            if getattr(args, option) is not None:
+                raise UserError(f"--{option.replace('_', '-')}: allowed only without --headless (the console's)")
+    if args.replay_gesture is not None and not args.simulated_participant:
+        raise UserError("--replay-gesture: allowed only with --simulated-participant (it moves the simulated hand)")
+    args.replay = replay_traces(args.replay_gesture) if args.replay_gesture is not None else None
     protocol = load_protocol(args.protocol)
     check_order_row(protocol, args.order_row)
     output_paths.check_folder(args.results, "--results")
     if not args.headless:
+        args.audio = args.audio or "device"
+        args.midi = args.midi or "first"
         return _run_in_gui(args)
 
+    from studyapp.experiment.hand_trace import ReplayingHand
     from studyapp.experiment.session import Session
     from studyapp.experiment.session_log import LogWriteError
     from studyapp.experiment.session_runner import SessionRunner
@@ -80,7 +122,8 @@ def run(args):
     runner = SessionRunner(session, progress=progress)
     try:
         runner.begin()
-        SimulatedParticipant(session.seed).play(runner)
+        player = runner if args.replay is None else ReplayingHand(runner, args.replay)
+        SimulatedParticipant(session.seed).play(player)
         complete = runner.finish()
     except BaseException as exc:
         if not isinstance(exc, LogWriteError):

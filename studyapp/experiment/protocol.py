@@ -2,7 +2,9 @@
 
 A protocol says everything a session needs (paper Sec. 8): the haptic rate,
 the estimator parameters (Table 1 unless overridden), the study-wide seed of
-the Latin squares, the tasks to run in order, and one table per task: its
+the Latin squares, the title the participant's screen shows (``participant_title``,
+neutral by default: the study's ``title`` may state its aim, which the
+participant must not see), the tasks to run in order, and one table per task: its
 conditions, instructions and fields, which the task type reads and checks
 (``studyapp.experiment.tasks``; e.g. the rating task's constant F_max, 1 N in
 the paper, or the adjustment knob's F_max ceiling and how many decades its
@@ -29,6 +31,9 @@ from studyapp.small_files import parse_toml, read_bytes
 
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
 NAME_ALLOWED = "1 to 32 letters, digits, '_' or '-'"
+# what the participant's screen calls the study unless [study] participant_title says otherwise: the
+# protocol's own title often states the study's aim, which must not reach the participant (blinding)
+PARTICIPANT_TITLE = "Listening study"
 
 
 @dataclass(frozen=True)
@@ -47,6 +52,7 @@ class Protocol:
     estimators: dict = field(default_factory=dict)
     specs: dict = field(default_factory=dict)  # task name -> its validated spec (the task type's parse)
     pages: tuple = ()  # the [[pages]] (studyapp.experiment.pages.Page), in file order
+    participant_title: str = PARTICIPANT_TITLE  # the title the participant sees (never ``title``)
 
     def task(self, name):
         return self.specs[name]
@@ -60,6 +66,7 @@ class Protocol:
         out = {
             "study": self.study,
             "title": self.title,
+            "participant_title": self.participant_title,
             "tasks": list(self.tasks),
             "seed": self.seed,
             "rate": self.rate,
@@ -173,6 +180,7 @@ def parse_protocol(text, source="<protocol>"):
     study = _table(source, document, "study")
     name = study.string("name", NAME_ALLOWED, pattern=NAME_PATTERN)
     title = study.string("title", default=name)
+    participant_title = study.string("participant_title", default=PARTICIPANT_TITLE)
     tasks_allowed = "a list of the tasks to run, in order, from: " + ", ".join(repr(t) for t in task_names())
     tasks = study.get("tasks", tasks_allowed)
     if (not isinstance(tasks, list) or not tasks or not all(isinstance(t, str) for t in tasks)
@@ -233,6 +241,7 @@ def parse_protocol(text, source="<protocol>"):
         estimators=overrides,
         specs=specs,
         pages=pages,
+        participant_title=participant_title.strip(),
     )
 
 

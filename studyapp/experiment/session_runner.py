@@ -15,6 +15,14 @@ reads, and ``advance`` only ticks the page's clock. A task whose protocol
 table says ``bow = "auto"`` gets the bow on the string at each trial's start
 (logged as a ``bowing`` record).
 
+The hand. Every change of the hand's gesture is logged (``gesture``, with
+``from``), including the return to the protocol's gesture when the next
+trial's loop starts with it. ``set_hand_target`` moves the hand's target
+with the ``live`` gesture (the participant's bowing surface); those targets
+and the bow's changes form the trial's ``hand_trace`` record, logged when the
+trial ends (experiment/hand_trace.py), on the trial's ``clock`` (s of loop
+time run).
+
 The current trial is the state machine its task type makes
 (``studyapp.experiment.tasks``). The loop is made per trial by
 ``make_loop(estimators, source, seed)`` with the conditions the task type asks
@@ -35,6 +43,7 @@ sudden return to a high F_max could be unsafe on a real device).
 import numpy as np
 
 from studyapp import __version__
+from studyapp.experiment.hand_trace import HandTrace
 from studyapp.experiment.session_log import LogWriteError
 from studyapp.experiment.tasks import task_type
 
@@ -63,6 +72,9 @@ class SessionRunner:
         self.loop = None
         self.bowing = False
         self.gesture = None
+        self.clock = 0.0  # s of loop time the current trial has run
+        self.trace = HandTrace()  # the participant's gesture in the current trial (hand_trace.py)
+        self._last_gesture = None  # the gesture the last trial's loop ended with
         self._loop_source = None
         self._loop_fmax = None
         self._broken = False
@@ -90,6 +102,7 @@ class SessionRunner:
 
     def start_trial(self):
         """Make the next unfinished trial current and return it (None when the session is done)."""
+        self._log_trace()
         trial = self.session.next_trial()
         self.trial, self.task, self.loop = trial, None, None
         if trial is None:
@@ -111,9 +124,15 @@ class SessionRunner:
         self._fault = None
         self.bowing = False
         self.gesture = p.gesture
+        self.clock = 0.0
         self.log({"type": "trial_start", "trial": trial.trial, "condition": trial.condition,
                   "conditions": list(trial.conditions), "restart": bool(earlier),
                   "restored_knobs": restored, "loop_seed": seed})
+        if self.loop is not None:
+            if self._last_gesture not in (None, p.gesture):  # a change for one trial ends: logged too
+                self.log({"type": "gesture", "name": p.gesture, "from": self._last_gesture,
+                          "reason": "a trial starts with the protocol's gesture"})
+            self._last_gesture = p.gesture
         self._apply()
         if getattr(spec, "bow", None) == "auto":
             self.set_bowing(True)
@@ -142,6 +161,7 @@ class SessionRunner:
         self._apply()
         if response is not None:
             self.set_bowing(False)
+            self._log_trace()
             self.progress(f"    response: {self._summary(response)}")
         return records
 
@@ -170,13 +190,27 @@ class SessionRunner:
             self.loop.set_bowing(on)
             self.bowing = on
             self.log({"type": "bowing", "on": on})
+            self.trace.bow(self.clock, on)
 
     def set_gesture(self, name):
-        """Change how the virtual hand moves the handle (e.g. ``strokes``, or ``hold`` to rest the bow)."""
+        """Change how the virtual hand moves the handle (e.g. ``strokes``, ``hold`` to rest the bow, ``live``)."""
         if self.loop is not None and name != self.gesture:
             self.loop.set_gesture(name)
-            self.gesture = name
-            self.log({"type": "gesture", "name": name})
+            self.log({"type": "gesture", "name": name, "from": self.gesture})
+            self.gesture = self._last_gesture = name
+
+    def set_hand_target(self, x_m):
+        """The participant's hand wants the handle at ``x_m`` (m): followed with the ``live`` gesture, and traced."""
+        if self.loop is not None and self.gesture == "live":
+            self.loop.set_hand_target(x_m)
+            self.trace.move(self.clock, x_m, self.bowing)
+
+    def _log_trace(self):
+        """The current trial's gesture as performed, once (when it ends)."""
+        trace, self.trace = self.trace, HandTrace()
+        record = trace.record(self.trial.trial) if self.trial is not None else None
+        if record is not None:
+            self.log(record)
 
     def advance(self, seconds):
         """Run the loop for ``seconds`` (whole samples), tick the task, and return the loop's block.
@@ -187,6 +221,7 @@ class SessionRunner:
             return None
         n = max(1, int(round(seconds * self.loop.rate)))
         block = self.loop.run(n)
+        self.clock += n / self.loop.rate
         broken = bool(self.loop.monitor.broken)
         if broken != self._broken:
             self._broken = broken
@@ -200,6 +235,7 @@ class SessionRunner:
 
     def finish(self, reason="done"):
         """Log the end of this run; and of the session, when every trial has a response."""
+        self._log_trace()
         self.trial, self.task = None, None
         complete = self.session.complete
         if complete:

@@ -63,6 +63,7 @@ def build(args):
     console.setup.results.setText(str(getattr(args, "results", "results")))
     console.setup.resume.setChecked(bool(getattr(args, "resume", False)))
     console.setup.simulated.setChecked(bool(getattr(args, "simulated_participant", False)))
+    console.replay = getattr(args, "replay", None)
     console.setup.fill_session_info(**{key: getattr(args, key, None)
                                        for key in ("experimenter", "session_number", "notes", "order_row")})
     return controller, console

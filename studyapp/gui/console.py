@@ -79,6 +79,7 @@ class Console(QMainWindow):
         super().__init__(parent)
         self.controller = controller
         self.simulated = None
+        self.replay = None  # {step: hand_trace}: the simulated participant's hand replays them (run --replay-gesture)
         self.notices = {}
         self.confirmation = None
         self._midi_shown = None
@@ -271,7 +272,8 @@ class Console(QMainWindow):
             return None
         self.setup.show_error("")
         if self.setup.simulated.isChecked():
-            self.simulated = SimulatedSession(self.controller, self, self.caller, session.seed).start()
+            self.simulated = SimulatedSession(self.controller, self, self.caller, session.seed,
+                                              replay=self.replay).start()
         return session
 
     def abort_session(self, confirm=False):
@@ -317,6 +319,10 @@ class Console(QMainWindow):
         else:
             self.bow_button.setChecked(bool(on))
 
+    def move_hand(self, x_m):
+        """The hand's target, as the participant's bowing surface moves it."""
+        self.controller.bow_move(x_m)
+
     def set_gesture(self, name):
         index = self.gesture.findText(name)
         self.gesture.setCurrentIndex(index)
@@ -334,7 +340,7 @@ class Console(QMainWindow):
 
     # views of the controller's events --------------------------------------------
     def _on_protocol(self, protocol):
-        self.participant_window.show_title(protocol.title)
+        self.participant_window.show_title(protocol.participant_title)  # never the aim
         self.setWindowTitle(f"studyapp — experimenter console — {protocol.title}")
         self.knobs.set_captions([])
 

@@ -774,8 +774,7 @@ class SessionController:
 
     def _hand_target(self, x_m):
         if self.playing:
-            if self.runner.gesture == "live" and self.runner.loop is not None:
-                self.runner.loop.set_hand_target(x_m)
+            self.runner.set_hand_target(x_m)  # followed with the live gesture, and traced
         else:
             self.engine.send(cmd.SetHandTarget(float(x_m)))
 

@@ -6,7 +6,9 @@ In a console it runs on its own thread against ``ParticipantProxy``, which acts
 out every call on the GUI thread (``act`` runs a function there and waits for
 it) through the console's widgets: ``knob`` turns the on-screen knob, ``pad``
 clicks the on-screen pad, ``set_bowing`` toggles the Bow button and
-``set_gesture`` picks the hand's gesture, and ``acknowledge_page`` presses a
+``set_gesture`` picks the hand's gesture, ``set_hand_target`` moves the
+hand as the participant's bowing surface does (a replayed gesture,
+``replay``: experiment/hand_trace.py), and ``acknowledge_page`` presses a
 page's Continue (or, for the headphone level check, the experimenter's
 confirm), just as a mouse would. A knob or
 pad goes to the engine's worker, which applies its action and reports it
@@ -28,6 +30,7 @@ import time
 
 import numpy as np
 
+from studyapp.experiment.hand_trace import ReplayingHand
 from studyapp.experiment.simulated_participant import SimulatedParticipant
 from studyapp.session.controller import PAGE_SETTLE_S
 
@@ -116,6 +119,11 @@ class ParticipantProxy:
         self._wait_running()
         self.act(lambda: self.controls.set_gesture(name))
 
+    def set_hand_target(self, x_m):
+        """The hand's target, as the participant's bowing surface moves it (a replayed gesture)."""
+        self._wait_running()
+        self.act(lambda: self.controls.move_hand(x_m))
+
     def acknowledge_page(self, by):
         self._wait_running()
         while by == "participant" and self.controller.page_age() < PAGE_SETTLE_S:  # a reader is not that quick
@@ -142,9 +150,10 @@ class ParticipantProxy:
 class SimulatedSession:
     """Runs ``SimulatedParticipant(seed).play`` on a thread; ``stop()`` ends it."""
 
-    def __init__(self, controller, controls, act, seed, **participant):
+    def __init__(self, controller, controls, act, seed, replay=None, **participant):
         self.stop_event = threading.Event()
         self.proxy = ParticipantProxy(controller, controls, act, self.stop_event)
+        self.player = self.proxy if not replay else ReplayingHand(self.proxy, replay)
         self.participant = SimulatedParticipant(seed, **participant)
         self.error = None
         self.done = False
@@ -156,7 +165,7 @@ class SimulatedSession:
 
     def _play(self):
         try:
-            self.participant.play(self.proxy)
+            self.participant.play(self.player)
         except Stopped:
             pass
         except Exception as exc:  # noqa: BLE001 - shown in the console, not lost on a thread
