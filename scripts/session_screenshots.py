@@ -1,6 +1,7 @@
 """Screenshots of a session, step by step, for docs/gui.md: taken by the console itself while it runs one.
 
     PYTHONPATH=. python scripts/session_screenshots.py DIR [--protocol FILE] [--size 1366x768]
+        [--only NAME ...] [--suffix TEXT]
 
 Runs one session of ``--protocol`` (default protocols/demo.toml) through the real console and participant
 window (offscreen Qt unless QT_QPA_PLATFORM says otherwise; engine audio and MIDI off), played with the
@@ -10,10 +11,14 @@ own rendering (``studyapp.gui.screenshot.save_widget``, as ``studyapp gui --scre
 
 - participant-welcome.png: the first page;
 - participant-rating.png: the first real rating trial, its knobs turned, bowing;
+- participant-bowing.png: that trial, the participant bowing on the bowing surface (a mouse press and
+  drag synthesised on it, bowing_surface.py), taken with the other pictures;
 - participant-break.png: the first break page;
 - console-trial.png: the console during that rating trial (the scope after a second of bowing).
 
-Prints each path written.
+``--only welcome rating break`` takes just those (stopping as soon as they are taken: ``--only rating``
+stops in the rating task); ``--suffix`` is added to each file name (e.g. ``-1366x768``). Prints each path
+written.
 """
 
 import argparse
@@ -38,7 +43,20 @@ def wait(app, predicate, what, timeout=TIMEOUT):
         time.sleep(0.005)
 
 
-def run(app, protocol, out, size, results):
+def bow_on_surface(app, surface, fraction):
+    """Press the mouse on the participant's bowing surface and drag it to ``fraction`` of its width."""
+    from PySide6.QtCore import QPoint, Qt
+    from PySide6.QtTest import QTest
+
+    y = surface.height() // 2
+    QTest.mousePress(surface, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, QPoint(surface.width() // 2, y))
+    for k in range(1, 11):
+        x = surface.width() // 2 + round(k / 10 * (fraction - 0.5) * surface.width())
+        QTest.mouseMove(surface, QPoint(x, y))
+        app.processEvents()
+
+
+def run(app, protocol, out, size, results, wanted=("welcome", "rating", "break"), suffix=""):
     from studyapp.gui.console import Console
     from studyapp.gui.screenshot import save_widget
     from studyapp.session.controller import PAGE_SETTLE_S, SessionController
@@ -54,7 +72,7 @@ def run(app, protocol, out, size, results):
     def shoot(widget, name):
         for _ in range(5):
             app.processEvents()
-        written.append(save_widget(widget, out / name))
+        written.append(save_widget(widget, out / name.replace(".png", f"{suffix}.png")))
 
     try:
         if not console.choose_protocol(str(protocol)):
@@ -65,7 +83,7 @@ def run(app, protocol, out, size, results):
         console.setup.experimenter.setText("AB")
         console.start_button.click()
         wait(app, lambda: c.playing or c.state == "aborted", "session engine")
-        wanted = {"welcome", "rating", "break"}
+        wanted = set(wanted)
         while wanted and c.state != "finished":
             trial, task = c.runner.trial, c.runner.task
             step = trial.step
@@ -81,13 +99,20 @@ def run(app, protocol, out, size, results):
                     console.turn_knob(knob, value)
                     wait(app, lambda: task.values[task.conditions[knob]] == value, "knob")
                     if not c.runner.bowing:
-                        participant.toggle_bowing()
+                        if participant.surface.isVisible():
+                            bow_on_surface(app, participant.surface, 0.62)
+                        else:
+                            participant.toggle_bowing()
                     wait(app, lambda: task.heard[task.conditions[knob]] >= max(task.min_listen_s, 0.3), "listening")
                 if not trial.practice and "rating" in wanted:
                     wanted.discard("rating")
                     wait(app, lambda: task.elapsed >= 1.5, "a second of the scope")
                     shoot(participant, "participant-rating.png")
+                    if participant.surface.isVisible():
+                        shoot(participant, "participant-bowing.png")
                     shoot(console, "console-trial.png")
+                    if not wanted:
+                        break
                 console.press_pad(task.confirm_pad)
             else:
                 console.turn_knob(0, 0)
@@ -110,6 +135,9 @@ def main(argv=None):
     parser.add_argument("dir", help="where the PNGs go")
     parser.add_argument("--protocol", default=str(ROOT / "protocols" / "demo.toml"), help="default protocols/demo.toml")
     parser.add_argument("--size", default="1366x768", help="both windows' size, WxH (default 1366x768)")
+    parser.add_argument("--only", nargs="+", default=["welcome", "rating", "break"],
+                        choices=["welcome", "rating", "break"], help="the pictures to take (default: all)")
+    parser.add_argument("--suffix", default="", help="added to each file name, e.g. -1366x768")
     args = parser.parse_args(argv)
     size = tuple(int(n) for n in args.size.split("x"))
     from PySide6.QtWidgets import QApplication
@@ -118,7 +146,7 @@ def main(argv=None):
     out = Path(args.dir)
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
-        for path in run(app, Path(args.protocol), out, size, Path(tmp) / "results"):
+        for path in run(app, Path(args.protocol), out, size, Path(tmp) / "results", args.only, args.suffix):
             print(path)
     return 0
 

@@ -12,6 +12,14 @@ rate). The two sides share a splitter, and no widget asks for width in
 proportion to what it says (long texts wrap or elide, ``ElidedLabel``), so
 the console fits a 1,366 x 768 screen.
 
+It opens at ``PREFERRED_SIZE`` or, on a smaller screen, within the
+screen's available area, maximised (``fit_screen``). None of its buttons
+takes the keyboard focus (``keep_space_for_the_bow``): a focused button
+would take the participant's space bar, and a space press would then pause
+the session (pause is a deliberate click); a space press that reaches the
+console goes to the participant's bow instead, as in the participant's
+window.
+
 Abort, and closing the console, while a session runs ask first (``confirm``;
 ``abort_session(confirm=False)``, the default, is the programmatic abort, and
 ``shut_down()`` closes without asking).
@@ -25,8 +33,9 @@ thread never blocks on the engine.
 """
 
 from PySide6.QtCore import Qt, QTimer
-from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtGui import QAction, QGuiApplication, QKeySequence
 from PySide6.QtWidgets import (
+    QAbstractButton,
     QCheckBox,
     QComboBox,
     QGroupBox,
@@ -72,6 +81,7 @@ STATE_WORDS = {
 COLOURS = {"error": "#c00", "warning": "#a60"}
 MESSAGE_MS = 8000  # how long a warning stays in the status bar
 LEFT_WIDTH = 360  # px: the set-up side's share of the splitter at first
+PREFERRED_SIZE = (1500, 940)  # px, where the screen has room for it
 
 
 class Console(QMainWindow):
@@ -218,6 +228,10 @@ class Console(QMainWindow):
         self.participant_window = ParticipantWindow(controller)
         self.participant_window.knobs.knob_turned.connect(controller.knob)
         self.participant_window.knobs.pad_pressed.connect(controller.pad)
+        surface = self.participant_window.surface  # the participant's bowing surface: as the bowing pad
+        surface.bow_pressed.connect(controller.bow_press)
+        surface.bow_moved.connect(controller.bow_move)
+        surface.bow_released.connect(controller.bow_release)
         self.participant_window.page_view.continued.connect(lambda: controller.acknowledge_page("participant"))
         self.show_participant = QAction("Participant window", self, checkable=True)
         self.show_participant.toggled.connect(self.participant_window.setVisible)
@@ -248,7 +262,31 @@ class Console(QMainWindow):
         self.timer.timeout.connect(self._tick)
         self.timer.start()
         self._on_state(state=controller.state)
-        self.resize(1500, 940)
+        self.keep_space_for_the_bow()
+        self.fit_screen()
+
+    def keep_space_for_the_bow(self):
+        """No button or gesture box of the console takes the keyboard focus (the set-up fields keep theirs)."""
+        for widget in [*self.findChildren(QAbstractButton), self.gesture]:
+            if not self.setup.isAncestorOf(widget):
+                widget.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+
+    def fit_screen(self, screen=None):
+        """``PREFERRED_SIZE``, or the available area of ``screen`` (default: the primary one) if smaller."""
+        screen = screen or self.screen() or QGuiApplication.primaryScreen()
+        area = screen.availableGeometry()
+        width, height = min(PREFERRED_SIZE[0], area.width()), min(PREFERRED_SIZE[1], area.height())
+        self.resize(width, height)
+        self.move(area.x() + (area.width() - width) // 2, area.y() + (area.height() - height) // 2)
+        small = (width, height) != PREFERRED_SIZE
+        self.setWindowState(self.windowState() | Qt.WindowState.WindowMaximized if small
+                            else self.windowState() & ~Qt.WindowState.WindowMaximized)
+
+    def keyPressEvent(self, event):
+        if event.key() == Qt.Key.Key_Space:  # the participant's space bar: the bow, never a button
+            self.participant_window.keyPressEvent(event)
+            return
+        super().keyPressEvent(event)
 
     # actions --------------------------------------------------------------
     def choose_protocol(self, path):

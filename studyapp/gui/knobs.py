@@ -16,10 +16,14 @@ are large and bare (no value, no notches, no caption, no tooltip: a number
 invites anchoring a rating on it), ``set_captions`` shows nothing, and
 ``show_only`` leaves visible just the knobs the trial uses and its pads,
 named in words (e.g. "Done"). Its controls never take the keyboard focus, so
-the space bar reaches the window (the bow) instead of pressing a button.
+the space bar reaches the window (the bow) instead of pressing a button. A
+dial the participant has not set yet in a trial (``mark_unset``) is drawn
+as an empty dashed ring with no pointer: at its resting position (the bottom)
+an unrated dial would read as "noisiest". Its first turn draws it as a dial.
 """
 
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QPainter, QPen
 from PySide6.QtWidgets import (
     QDial,
     QGridLayout,
@@ -36,6 +40,32 @@ PAD_MIN_WIDTH = 36  # px
 PARTICIPANT_DIAL = 110  # px: a large target for the mouse, eight of them fit in 1,366 px
 
 
+class ParticipantDial(QDial):
+    """The participant's dial; ``unset`` (not turned yet in this trial) draws an empty dashed ring."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.unset = False
+
+    def set_unset(self, on):
+        if self.unset != bool(on):
+            self.unset = bool(on)
+            self.update()
+
+    def paintEvent(self, event):
+        if not self.unset:
+            super().paintEvent(event)
+            return
+        p = QPainter(self)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        side = min(self.width(), self.height()) - 8
+        ring = QRectF((self.width() - side) / 2, (self.height() - side) / 2, side, side)
+        p.setBrush(QColor("#f4f4f4"))
+        p.setPen(QPen(QColor("#888"), 2, Qt.PenStyle.DashLine))
+        p.drawEllipse(ring)
+        p.end()
+
+
 class KnobPanel(QWidget):
     knob_turned = Signal(int, int)
     pad_pressed = Signal(int)
@@ -48,7 +78,7 @@ class KnobPanel(QWidget):
         self.captions = []
         self.pads = []
         for i in range(knobs):
-            dial = QDial()
+            dial = ParticipantDial() if participant else QDial()
             dial.setRange(0, KNOB_MAX)
             dial.setWrapping(False)
             dial.valueChanged.connect(lambda value, i=i: self._turned(i, value))
@@ -125,7 +155,18 @@ class KnobPanel(QWidget):
 
     def _turned(self, index, value):
         self._show_value(index, value)
+        self._set(index)
         self.knob_turned.emit(index, value)
+
+    def mark_unset(self, indices):
+        """The participant's dials ``indices`` are not set yet (drawn as empty rings); the others are."""
+        if self.participant:
+            for i, dial in enumerate(self.dials):
+                dial.set_unset(i in indices)
+
+    def _set(self, index):
+        if self.participant and 0 <= index < len(self.dials):
+            self.dials[index].set_unset(False)
 
     def _show_value(self, index, value):
         if self.values:
@@ -140,6 +181,7 @@ class KnobPanel(QWidget):
         dial.setValue(int(value))
         dial.blockSignals(False)
         self._show_value(index, value)
+        self._set(index)
 
     def turn(self, index, value):
         """Set knob ``index`` to ``value`` as a hand would: ``knob_turned`` even if it is already there."""

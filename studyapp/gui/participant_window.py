@@ -2,7 +2,8 @@
 
 Shown on a second screen, full-screen (``show_full_screen``), or not at all.
 It never names an estimator, a condition, F_max or a knob's meaning, and
-never shows a knob's value: only the study's title, the current task's
+never shows a knob's value or the study's aim: only the protocol's
+``participant_title`` (neutral by default; never its ``title``), the current task's
 instructions from the protocol, "trial x of y", whether the session is
 paused, and whether the bow is on the string.
 
@@ -15,8 +16,19 @@ the "Bow" toggle or the space bar, through the controller's ``set_bowing``;
 "Bowing" / "Bow lifted" follows the controller's ``bowing`` event, so it is
 right whoever moved the bow (console, participant, protocol).
 
+**The bowing surface** (``bowing_surface.BowingSurface``): in a trial of a
+task whose bow is the participant's (``bow = "participant"``, the default),
+a full-width surface where the pointer (mouse, trackpad, pen) is the hand on
+the handle: pressing bows, moving moves the hand's target, releasing lifts
+the bow (the console connects it to the controller's ``bow_press``,
+``bow_move`` and ``bow_release``, as its own bowing pad). The Bow toggle and
+the space bar still put the bow on the string with the protocol's gesture.
+A space press within ``BOUNCE_S`` of the last toggle is ignored: no person
+means to lift the bow 25 ms after putting it down, and the second toggle
+logged a bow on and off at once when a trial had just appeared.
+
 **Refusals.** A refused confirm (the controller's ``refused`` event) is shown by ``show_refusal`` in the participant's words: a condition's
-name becomes the dial that plays it ("the second dial"), F_max "the level".
+name, or "knob N", becomes the dial that plays it ("the second dial"), F_max "the level".
 
 **Legibility.** Body text is ``BODY_PT`` = 22 pt, headings 28 pt. ISO
 9241-303 asks for characters of at least 16 arcmin, preferably 20 to 22
@@ -33,12 +45,14 @@ Progress counts the current task's practice or real trials ("Practice 1 of
 """
 
 import re
+import time
 
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from studyapp.estimators import names as estimator_names
 from studyapp.experiment.tasks import task_type
+from studyapp.gui.bowing_surface import BowingSurface
 from studyapp.gui.knobs import KnobPanel
 from studyapp.gui.page_view import PageView
 
@@ -56,6 +70,7 @@ REFUSED = "confirm refused: "
 ORDINALS = ("first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth")
 PLAIN_WORDS = (("F_max is 0", "nothing is playing yet"), ("F_max", "the level"))
 DONE = "Done"
+BOUNCE_S = 0.15  # s: a second space toggle sooner than this is a bounce, not a decision
 BOW_ON, BOW_OFF = "Bowing", "Bow lifted"
 
 
@@ -97,12 +112,14 @@ def _label(size, style=""):
 
 
 class ParticipantWindow(QWidget):
-    def __init__(self, controller=None, knobs=8, pads=8, parent=None):
+    def __init__(self, controller=None, knobs=8, pads=8, parent=None, clock=time.monotonic):
         super().__init__(parent, Qt.WindowType.Window)
         self.controller = controller
+        self.clock = clock
         self.bowing = False
         self.running = False
         self._sounds = {}
+        self._toggled = -BOUNCE_S  # self.clock() at the last space toggle
         self.setWindowTitle("Study")
         self.title = _label(HEADING_PT, "font-weight: bold;")
         self.progress = _label(BODY_PT, "color: #444;")
@@ -122,6 +139,7 @@ class ParticipantWindow(QWidget):
         self.bow_state = _label(BODY_PT)
         self.bow_hint = _label(BODY_PT, "color: #666;")
         self.bow_hint.setText("(or the space bar)")
+        self.surface = BowingSurface(BODY_PT)
         self.knobs = KnobPanel(knobs, pads, participant=True)
         self.knobs.setStyleSheet(f"QPushButton {{ font-size: {BODY_PT}pt; padding: 4px 48px; }}")
         bow_row = QHBoxLayout()
@@ -135,11 +153,12 @@ class ParticipantWindow(QWidget):
         self.page_view = PageView()
         self.page_view.hide()
         layout = QVBoxLayout(self)
-        layout.setContentsMargins(40, 32, 40, 32)
-        layout.setSpacing(12)
+        layout.setContentsMargins(40, 24, 40, 24)  # a 1,366 x 768 screen holds a rating trial's every control
+        layout.setSpacing(10)
         layout.addWidget(self.title)
         layout.addWidget(self.progress)
         layout.addWidget(self.instructions, 1)
+        layout.addWidget(self.surface, 1)
         layout.addWidget(self.page_view, 1)
         layout.addWidget(self.notice)
         layout.addWidget(self.refusal)
@@ -148,6 +167,7 @@ class ParticipantWindow(QWidget):
         layout.addWidget(self.knobs)
         self.show_bowing(False)
         self.show_controls([], [])
+        self.show_title("")
         self._hide_empty()
         if controller is not None:
             e = controller.events
@@ -158,7 +178,9 @@ class ParticipantWindow(QWidget):
 
     # what the console (or the controller's events) tell it --------------------------
     def show_title(self, title):
+        """The title the participant sees (the protocol's ``participant_title``)."""
         self.title.setText(title)
+        self.title.setVisible(bool(title))
 
     def show_trial(self, step, total, instructions, phase="trial", number=None, of=None):
         self._show_page_view(phase == "page")
@@ -181,6 +203,7 @@ class ParticipantWindow(QWidget):
         if on:
             self.knobs.setVisible(False)
             self.bow_row.setVisible(False)
+            self.surface.setVisible(False)
 
     def show_pickup(self, text):
         """A physical knob waiting for pickup: say which way to turn it ("" once it acts)."""
@@ -198,18 +221,25 @@ class ParticipantWindow(QWidget):
         self.running = state == "running" and not emergency
         self.knobs.setEnabled(self.running)
         self.bow_button.setEnabled(self.running)
+        self.surface.setEnabled(self.running)
         self._hide_empty()
 
-    def show_controls(self, knobs, pads, sounds=None):
-        """Show the dials ``knobs`` and the pads ``pads`` (as "Done"), and the bow row if any is shown."""
+    def show_controls(self, knobs, pads, sounds=None, surface=False):
+        """Show the dials ``knobs`` and the pads ``pads`` (as "Done"), the bow row if any is shown, and
+        the bowing surface (``surface``: the participant bows)."""
         self.knobs.show_only(knobs, pads, DONE)
         self.knobs.setVisible(bool(knobs or pads))
         self.bow_row.setVisible(bool(knobs or pads))
+        self.surface.bowing = False  # a press left over from the last trial bows nothing
+        self.surface.setVisible(bool(surface))
         self._sounds = dict(sounds or {})
 
     def show_bowing(self, on):
         """The bow is on the string (True) or lifted: the toggle and the words follow."""
         self.bowing = bool(on)
+        if not self.bowing and self.surface.bowing:  # lifted elsewhere: press again to bow
+            self.surface.bowing = False
+            self.surface.update()
         self.bow_button.setChecked(self.bowing)
         self.bow_state.setText(BOW_ON if self.bowing else BOW_OFF)
         self.bow_state.setStyleSheet(f"font-size: {BODY_PT}pt; font-weight: bold; "
@@ -229,14 +259,15 @@ class ParticipantWindow(QWidget):
             return ""
         shown = self.knobs.visible_knobs()
 
-        def dial(match):
-            knob = self._sounds.get(match.group(0))
+        def named(knob):
             if knob in shown and shown.index(knob) < len(ORDINALS):
                 return f"the {ORDINALS[shown.index(knob)]} dial"
             return "one of the dials"
 
         names = sorted(estimator_names(), key=len, reverse=True)
-        reason = re.sub(r"\b(" + "|".join(map(re.escape, names)) + r")\b", dial, reason)
+        reason = re.sub(r"\b(" + "|".join(map(re.escape, names)) + r")\b",
+                        lambda match: named(self._sounds.get(match.group(0))), reason)
+        reason = re.sub(r"\bknob (\d+)\b", lambda match: named(int(match.group(1)) - 1), reason)
         for term, words in PLAIN_WORDS:
             reason = reason.replace(term, words)
         return reason[0].upper() + reason[1:] + ("" if reason.endswith(".") else ".")
@@ -249,8 +280,11 @@ class ParticipantWindow(QWidget):
         self.show_bowing(self.bowing)  # a refused toggle leaves the button as the bow is
 
     def keyPressEvent(self, event):
-        if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
-            self.toggle_bowing()
+        if event.key() == Qt.Key.Key_Space:
+            now = self.clock()
+            if not event.isAutoRepeat() and now - self._toggled >= BOUNCE_S:
+                self._toggled = now
+                self.toggle_bowing()
             return
         super().keyPressEvent(event)
 
@@ -258,7 +292,10 @@ class ParticipantWindow(QWidget):
     def _on_trial(self, trial, step, total, instructions, **_):
         runner = self.controller.runner
         knobs, pads, sounds = trial_controls(trial, runner.task)
-        self.show_controls(knobs, pads, sounds)
+        protocol = self.controller.protocol
+        spec = protocol.specs.get(trial.task) if protocol is not None else None
+        self.show_controls(knobs, pads, sounds, surface=getattr(spec, "bow", None) == "participant")
+        self.knobs.mark_unset([k for k in knobs if k not in runner.task.knob_positions()])
 
     def _hide_empty(self):
         for label in (self.notice, self.refusal, self.pickup):

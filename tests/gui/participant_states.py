@@ -33,6 +33,7 @@ class FakeController:
     def __init__(self):
         self.events = EventGroup("trial", "bowing", "refused")
         self.runner = SimpleNamespace(task=None)
+        self.protocol = None
         self.bowing_asked = []
 
     def set_bowing(self, on):
@@ -45,7 +46,9 @@ class FakeController:
         protocol = load_protocol(ROOT / "protocols" / protocol)
         trials, _ = build_schedule(protocol, 0)
         trial = next(t for t in trials if t.task == task)
-        self.runner.task = task_type(task).start(replace(protocol.task(task), **spec_changes), trial)
+        spec = replace(protocol.task(task), **spec_changes)
+        self.protocol = SimpleNamespace(specs={task: spec}, participant_title=protocol.participant_title)
+        self.runner.task = task_type(task).start(spec, trial)
         shown = {"step": step, "total": len(trials), "instructions": instructions_for(protocol, task)}
         self.events.trial.emit(trial=trial, **shown)
         return shown

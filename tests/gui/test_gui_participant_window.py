@@ -101,11 +101,14 @@ def test_no_knob_value_condition_or_estimator_is_ever_shown(window, state):
 
 def test_the_space_bar_and_the_bow_button_put_the_bow_on_and_lift_it(window, qtbot):
     c = window.controller
+    now = [100.0]
+    window.clock = lambda: now[0]  # a person's presses, half a second apart
     put_in_state(window, c, "rating3")
     assert window.bow_state.text() == "Bow lifted" and not window.bow_button.isChecked()
     qtbot.keyClick(window, Qt.Key.Key_Space)
     assert c.bowing_asked == [True]
     assert window.bow_state.text() == "Bowing" and window.bow_button.isChecked()
+    now[0] += 0.5
     qtbot.keyClick(window, Qt.Key.Key_Space)
     assert c.bowing_asked == [True, False] and window.bow_state.text() == "Bow lifted"
     qtbot.mouseClick(window.bow_button, Qt.MouseButton.LeftButton)
@@ -115,6 +118,56 @@ def test_the_space_bar_and_the_bow_button_put_the_bow_on_and_lift_it(window, qtb
     window.show_state("paused")
     qtbot.keyClick(window, Qt.Key.Key_Space)
     assert c.bowing_asked == [True, False, True] and not window.bow_button.isChecked()
+
+
+def test_a_second_space_press_25_ms_after_the_first_is_a_bounce_not_a_lift(window, qtbot):
+    """Issue 22 item 15: a space press as a trial appears logged the bow on, then off 25 ms later."""
+    c = window.controller
+    now = [100.0]
+    window.clock = lambda: now[0]
+    put_in_state(window, c, "rating3")
+    qtbot.keyClick(window, Qt.Key.Key_Space)
+    now[0] += 0.025
+    qtbot.keyClick(window, Qt.Key.Key_Space)
+    assert c.bowing_asked == [True] and window.bow_state.text() == "Bowing"
+    now[0] += 0.3
+    qtbot.keyClick(window, Qt.Key.Key_Space)  # a deliberate lift
+    assert c.bowing_asked == [True, False]
+
+
+def test_unset_dials_are_drawn_as_empty_rings_until_turned(window):
+    """Issue 22 item 15: an unrated dial rests at the bottom, which reads as "noisiest"."""
+    c = window.controller
+    c.start("sinclair2014.toml", "rating")
+    shown = window.knobs.visible_knobs()
+    assert len(shown) == 8 and all(window.knobs.dials[k].unset for k in shown)
+    window.knobs.show_knob(shown[2], 40)  # the participant turned the third dial (MIDI or on screen)
+    assert [window.knobs.dials[k].unset for k in shown] == [True, True, False, True, True, True, True, True]
+    unset = window.knobs.dials[shown[0]].grab().toImage()
+    rated = window.knobs.dials[shown[2]].grab().toImage()
+    assert unset != rated
+    c.start("sinclair2014.toml", "adjustment")  # its knob has a position (F_max 0): drawn as a dial
+    assert not any(window.knobs.dials[k].unset for k in window.knobs.visible_knobs())
+
+
+def test_a_refusal_naming_a_knob_names_the_dial(window):
+    """Issue 22 item 15: the refusal said "knob 6" where the docs promise "the sixth dial"."""
+    c = window.controller
+    c.start("sinclair2014.toml", "rating")
+    c.events.refused.emit(reason="listen longer with the bow on: knob 6 needs 0.8 s more")
+    assert window.refusal.text() == "Listen longer with the bow on: the sixth dial needs 0.8 s more."
+    c.events.refused.emit(reason="not rated yet: knob 2, knob 7")
+    assert window.refusal.text() == "Not rated yet: the second dial, the seventh dial."
+
+
+def test_the_bowing_surface_shows_for_the_participants_bow_only(window):
+    c = window.controller
+    c.start("sinclair2014.toml", "rating")  # bow = "participant" (the default)
+    assert window.surface.isVisibleTo(window)
+    c.start("sinclair2014.toml", "adjustment", bow="auto")
+    assert not window.surface.isVisibleTo(window)
+    window.show_state("finished")
+    assert not window.surface.isVisibleTo(window)
 
 
 def test_a_refused_confirm_is_said_in_plain_words(window):
