@@ -2,8 +2,8 @@
 
 Left: session set-up and the apparatus found, and the session's progress
 (task, trial x of y, the page the participant sees with the headphone level
-check's confirm (``PageControls``), the current condition, which a tick hides
-for blinding), in a scroll area; below them, always in view, the session's
+check's confirm (``PageControls``), the current condition), in a scroll area; below them, always in view, the
+tick that hides the condition (blinding), the session's
 buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
 scope with the on-screen knobs and pads and the bowing pad; the analysis view
 (``AnalysisView``) of a results folder; the session's log. Bottom: the status
@@ -148,7 +148,6 @@ class Console(QMainWindow):
         p.addWidget(self.progress_bar)
         p.addWidget(QLabel("Current condition:"))
         p.addWidget(self.condition_label)
-        p.addWidget(self.blind)
         p.addWidget(self.response_label)
         p.addWidget(self.pickup_label)
         details = QWidget()
@@ -166,6 +165,7 @@ class Console(QMainWindow):
         left = QWidget()
         lv = QVBoxLayout(left)
         lv.addWidget(scroll, 1)
+        lv.addWidget(self.blind)  # in view without scrolling, at 1,366 x 768 too
         lv.addWidget(self.page_controls)  # the level check's confirm stays in view, as the buttons do
         lv.addLayout(buttons)
         lv.addWidget(self.stop_button)

@@ -3,7 +3,10 @@
 The session's information (experiment/session_info.py) is asked for here too:
 the experimenter, the session number (0 shows "none"), notes, and the
 Latin-square order row ("auto": from the participant's enrolment). They are
-checked when the session starts; a refusal shows in the panel's error line.
+checked when the session starts; a refusal shows in the panel's error line
+(below the form, wrapped to its whole height). Resuming takes only the
+participant, the protocol and the results folder: with "Resume" ticked the
+session's information (set when it started) is greyed and not passed on.
 
 The apparatus lines say what the engine really opened, in words: the device
 (the simulated 1-DOF device unless a driver is configured), the audio output
@@ -44,6 +47,8 @@ class SetupPanel(QWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
+        self._editable = True
+        self._tips = {}  # a session field -> its own tooltip (while resuming it says why it is greyed)
         self.participant = QLineEdit()
         self.participant.setPlaceholderText("pseudonym, e.g. P07")
         self.protocol = QComboBox()
@@ -103,7 +108,7 @@ class SetupPanel(QWidget):
         form.addRow("Notes", self.notes)
         form.addRow(self.resume)
         form.addRow(self.simulated)
-        form.addRow(self.error)
+        self.resume.toggled.connect(lambda _: self._grey_for_resume())
 
         self.device = QLabel("")
         self.audio = QLabel("")
@@ -121,6 +126,7 @@ class SetupPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(session)
+        layout.addWidget(self.error)  # not a form row: a form clipped a long refusal's wrapped lines
         layout.addWidget(apparatus)
 
     # what the user set ------------------------------------------------------
@@ -138,7 +144,9 @@ class SetupPanel(QWidget):
 
     @property
     def session_info(self):
-        """The session's information as ``Session.create`` takes it (None: not given)."""
+        """The session's information as ``Session.create`` takes it (None: not given); {} to resume."""
+        if self.resume.isChecked():
+            return {}
         number, row = self.session_number.value(), self.order_row.value()
         return {"experimenter": self.experimenter.text().strip() or None, "session_number": number or None,
                 "notes": self.notes.text().strip(), "order_row": None if row < 0 else row}
@@ -170,9 +178,21 @@ class SetupPanel(QWidget):
             self.results.setText(folder)
 
     def set_editable(self, on):
-        for widget in (self.participant, self.protocol, self.results, self.resume, self.simulated, self.experimenter,
-                       self.session_number, self.notes, self.order_row):
+        self._editable = bool(on)
+        for widget in (self.participant, self.protocol, self.results, self.resume, self.simulated):
             widget.setEnabled(on)
+        self._grey_for_resume()
+
+    def _session_fields(self):
+        return (self.experimenter, self.session_number, self.notes, self.order_row)
+
+    def _grey_for_resume(self):
+        """The session's own fields: editable for a new session, greyed to resume (its start set them)."""
+        resuming = self.resume.isChecked()
+        for widget in self._session_fields():
+            widget.setEnabled(self._editable and not resuming)
+            self._tips.setdefault(widget, widget.toolTip())
+            widget.setToolTip("kept from the session's start when resuming" if resuming else self._tips[widget])
 
     def show_error(self, text):
         self.error.setText(text)

@@ -14,7 +14,9 @@ The readouts whose text has no fixed length (the engine's state, the latched
 fault, the knob latency) and the latest warning (``show_message``, left) are
 ``ElidedLabel`` widgets: they shrink to a few characters and end in "…"
 rather than widen the window; the whole text is in their tooltip. The short
-numeric readouts keep their width.
+numeric readouts keep their width. The warning keeps at least
+``MESSAGE_CHARACTERS`` characters' width (the readouts that elide give way
+first): at 1,366 px it read "Em…".
 """
 
 from PySide6.QtCore import QTimer
@@ -24,6 +26,7 @@ from studyapp.gui.elided_label import ElidedLabel
 
 RED = "color: #c00; font-weight: bold;"
 ELIDED = ("engine", "faults", "knob")
+MESSAGE_CHARACTERS = 40
 
 
 class StatusBar(QStatusBar):
@@ -31,6 +34,7 @@ class StatusBar(QStatusBar):
         super().__init__(parent)
         self.labels = {}
         self.message = ElidedLabel("")
+        self.message.setMinimumWidth(self.message.fontMetrics().averageCharWidth() * MESSAGE_CHARACTERS)
         self.addWidget(self.message, 1)
         self._message_timer = QTimer(self)
         self._message_timer.setSingleShot(True)
