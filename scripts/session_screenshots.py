@@ -12,12 +12,12 @@ own rendering (``studyapp.gui.screenshot.save_widget``, as ``studyapp gui --scre
 - participant-welcome.png: the first page;
 - participant-rating.png: the first real rating trial, its knobs turned, bowing;
 - participant-bowing.png: that trial, the participant bowing on the bowing surface (a mouse press and
-  drag synthesised on it, bowing_surface.py), taken with the other pictures;
+  drag synthesised on it, gui/bowing_surface.py), when the task's bow is the participant's;
 - participant-break.png: the first break page;
 - console-trial.png: the console during that rating trial (the scope after a second of bowing).
 
-``--only welcome rating break`` takes just those (stopping as soon as they are taken: ``--only rating``
-stops in the rating task); ``--suffix`` is added to each file name (e.g. ``-1366x768``). Prints each path
+``--only welcome rating bowing break`` takes just those (``rating`` is participant-rating.png and
+console-trial.png), stopping as soon as they are taken (``--only bowing`` stops in the rating task); ``--suffix`` is added to each file name (e.g. ``-1366x768``). Prints each path
 written.
 """
 
@@ -56,7 +56,7 @@ def bow_on_surface(app, surface, fraction):
         app.processEvents()
 
 
-def run(app, protocol, out, size, results, wanted=("welcome", "rating", "break"), suffix=""):
+def run(app, protocol, out, size, results, wanted=("welcome", "rating", "bowing", "break"), suffix=""):
     from studyapp.gui.console import Console
     from studyapp.gui.screenshot import save_widget
     from studyapp.session.controller import PAGE_SETTLE_S, SessionController
@@ -104,13 +104,14 @@ def run(app, protocol, out, size, results, wanted=("welcome", "rating", "break")
                         else:
                             participant.toggle_bowing()
                     wait(app, lambda: task.heard[task.conditions[knob]] >= max(task.min_listen_s, 0.3), "listening")
-                if not trial.practice and "rating" in wanted:
-                    wanted.discard("rating")
+                if not trial.practice and wanted & {"rating", "bowing"}:
                     wait(app, lambda: task.elapsed >= 1.5, "a second of the scope")
-                    shoot(participant, "participant-rating.png")
-                    if participant.surface.isVisible():
+                    if "rating" in wanted:
+                        shoot(participant, "participant-rating.png")
+                        shoot(console, "console-trial.png")
+                    if "bowing" in wanted and participant.surface.isVisible():
                         shoot(participant, "participant-bowing.png")
-                    shoot(console, "console-trial.png")
+                    wanted -= {"rating", "bowing"}
                     if not wanted:
                         break
                 console.press_pad(task.confirm_pad)
@@ -135,8 +136,8 @@ def main(argv=None):
     parser.add_argument("dir", help="where the PNGs go")
     parser.add_argument("--protocol", default=str(ROOT / "protocols" / "demo.toml"), help="default protocols/demo.toml")
     parser.add_argument("--size", default="1366x768", help="both windows' size, WxH (default 1366x768)")
-    parser.add_argument("--only", nargs="+", default=["welcome", "rating", "break"],
-                        choices=["welcome", "rating", "break"], help="the pictures to take (default: all)")
+    parser.add_argument("--only", nargs="+", default=["welcome", "rating", "bowing", "break"],
+                        choices=["welcome", "rating", "bowing", "break"], help="the pictures to take (default: all)")
     parser.add_argument("--suffix", default="", help="added to each file name, e.g. -1366x768")
     args = parser.parse_args(argv)
     size = tuple(int(n) for n in args.size.split("x"))

@@ -111,4 +111,4 @@ def test_the_console_and_participant_window_walk_through_the_pages(paged_console
     c.knob(0, 100)
     c.pad(0)
     c.poll()
-    assert participant.refusal.text() == "Not rated yet: knob 2."
+    assert participant.refusal.text() == "Not rated yet: the second dial."  # issue 22 item 15: as the docs promise
