@@ -156,7 +156,8 @@ class ReplayingHand:
     def _place(self, t):
         """Aim the hand at the motion's position at ``t``: ``Live`` reaches it at the end of the next run."""
         if self._runner.loop is not None:
-            self._runner.set_gesture("live")
+            if getattr(self._runner, "gesture", None) != "live":
+                self._runner.set_gesture("live")
             self._runner.set_hand_target(self._replay.at(t))
 
     def advance(self, seconds):

@@ -83,6 +83,12 @@ class ParticipantProxy:
     def loop(self):
         return self._current("loop")
 
+    @property
+    def gesture(self):
+        """The hand's gesture in the current trial (None between trials)."""
+        runner = self.controller.runner
+        return runner.gesture if runner is not None else None
+
     def start_trial(self):
         c = self.controller
         while True:

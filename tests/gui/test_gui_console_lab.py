@@ -205,3 +205,35 @@ def test_the_participants_bowing_surface_bows_through_the_controller(lab_console
     assert trace is not None and trace["bow"][1] == 1 and trace["bow"][-1] == 0
     assert trace["x_mm"][-1] > trace["x_mm"][0]  # the pointer went right: so did the hand's target
     participant.hide()
+
+
+def test_the_simulated_participant_replays_a_logged_gesture_in_the_console(lab_console, qapp, tmp_path):
+    """``run --simulated-participant --replay-gesture``: its hand moves through the console as logged."""
+    import math
+
+    from studyapp.experiment.hand_trace import HandTrace
+
+    console, c = lab_console, lab_console.controller
+    trace = HandTrace()
+    for k in range(100):  # 1 s of quick strokes at 4 Hz, 5 mm either side, the bow on
+        trace.move(0.01 * k, 0.005 * math.sin(2 * math.pi * 4 * 0.01 * k), True)
+    record = trace.record(1)
+    console.replay = {0: record}
+    console.setup.simulated.setChecked(True)
+    try:
+        start(console, qapp, "SIM01")
+        folder = c.session.folder
+        wait_until(qapp, lambda: c.state == "finished" or console.simulated is None, 600)
+        assert c.state == "finished", console.log.toPlainText()[-2000:]
+    finally:
+        console.replay = None
+        console.setup.simulated.setChecked(False)
+        if c.in_session:
+            console.abort_session()
+    logged = events(folder)
+    trials = {e["step"] for e in logged if e["type"] == "trial_start" and e["conditions"]}
+    assert {e["step"] for e in logged if e["type"] == "gesture" and e["name"] == "live"} == trials
+    traces = [e for e in logged if e["type"] == "hand_trace"]
+    assert {e["step"] for e in traces} == trials
+    for e in traces:
+        assert max(e["x_mm"]) > 3.0 and min(e["x_mm"]) < -3.0  # the logged strokes, replayed
