@@ -5,10 +5,13 @@ same drawing code renders to files (Agg, PNG and SVG) and into the GUI's Qt
 canvas. Boxes follow matplotlib's defaults (median line, quartile box,
 whiskers to the furthest sample within 1.5 IQR of the box); every sample is
 drawn over its box, outliers included, so no separate outlier marks. Conditions run best first, left to right, as in
-the paper. The letters above the boxes are the compact letter display of the
-pairwise rank-sum tests (compact_letters.py), on trials pooled across
-participants as in the paper: two conditions sharing a letter are not
-significantly different. The footnote saying so is the figure's
+the paper. The letters above the boxes are a compact letter display
+(compact_letters.py): two conditions sharing a letter are not significantly
+different. By default they come from the within-subject tests, participants
+as the units (Friedman's test, then Holm-corrected pairwise signed-rank
+tests: study.py); with ``pooled_letters`` (``analyse --pooled-letters``) from
+the paper's pairwise rank-sum tests on trials pooled across participants,
+and the footnote then says they are pooled. The footnote is the figure's
 ``supxlabel``, so the constrained layout keeps room for it below the tick
 labels and the x label instead of drawing it over them.
 """
@@ -118,16 +121,23 @@ def _draw_box_plot(figure, task, study, ylabel, title):
         ax.scatter(x + jitter.uniform(-0.18, 0.18, values.size), values, s=9, color="C0", alpha=0.45,
                    linewidths=0, zorder=3)
     above = blended_transform_factory(ax.transData, ax.transAxes)
+    letters, source = study.figure_letters(task)
     for x, name in zip(positions, names):
-        ax.text(x, 1.01, task.letters[name], transform=above, ha="center", va="bottom", fontsize=9)
+        ax.text(x, 1.01, letters[name], transform=above, ha="center", va="bottom", fontsize=9)
     ax.tick_params(axis="x", labelrotation=30)
     ax.grid(True, axis="y", alpha=0.3)
-    correction = ", Holm-corrected" if study.holm else ""
-    _footnote(
-        figure,
-        f"letters: conditions sharing a letter do not differ (Wilcoxon rank-sum, p < {study.alpha:g}{correction}),\n"
-        f"{POOLED}",
-    )
+    _footnote(figure, letters_footnote(study, task, source))
+
+
+def letters_footnote(study, task, source):
+    """What the letters over a box plot come from, in the figure's words."""
+    if source == "pooled":
+        correction = ", Holm-corrected" if study.holm else ", uncorrected"
+        return (f"letters (pooled, on request): conditions sharing a letter do not differ (Wilcoxon rank-sum, "
+                f"p < {study.alpha:g}{correction}),\n{POOLED}")
+    n = task.within.n_participants
+    return (f"letters: conditions sharing a letter do not differ within subjects ({n} participants: Friedman, "
+            f"then Wilcoxon signed-rank,\nHolm-corrected, p < {study.alpha:g})")
 
 
 def _footnote(figure, text):

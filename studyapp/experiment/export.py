@@ -7,7 +7,7 @@ One row per response, first the columns of the "Study results" contract:
 then ``study, step, practice, value, knob, peak_fmax, duration, app_version``,
 the trial's engine health ``deadline_misses, underruns, faults,
 events_dropped``, and the session's ``experimenter, session_number,
-order_row``.
+order_row, simulated``.
 
 - ``task`` names the task type; ``trial``, ``fmax``, ``time``, ``step`` and
   ``duration`` come from the response event, the rest from the task type's
@@ -33,6 +33,10 @@ order_row``.
   records of its step, summed over its attempts); empty for a session without
   a real-time engine (``studyapp run``).
 
+- ``simulated``: True when the simulated participant played the session
+  (``enrolment.is_simulated``: session.json's ``simulated``, or its
+  ``apparatus.participant`` for older sessions); the analysis leaves these
+  rows out by default (``studyapp analyse --include-simulated``).
 - ``experimenter``, ``session_number``, ``order_row``: from session.json
   (``session_info``); empty when not given, or for a session stored before
   they were. The experimenter's ``notes`` stay in session.json: free text of
@@ -53,6 +57,7 @@ import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
 from studyapp.experiment import response_event
+from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
@@ -61,7 +66,7 @@ HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
 SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
            "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS,
-           *SESSION_COLUMNS]
+           *SESSION_COLUMNS, "simulated"]
 
 
 def _session_rows(folder, problems):
@@ -80,6 +85,7 @@ def _session_rows(folder, problems):
             "study": info["study"],
             "app_version": info["app_version"],
             **{column: info.get(column) for column in SESSION_COLUMNS},
+            "simulated": is_simulated(info),
         }
     except UserError as exc:
         problems.append(f"{folder}: skipped, {exc}")
@@ -159,6 +165,7 @@ def export_responses(results_dir, problems=None):
     frame = frame.sort_values(["study", "participant", "session", "step", "knob"], kind="stable")
     frame["trial"] = frame["trial"].astype("int64")
     frame["practice"] = frame["practice"].astype(bool)
+    frame["simulated"] = frame["simulated"].astype(bool)
     frame["step"] = frame["step"].astype("int64")
     frame["knob"] = frame["knob"].astype("Int64")
     frame["value"] = frame["value"].astype("Int64")  # empty for a task without a knob answer

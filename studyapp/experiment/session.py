@@ -7,7 +7,9 @@ Layout (DESIGN.md "Results layout"):
 
 ``session.json`` is written once, atomically, when the session is created:
 the protocol (its text, validated settings and SHA-256), the app version, the
-seed, the participant's enrolment index and Latin-square rows, the order row
+seed, the participant's enrolment index (counted among participants of the
+same kind, real or simulated: ``enrolment``) and Latin-square rows, whether
+the simulated participant plays (``simulated``), the order row
 (``order_row``, ``order_rows``, ``order_row_source``), the schedule, the
 apparatus (device, rate), and what the experimenter tells (``experimenter``,
 ``session_number``, ``notes``; ``session_info`` checks them, before anything
@@ -49,6 +51,7 @@ from studyapp import __version__
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, make_folders
+from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
 from studyapp.experiment.session_info import (
@@ -136,14 +139,6 @@ def _write_description(folder, info):
         f.flush()
         os.fsync(f.fileno())
     fsync_directory(folder)
-
-
-def enrolled_participants(study_folder):
-    """The participant IDs with at least one session under ``study_folder``."""
-    folder = Path(study_folder)
-    if not folder.is_dir():
-        return []
-    return sorted(p.name for p in folder.iterdir() if p.is_dir() and session_folders(p))
 
 
 def default_seed(protocol_seed, participant_index):
@@ -270,7 +265,8 @@ class Session:
     @staticmethod
     def _describe(protocol, participant, study_folder, participant_folder, seed, apparatus, order_row):
         """(the new session's folder, its description): enrolment index, seed, order row, schedule, protocol."""
-        index = len([p for p in enrolled_participants(study_folder) if p != participant])
+        simulated = apparatus_is_simulated(apparatus)
+        index = enrolment_index(study_folder, participant, simulated)  # counted per kind (enrolment.py)
         seed = default_seed(protocol.seed, index) if seed is None else int(seed)
         rows = order_rows(protocol)
         source = "enrolment" if order_row is None else "set"
@@ -287,6 +283,7 @@ class Session:
             "study": protocol.study,
             "participant": participant,
             "participant_index": index,
+            "simulated": simulated,
             "session": folder.name,
             "started": wall_time(),
             "app_version": __version__,

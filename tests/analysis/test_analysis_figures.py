@@ -22,8 +22,14 @@ def _study(participants, holm=False, task=None, seed=0):
     return analyse(check_responses(frame, "synthetic.csv"), holm=holm)
 
 
+def _pooled(study):
+    study.pooled_letters = True
+    return study
+
+
 STUDIES = {
-    "paper-like, Holm": lambda: _study(9, holm=True),  # the most letters and the longest footnote
+    "paper-like, Holm": lambda: _study(9, holm=True),
+    "paper-like, pooled letters": lambda: _pooled(_study(9, holm=False)),  # the most letters, longest footnote
     "two participants": lambda: _study(2),
     "rating only": lambda: _study(4, task="rating"),
 }
@@ -41,8 +47,13 @@ def test_no_text_overlaps_or_leaves_the_figure(study, name):
     assert texts_outside(figure) == []
 
 
-def test_box_plot_footnotes_name_the_pooled_test():
+def test_box_plot_footnotes_name_the_test_behind_the_letters():
+    # issue 22 item 14: within-subject letters by default; the pooled ones on request, named so
     study = _study(3)
     for name in ("fig7_adjustment", "fig8_rating"):
         footnote = render(name, study).get_supxlabel()
-        assert "Wilcoxon rank-sum" in footnote and POOLED in footnote
+        assert "within subjects" in footnote and "signed-rank" in footnote and POOLED not in footnote
+    study.pooled_letters = True
+    for name in ("fig7_adjustment", "fig8_rating"):
+        footnote = render(name, study).get_supxlabel()
+        assert "Wilcoxon rank-sum" in footnote and POOLED in footnote and "(pooled, on request)" in footnote
