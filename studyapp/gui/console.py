@@ -54,6 +54,7 @@ from studyapp.gui.knobs import KnobPanel
 from studyapp.gui.page_controls import PageControls
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.scope import Scope
+from studyapp.gui.session_tools import SessionTools
 from studyapp.gui.setup_panel import SetupPanel
 from studyapp.gui.status_bar import StatusBar
 from studyapp.session.controller import GESTURES, REST, State
@@ -145,6 +146,8 @@ class Console(QMainWindow):
         dv.setContentsMargins(0, 0, 0, 0)
         dv.addWidget(self.setup)
         dv.addWidget(progress)
+        self.tools = SessionTools(controller, self.setup, self.blind.isChecked)  # run sheet, notes, sound
+        dv.addWidget(self.tools)
         dv.addStretch(1)
         scroll = QScrollArea()
         scroll.setWidget(details)

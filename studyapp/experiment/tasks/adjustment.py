@@ -144,6 +144,11 @@ class Adjustment:
         return AdjustmentTrial(trial.condition, trial.trial, spec.ceiling, spec.decades, spec.knob, spec.confirm_pad,
                                spec.min_listen_s)
 
+    def typical_duration(self, spec, trial):
+        # no figure in the paper: our guess of a slow turn to breakdown, a turn back and the confirm
+        # (the simulated participant takes 20-40 s of loop time); or min_listen_s and a confirm
+        return max(45.0, spec.min_listen_s + 15.0)
+
     def describe(self, trial):
         return f"adjustment {trial.condition} trial {trial.trial}"
 
