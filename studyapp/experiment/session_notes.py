@@ -76,6 +76,8 @@ def list_notes(results):
     from studyapp.experiment.export import session_folders_under
 
     root = Path(results)
+    if root.exists() and not root.is_dir():
+        raise UserError(f"{root}: is a file: allowed is a results folder (or any folder inside it)")
     if not root.is_dir():
         raise UserError(f"{root}: no such results folder")
     rows = []
