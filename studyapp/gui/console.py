@@ -3,7 +3,8 @@
 Left: session set-up and the apparatus found, and the session's progress
 (task, trial x of y, the page the participant sees with the headphone level
 check's confirm (``PageControls``), the current condition, which a tick hides
-for blinding), in a scroll area; below them, always in view, the session's
+for blinding), the run sheet, notes and master volume (``SessionTools``), in a
+scroll area; below them, always in view, the session's
 buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
 scope with the on-screen knobs and pads and the bowing pad; the analysis view
 (``AnalysisView``) of a results folder; the session's log. Bottom: the status
