@@ -90,8 +90,8 @@ class WithinSubject:
         else:
             lines.append(
                 f"no pair can be significant with {n} participants: the smallest exact two-sided signed-rank p "
-                f"is 2^(1-n) = {smallest:.3g}, and Holm's correction over the {pairs} pairs makes it "
-                f"{pairs} x {smallest:.3g} = {pairs * smallest:.3g}; {needed} participants are needed"
+                f"is 2^(1-n) = {smallest:.3g}, and Holm's correction over the {pairs} pairs multiplies it by "
+                f"{pairs}: {pairs * smallest:.3g}, not below {alpha:g}; {needed} participants are needed"
             )
         return lines
 

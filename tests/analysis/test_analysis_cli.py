@@ -87,7 +87,7 @@ def test_within_subject_tables_beside_the_pooled_ones(report):
     assert "Friedman test across conditions" in html and "Wilcoxon signed-rank tests, Holm-corrected" in html
     # nine participants and 36 pairs: 36 x 2^-8 = 0.14, so no Holm-corrected pair can be significant
     assert ("no pair can be significant with 9 participants: the smallest exact two-sided signed-rank p is "
-            "2^(1-n) = 0.00391, and Holm&#x27;s correction over the 36 pairs makes it 36 x 0.00391 = 0.141; "
+            "2^(1-n) = 0.00391, and Holm&#x27;s correction over the 36 pairs multiplies it by 36: 0.141, not below 0.05; "
             "11 participants are needed") in html
     assert "warning: adjustment: no pair can be significant with 9 participants" in err
     settings = json.loads((out / "analysis_settings.json").read_text())
@@ -113,7 +113,7 @@ def test_two_participants_pooled_p_is_labelled_and_within_subject_p_is_honest(tm
         # the test used is Holm over the task's pairs: 11 participants are needed, not 6 (issue 22 item 14)
         assert (f"studyapp analyse: warning: {task}: no pair can be significant with 2 participants: the smallest "
                 f"exact two-sided signed-rank p is 2^(1-n) = 0.5, and Holm's correction over the {pairs} pairs "
-                f"makes it {pairs} x 0.5 = {pairs * 0.5:g}; 11 participants are needed") in lines
+                f"multiplies it by {pairs}: {pairs * 0.5:g}, not below 0.05; 11 participants are needed") in lines
         assert any(line.startswith(f"studyapp analyse: warning: {task}: Friedman's test with 2 participants")
                    for line in lines)
 
