@@ -45,8 +45,11 @@ def _lock(fd):
     """Hold an open-file-description write lock (``F_OFD_SETLKW``) on ``fd`` until it is closed.
 
     Not ``flock``: HDF5 flocks the files it writes and would find ours taken. An OFD
-    lock conflicts with another open of the file (in any process, this one too) only."""
-    fcntl.fcntl(fd, fcntl.F_OFD_SETLKW, _whole_file(fcntl.F_WRLCK))
+    lock conflicts with another open of the file (in any process, this one too) only.
+    Where locks are not supported the write goes on unlocked: ``_unheld`` then fails
+    too, so no one removes the temporary."""
+    with contextlib.suppress(OSError):
+        fcntl.fcntl(fd, fcntl.F_OFD_SETLKW, _whole_file(fcntl.F_WRLCK))
 
 
 def _unheld(fd):

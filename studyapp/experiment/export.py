@@ -43,7 +43,10 @@ Incomplete sessions are exported too: every confirmed response is data. A
 session that cannot be read is skipped, and a damaged line of a log left out
 (the valid lines after it are kept); each is reported, naming the file and
 line (``studyapp export`` prints them as warnings, and with ``--strict``
-refuses to write anything). The
+refuses to write anything). A session whose log two programs wrote at once (a
+step with two responses, a repeated ``seq``: ``written_twice``) is skipped the
+same way: which answer counts cannot be told. A complete session is exported
+whole whether or not its ``session_end`` was written. The
 CSV (``studyapp export``) reads as is in pandas and R; empty cells are missing.
 """
 

@@ -10,8 +10,8 @@ damaged line seems to say (a ``"type"`` flipped to ``"typa"``) never counts:
   together by a damaged newline are both kept (``mended``: the line's number);
   a confirmed last line whose newline is missing or damaged is kept too.
 - a line whose checksum fails, that is not valid JSON, or that lacks its
-  checksum in a log whose lines have one, is *damaged*: left out and reported
-  by its line number; the lines after it are kept.
+  checksum after a line that has one, is *damaged*: left out and reported by
+  its line number; the lines after it are kept.
 - a line that is valid JSON but not an event object, without a checksum or
   with a valid one, was written by hand or by another program: *malformed*
   (the export refuses it; resuming sets it aside like a damaged one).
@@ -19,7 +19,8 @@ damaged line seems to say (a ``"type"`` flipped to ``"typa"``) never counts:
   are a *torn* last line: a write cut short (power lost, the disk full); that
   event was never confirmed.
 
-A log without any checksum (written before checksums existed) is read as it is.
+Lines without a checksum before the first line that has one (a session begun
+by a version that wrote none) are read as they are.
 """
 
 import json
@@ -126,8 +127,9 @@ def scan(data):
                 result.mended.append(number)
                 continue
         found.append((number, event, why, checked, line + b"\n"))
-    checksummed = any(checked for *_, checked, _ in found)
+    checksummed = False  # from the first line that has one on, every line must
     for number, event, why, checked, raw in found:
+        checksummed = checksummed or checked
         if event is not None and checksummed and not checked:
             event, why = None, NO_CHECKSUM
         if event is not None:

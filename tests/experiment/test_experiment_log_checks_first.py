@@ -95,6 +95,10 @@ def test_a_line_without_its_checksum_in_a_checksummed_log_is_damaged(tmp_path):
     replace_on_line(path, 2, b'"crc"', b'"crb"')  # the checksum's own key flipped
     log = read_log(path)
     assert [e["step"] for e in log.events] == [0] and [(n, why) for n, why, _ in log.damaged] == [(2, "no checksum")]
+    # lines before the first checksum (a session begun by a version that wrote none) are read as they are
+    path.write_bytes(b'{"seq":0,"type":"old"}\n' + path.read_bytes())
+    log = read_log(path)
+    assert [e["type"] for e in log.events] == ["old", "response"] and [n for n, *_ in log.damaged] == [3]
 
 
 def test_a_confirmed_last_response_with_a_damaged_newline_is_kept_on_resume(tmp_path, protocol):
