@@ -29,11 +29,15 @@ Data safety (docs/experiment.md "Data safety"):
   before they read or write anything, and the session holds it until
   ``close``: a second program starting the same participant is refused with
   one line naming the holder, and writes nothing. ``create`` also holds the
-  study's lock while it enrols, so two participants never get one index.
+  study's lock while it enrols, so two participants never get one index. A
+  ``create`` that fails removes what it made, a lock file only while it holds
+  that lock (never the winner's), and says that there is nothing to resume.
 - The first event of ``events.jsonl`` (``session_created``) repeats the whole
   description. A ``session.json`` that is missing or damaged is rebuilt from it
   on resume (the damaged file is kept as ``session.json.damaged-<time>``);
   without it the session is refused with one line.
+- Resuming a session whose every trial is answered writes its ``session_end``
+  if a kill kept that from being written, and says it is complete.
 - Folders and files get the modes of ``data_modes`` (private by default).
 """
 

@@ -37,7 +37,6 @@ from studyapp.experiment.session_files import LOCK_FILE
 from studyapp.experiment.session_log import wall_time
 
 
-
 def _acquire(path, blocking):
     """An fd holding flock on ``path``, or None when another process holds it (``blocking`` False)."""
     while True:
