@@ -1,11 +1,15 @@
-"""Outputs are written whole or not at all, with the usual permissions."""
+"""Outputs are written whole or not at all, with the usual permissions; a killed writer leaves no temporary."""
 
 import os
+import signal
 import stat
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
-from studyapp.atomic import atomic_open
+from studyapp.atomic import atomic_open, atomic_path
 
 
 def test_complete_write_replaces_target(tmp_path):
@@ -39,13 +43,6 @@ def test_permissions_follow_the_umask(tmp_path):
 
 
 # --- issue 21, item 8: a killed writer leaves no visible temporary, or the next write removes it ---
-
-import signal  # noqa: E402
-import subprocess  # noqa: E402
-import sys  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-from studyapp.atomic import atomic_path  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 

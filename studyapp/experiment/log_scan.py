@@ -69,12 +69,6 @@ def classify(line):
     return event, why, False
 
 
-def decode(line):
-    """(event, None) for a valid line (bytes, no newline), else (None, why it is damaged)."""
-    event, why, _ = classify(line)
-    return event, why
-
-
 def _records(chunk):
     """The confirmed records at the start of ``chunk``, one damaged byte (a newline) between two.
 

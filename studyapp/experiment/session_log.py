@@ -37,7 +37,7 @@ from pathlib import Path
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, open_file
-from studyapp.experiment.log_scan import LogScan, decode, read_events, read_log, scan  # noqa: F401 - the log's readers
+from studyapp.experiment.log_scan import read_events, read_log, scan  # noqa: F401 - the log's readers, here too
 
 DAMAGED_SUFFIX = ".damaged"
 TORN_SUFFIX = ".torn-"
