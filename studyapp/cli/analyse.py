@@ -65,7 +65,7 @@ def run(args):
     def say(message):
         print(f"studyapp analyse: {message}", file=sys.stderr, flush=True)
 
-    output_paths.check_folder(args.output)
+    output_paths.check_folder(args.output, inputs=[args.results, *filter(None, [args.evaluation])])
     # read before saying anything: bad input is then the one line on stderr
     problems = []
     responses, label = load_responses(args.results, problems, include_practice=args.include_practice,

@@ -78,7 +78,9 @@ def run(args):
     output = Path(args.output)
     if output.suffix.lower() != ".toml":
         raise UserError(f"-o {output}: expected a .toml file")
-    output_paths.check_file(output)
+    checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
+    output_paths.check_file(output, inputs=args.recordings)
+    output_paths.check_file(checkpoint, "--checkpoint", inputs=[*args.recordings, output])
     if args.max_lag <= 0:
         raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
     if args.patience < 1:
@@ -105,7 +107,6 @@ def run(args):
         rate = min(t.rate for t in takes)
     ranges = parse_ranges(args.range)
     spaces = {name: Space(name, rate, args.tune, ranges=ranges.get(name)) for name in names}
-    checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
     if args.resume and not checkpoint.is_file():
         raise UserError(f"--resume: no checkpoint at {checkpoint}")
 

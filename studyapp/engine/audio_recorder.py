@@ -13,7 +13,9 @@ silence once the writer catches up, so the file's timeline stays the engine's.
 
 Files are never overwritten (``free_path``): ``audio.wav`` is reserved with an
 exclusive create, else ``audio-2.wav``, ``audio-3.wav``, ...: one file per
-engine run of a session (a resumed session, a restarted engine).
+engine run of a session (a resumed session, a restarted engine). The WAV file
+and ``audio_cues.csv`` are created with the permissions ``mode`` (the session's
+files' mode, 0600 or 0660: participant data), whatever the umask.
 
 Cues. ``cue(...)`` notes a trial boundary at the recording's current frame: the
 worker calls it when it applies an ``AudioCue`` command, at a block boundary,
@@ -46,13 +48,20 @@ def numbered(path, number):
     return path if number == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
 
 
-def free_path(path):
+def create(path, mode):
+    """An fd of the new file ``path`` (``FileExistsError`` if it exists) with permissions ``mode``, not the umask's."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode)
+    os.fchmod(fd, mode)
+    return fd
+
+
+def free_path(path, mode=0o600):
     """``(file object, path)``: ``path`` or the first free numbered name, created exclusively (never overwriting)."""
     number = 1
     while True:
         candidate = numbered(path, number)
         try:
-            return open(candidate, "xb"), candidate  # noqa: SIM115 - the writer thread owns and closes it
+            return open(create(candidate, mode), "wb"), candidate  # noqa: SIM115 - the writer thread closes it
         except FileExistsError:
             number += 1
 
@@ -62,9 +71,10 @@ def pcm16(samples):
 
 
 class AudioRecorder:
-    def __init__(self, path, rate):
+    def __init__(self, path, rate, mode=0o600):
         self.rate = float(rate)
-        self._file, self.path = free_path(path)
+        self.mode = mode
+        self._file, self.path = free_path(path, mode)
         self.cues_path = self.path.parent / CUES_FILE
         self.capacity = int(QUEUE_SECONDS * self.rate)
         self.frames = 0  # frames of the file's timeline so far, dropped ones included
@@ -147,6 +157,8 @@ class AudioRecorder:
 
     def _append_cue(self, row):
         new = not self.cues_path.exists() or self.cues_path.stat().st_size == 0
+        with contextlib.suppress(FileExistsError):
+            os.close(create(self.cues_path, self.mode))
         with open(self.cues_path, "a", newline="", encoding="utf-8") as f:
             writer = csv.DictWriter(f, fieldnames=CUE_COLUMNS)
             if new:

@@ -233,7 +233,7 @@ class Worker:
         if not self.sink.render:
             self.notice(f"audio: the {self.sink.description} sink renders no audio: nothing to record", "warning", "audio")
             return
-        self.recorder = self.sink.recorder = AudioRecorder(c.path, self.sink.rate)
+        self.recorder = self.sink.recorder = AudioRecorder(c.path, self.sink.rate, c.mode)
         self.recordings.append(self.recorder)
         self.notice(f"audio: recording what is heard to {self.recorder.path}", "info", "audio")
 

@@ -47,7 +47,10 @@ Incomplete sessions are exported too: every confirmed response is data. A
 session that cannot be read is skipped, and a damaged line of a log left out
 (the valid lines after it are kept); each is reported, naming the file and
 line (``studyapp export`` prints them as warnings, and with ``--strict``
-refuses to write anything). The
+refuses to write anything). A session whose log two programs wrote at once (a
+step with two responses, a repeated ``seq``: ``written_twice``) is skipped the
+same way: which answer counts cannot be told. A complete session is exported
+whole whether or not its ``session_end`` was written. The
 CSV (``studyapp export``) reads as is in pandas and R; empty cells are missing.
 """
 
@@ -103,6 +106,11 @@ def _session_rows(folder, problems):
         number, _, raw = log.malformed[0]
         raise InputDataError(f"{events_file} line {number}: {raw.strip()[:40]!r} is not an event: "
                              "allowed is a JSON object with a 'type'")
+    twice = written_twice(log)
+    if twice:
+        problems.append(f"{folder}: skipped, {events_file}: {twice}: two programs wrote this log at once, so "
+                        "which answer counts cannot be told")
+        return []
     health = _trial_health(log.events)
     rows = []
     for event in log.events:
@@ -118,6 +126,33 @@ def _session_rows(folder, problems):
         base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
+
+
+def _repeats(values, lines):
+    """{value: [line numbers]} of the values (whole numbers) that occur more than once."""
+    seen = {}
+    for value, line in zip(values, lines):
+        if isinstance(value, int) and not isinstance(value, bool):
+            seen.setdefault(value, []).append(line)
+    return {value: at for value, at in seen.items() if len(at) > 1}
+
+
+def written_twice(log):
+    """What shows that two programs appended to one log (a ``LogScan``), or None.
+
+    Each program numbers its events ``seq`` from the end of the log it opened, and
+    a step is answered once (resume skips answered steps); a repeated ``seq`` or a
+    second ``response`` for a step means two writers at once (issue 21, item 1)."""
+    found = []
+    seqs = _repeats([e.get("seq") for e in log.events], log.lines)
+    responses = [(e.get("step"), line) for e, line in zip(log.events, log.lines) if e.get("type") == "response"]
+    steps = _repeats([s for s, _ in responses], [line for _, line in responses])
+    for what, repeats in (("step", steps), ("seq", seqs)):
+        if repeats:
+            value, lines = min(repeats.items(), key=lambda item: item[1][0])
+            kind = "steps with more than one response" if what == "step" else "seq values repeated"
+            found.append(f"{len(repeats)} {kind} (first: {what} {value}, lines {', '.join(map(str, lines))})")
+    return "; ".join(found) or None
 
 
 def _trial_health(events):

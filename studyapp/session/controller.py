@@ -114,6 +114,7 @@ from studyapp.engine.config import EngineConfig
 from studyapp.engine.events import Learned
 from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
+from studyapp.experiment.data_modes import file_mode
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.schedule import counted
 from studyapp.experiment.session import Session, check_participant
@@ -519,7 +520,8 @@ class SessionController:
                          "note": "one real-time engine per session: its seed, not the trials' loop_seed, "
                                  "seeds the sensor noise"})
         self.fed = self.host.position
-        self._send(cmd.RecordAudio(str(self.session.folder / AUDIO_FILE)))  # one file per engine run
+        # one file per engine run; participant data, with the mode of the session's other files
+        self._send(cmd.RecordAudio(str(self.session.folder / AUDIO_FILE), file_mode()))
 
     def _make_loop(self, estimators, source, seed):
         self.trial_serial += 1
