@@ -29,7 +29,8 @@ bounds every sample below the ceiling C = 10^(CEILING_DBFS / 20):
     y = x                                          for |x| <= K,  K = C 10^(-KNEE_DB / 20)
     y = sign(x) (K + (C - K) tanh((|x| - K) / (C - K)))   above,
 
-continuous with slope 1 at the knee K and |y| < C always. The typical bowed
+continuous with slope 1 at the knee K and |y| <= C always (tanh reaches 1 only
+in floating point, for inputs far above the knee). The typical bowed
 string (1 N, strokes: about -36 dBFS RMS, peaks about -27 dBFS) stays under
 the knee; only loud breakdown sounds are bent, never clipped flat.
 
@@ -47,7 +48,7 @@ from studyapp.engine.reference_tone import ReferenceTone
 from studyapp.engine.resampler import Resampler
 from studyapp.errors import ParameterError
 
-CEILING_DBFS = -12.0  # the documented peak: no output sample reaches it
+CEILING_DBFS = -12.0  # the documented peak: no output sample exceeds it
 KNEE_DB = 6.0  # the limiter bends the signal only above CEILING_DBFS - KNEE_DB
 FADE_S = 0.005  # s: every start, stop and cut fades over this (and the gate looks ahead this far)
 CEILING = 10.0 ** (CEILING_DBFS / 20.0)
@@ -111,6 +112,9 @@ class Gate:
         """The next ``len(x)`` samples of the gated stream (delayed by ``length``)."""
         n = self.length
         sounding = bool(sounding)
+        x = np.asarray(x, dtype=np.float64)
+        if sounding == self.sounding and not cut and (not sounding or self._since >= n):
+            return self._steady(x, sounding)
         if self.sounding and (cut or not sounding):
             self._tail_gain *= self.rise[::-1]  # fade out, ending at the boundary
         if sounding and (cut or not self.sounding):
@@ -121,10 +125,22 @@ class Gate:
             gain = np.where(k < n, self.rise[np.minimum(k, n - 1)], 1.0)
             self._since = min(self._since + x.shape[0], n)
         self.sounding = sounding
-        xs = np.concatenate((self._tail, np.asarray(x, dtype=np.float64)))
+        xs = np.concatenate((self._tail, x))
         gs = np.concatenate((self._tail_gain, gain))
         self._tail, self._tail_gain = xs[-n:].copy(), gs[-n:].copy()
         return xs[:-n] * gs[:-n]
+
+    def _steady(self, x, sounding):
+        """No boundary in this block nor in the held-back tail: the new samples' gains are all 1, or all 0."""
+        n = self.length
+        tail = self._tail * self._tail_gain  # kept with its gains applied from here on
+        self._tail_gain = np.ones(n)
+        if not sounding and not tail.any():
+            self._tail = np.zeros(n)
+            return np.zeros(x.shape[0])
+        xs = np.concatenate((tail, x if sounding else np.zeros(x.shape[0])))
+        self._tail = xs[-n:].copy()
+        return xs[:-n]
 
 
 class SignalChain:
