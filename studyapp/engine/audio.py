@@ -7,7 +7,8 @@ rate, volume and mute, the headphone check's reference tone, and a soft
 limiter under ``CEILING_DBFS``), and plays or stores it. The session's
 recorder (``audio_recorder``), if one is attached, gets what reached the
 device: a device sink tees it in its callback, gaps included (an underrun is
-silence in the file, and marked), a file sink as it writes. Choose one with ``open_sink(spec, haptic_rate)``::
+silence in the file, and marked), a file sink as it writes. Choose one with
+``open_sink(spec, haptic_rate)``::
 
     "device" | "device:NAME"   PortAudio output (sounddevice), NAME a substring of the device name
     "wav:FILE"                 16-bit mono WAV at 48 kHz, written atomically when the sink closes; never
@@ -15,8 +16,8 @@ silence in the file, and marked), a file sink as it writes. Choose one with ``op
     "null"                     nothing rendered at all
     "discard"                  rendered and resampled, then dropped (what audio costs, for benchmarks)
 
-A device sink plays from a FIFO that the engine keeps filled ``lead`` seconds
-ahead; PortAudio's callback reads it. When the FIFO cannot fill a device
+A device sink (``device_sink.DeviceSink``) plays from a FIFO that the engine
+keeps filled ``lead`` seconds ahead; PortAudio's callback reads it. When the FIFO cannot fill a device
 period the callback plays silence for the rest and counts an *underrun*; when
 the device itself reports one (``output_underflow``, e.g. a JACK xrun) that is
 counted too, and separately as an *xrun*. The device's callback is the audio

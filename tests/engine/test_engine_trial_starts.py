@@ -5,7 +5,6 @@ silent from the start cue on while the bow is lifted; it never passes the ceilin
 
 import time
 
-import numpy as np
 import pytest
 
 from studyapp.engine import commands as cmd
