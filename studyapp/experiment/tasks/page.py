@@ -140,6 +140,8 @@ class PageType:
         return []
 
     def simulate(self, participant, runner, rng):
+        if runner.task.page.kind == "calibration":
+            runner.advance(participant.level_check_time)  # the experimenter listens to the tone first
         runner.acknowledge_page(runner.task.page.by)
 
 
