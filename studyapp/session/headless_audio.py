@@ -22,6 +22,7 @@ simulated experimenter listens to the tone before confirming the level
 from studyapp.engine.audio import WAV_RATE
 from studyapp.engine.audio_recorder import AudioRecorder
 from studyapp.engine.signal_chain import SignalChain
+from studyapp.experiment.data_modes import file_mode
 from studyapp.experiment.session_runner import SessionRunner, closed_loop_factory
 
 AUDIO_FILE = "audio.wav"
@@ -31,7 +32,7 @@ class ArchivingRunner(SessionRunner):
     def __init__(self, session, progress=None):
         super().__init__(session, make_loop=closed_loop_factory(session.protocol, audio=True), progress=progress)
         self.chain = SignalChain(self.protocol.rate, WAV_RATE)
-        self.recorder = AudioRecorder(session.folder / AUDIO_FILE, self.chain.rate)
+        self.recorder = AudioRecorder(session.folder / AUDIO_FILE, self.chain.rate, file_mode())
         self.path = self.recorder.path  # audio.wav, or audio-2.wav, ... for a resumed session
         self._cut = False
         self._source = None

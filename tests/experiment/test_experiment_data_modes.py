@@ -86,3 +86,19 @@ def test_the_session_controller_asks_the_engine_for_that_mode(controller, monkey
     up(controller)
     (sent,) = controller.host.engine.sent_of(cmd.RecordAudio)
     assert sent.path == str(controller.session.folder / "audio.wav") and sent.mode == file
+
+
+@pytest.mark.parametrize("shared,file", [(None, 0o600), ("1", 0o660)])
+def test_a_headless_session_archives_its_audio_with_that_mode(tmp_path, monkeypatch, open_umask, shared, file):
+    """The headless archive (run --simulated-participant --headless --audio wav) writes participant data too."""
+    from studyapp.cli import main
+
+    if shared is None:
+        monkeypatch.delenv("STUDYAPP_GROUP_SHARED", raising=False)
+    else:
+        monkeypatch.setenv("STUDYAPP_GROUP_SHARED", shared)
+    code = main(["run", "--protocol", str(DEMO), "--participant", "H01", "--simulated-participant", "--headless",
+                 "--results", str(tmp_path), "--audio", "wav", "--seed", "3"])
+    assert code == 0
+    audio = {p.name: stat.S_IMODE(p.stat().st_mode) for p in tmp_path.rglob("audio*")}
+    assert audio == {"audio.wav": file, "audio_cues.csv": file}
