@@ -196,4 +196,5 @@ SPEC = EstimatorSpec(
     ),
     build=build,
     reference="paper Sec. 5.3; Janabi-Sharifi, Hayward, Chen 2000 (best-fit); Table 1 (size 17, margin 1.001e-4)",
+    extra={"conventions": {"window": "size"}},
 )

@@ -193,6 +193,7 @@ SPEC_KALFOAW = EstimatorSpec(
     params=(q_param(77.7), r_acc_param(8.06), r_pos_param(), _window(), _margin(), _margin_vel(),
             q_convention("scaled")),
     build=build_kalfoaw, reference="paper Sec. 5.7; Tables 1-2 (Q = 77.7, R_a = 8.06; size 12, 1e-4 m, 0.5 m/s)",
+    extra={"conventions": {"window": "size"}},
 )
 SPEC_KALFOAWACC = EstimatorSpec(
     name="KALFOAWACC", kind=kinds.KALFOAWACC,
@@ -202,4 +203,5 @@ SPEC_KALFOAWACC = EstimatorSpec(
             q_convention("scaled")),
     build=build_kalfoawacc,
     reference="paper Sec. 5.7; Tables 1-2 (Q = 88.5, R_a = 3.85; size 12, 1e-4 m, 0.5 m/s)",
+    extra={"conventions": {"window": "size"}},
 )

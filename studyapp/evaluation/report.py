@@ -100,7 +100,13 @@ class Evaluation:
         }
 
     def to_json(self):
-        """The ``studyapp evaluate --json`` structure (NaN becomes null)."""
+        """The ``studyapp evaluate --json`` structure (NaN becomes null).
+
+        ``parameters``: what each estimator ran with; ``conventions``: what
+        those numbers mean (``estimators.conventions.record``).
+        """
+        from studyapp.estimators import conventions
+
         return {
             "estimators": {
                 name: {
@@ -113,6 +119,8 @@ class Evaluation:
                 for name in self.names
             },
             "ranking": self.ranking,
+            "parameters": {name: dict(self.params[name]) for name in self.names},
+            "conventions": conventions.record({name: self.params[name] for name in self.names}),
             "delay_method": self.delay_method,
             "recordings": [
                 {"file": r, "fmax": f, "rate": rate}
