@@ -53,7 +53,7 @@ PAPER_TUNED = {
     "LVT": (),
 }
 
-_FOAW_RANGES = {"window": (1, 64), "margin": (1e-7, 1e-2), "margin_vel": (1e-4, 1e2)}
+_FOAW_RANGES = {"window": (2, 64), "margin": (1e-7, 1e-2), "margin_vel": (1e-4, 1e2)}
 SEARCH_RANGES = {name: dict(_FOAW_RANGES) for name in ("FOAW", "KALFOAW", "KALFOAWACC")}
 
 # The thirteen estimators of the paper's Table 2 (BDIFF and LVT are ours).
