@@ -17,8 +17,8 @@ Discretisation (DESIGN.md "Numerical conventions"): explicit Euler with the
 sample period T, sgn(0) = 0. The starting state is the parameter ``start``:
 
     "zero"   w = 0, u1 = 0 (the authors' code; the default): on a position far
-             from 0 the observer first has to travel there, a transient of
-             about sqrt(2 |x_0| / C) seconds
+             from 0 the observer first has to travel there (its first output
+             is sqrt(C |x_0|); docs/estimators-nonlinear.md measures the transient)
     "first"  w = x_0, u1 = 0 (the observer on the first sample): the first output is 0
 
 On the authors' test signal (tests/estimators/test_estimators_oracle.py) the
