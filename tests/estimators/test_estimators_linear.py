@@ -67,9 +67,9 @@ def exact_taps(order, window):
     return np.array([float(sum(w[a] * (-j) ** a for a in range(n))) for j in range(window)])
 
 
-@pytest.mark.parametrize("order, window", [(1, 2), (2, 33), (4, 400), (5, 257), (6, 300), (6, 512)])
+@pytest.mark.parametrize("order, window", [(1, 2), (2, 33), (4, 512), (5, 400), (6, 257), (6, 512)])
 def test_leastsq_taps_equal_the_exact_rational_taps(order, window):
-    """Ours to 1e-13 everywhere in range; scipy's savgol_coeffs is 100 % off at (6, 300) and (6, 512)."""
+    """Ours to 1e-13 everywhere in range; scipy's savgol_coeffs is 100 % off at (5, 400), (6, 257), (6, 512)."""
     from studyapp.estimators.leastsq import taps
 
     exact = exact_taps(order, window)

@@ -102,7 +102,7 @@ def test_search_stays_in_range_and_in_natural_scale():
 
 def test_space_follows_table_2_and_keeps_choices_fixed():
     assert Space("KALMAN", RATE).names == ["q", "r_acc"]
-    assert Space("KALMAN", RATE).fixed == {"r_pos": 2e-10, "q_convention": "eq19"}
+    assert Space("KALMAN", RATE).fixed == {"r_pos": 2e-10, "q_convention": "scaled"}  # Table 1's convention
     assert Space("KALLEV", RATE, tune="all").names == ["q", "r_acc", "r_pos", "c"]
     cutoff = Space("LOWPASS", 5000.0).dims[0]
     assert cutoff.log and cutoff.low == 1.0 and cutoff.high == pytest.approx(NYQUIST_FRACTION * 5000.0)
