@@ -112,7 +112,7 @@ def test_space_follows_table_2_and_keeps_choices_fixed():
 
 def test_search_ranges_narrow_foaw_and_follow_range_options():
     foaw = {d.name: d for d in Space("FOAW", RATE).dims}
-    assert (foaw["window"].low, foaw["window"].high) == (1.0, 64.0)
+    assert (foaw["window"].low, foaw["window"].high) == (2.0, 64.0)  # sizes: a line through at least 2 samples
     assert (foaw["margin"].low, foaw["margin"].high) == (1e-7, 1e-2)
     from studyapp.cli.optimise import parse_ranges
 
