@@ -44,7 +44,7 @@ def register(sub):
                    help="longest delay searched by the cross-correlation (default 0.02 s)")
     delay_option.add(p)
     p.add_argument("--range", action="append", default=[], metavar="NAME.PARAM=LOW:HIGH",
-                   help="search range of one parameter, within its allowed range (e.g. FOAW.window=1:128)")
+                   help="search range of one parameter, within its allowed range (e.g. FOAW.window=2:128)")
     p.add_argument("--max-sets", type=int, metavar="N", help="also stop an estimator after N new sets")
     p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores; 1: in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -178,8 +178,8 @@ def parse_ranges(items):
         try:
             pair = (float(low), float(high))
         except ValueError:
-            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=1:128") from None
+            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=2:128") from None
         if not name or not param:
-            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=1:128")
+            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=2:128")
         ranges.setdefault(spec(name).name, {})[param] = pair
     return ranges
