@@ -319,3 +319,48 @@ def test_a_recording_csv_with_a_byte_order_mark_is_accepted(tmp_path):
     loaded = load(tmp_path / "excel.csv")
     assert loaded.rate == 1000.0 and list(loaded.columns) == list(COLUMNS)
     np.testing.assert_array_equal(loaded["position"], rec["position"])
+
+
+# ---- studyapp plan and studyapp notes (issue 22 item 16) ------------------------------------------
+PLAN = ["plan", "--participant", "P07", "--results", "{in}/results_good", "--protocol"]
+PLAN_CASES = {
+    "plan-protocol-missing": [*PLAN, "{in}/none.toml"],
+    "plan-protocol-empty": [*PLAN, "{in}/empty.toml"],
+    "plan-protocol-binary": [*PLAN, "{in}/binary.toml"],
+    "plan-protocol-dir": [*PLAN, "{in}/adir.toml"],
+    "plan-protocol-nested": [*PLAN, "{in}/nested.toml"],
+    "plan-protocol-huge": [*PLAN, "{in}/huge.toml"],
+    "plan-participant-bad": ["plan", "--participant", "P 07!", "--protocol", PROTOCOL],
+    "plan-participant-empty": ["plan", "--participant", "", "--protocol", PROTOCOL],
+    "plan-order-row-high": [*PLAN, PROTOCOL, "--order-row", "999"],
+    "plan-order-row-negative": [*PLAN, PROTOCOL, "--order-row", "-1"],
+    "plan-order-row-text": [*PLAN, PROTOCOL, "--order-row", "first"],
+    "plan-results-file": ["plan", "--participant", "P07", "--protocol", PROTOCOL, "--results", "{in}/good.csv"],
+    "plan-out-dir": [*PLAN, PROTOCOL, "-o", "{in}/adir"],
+    "plan-out-unwritable": [*PLAN, PROTOCOL, "-o", UNWRITABLE + "/sheet.md"],
+    "plan-out-under-file": [*PLAN, PROTOCOL, "-o", "{in}/good.csv/sheet.md"],
+    "plan-out-is-protocol": [*PLAN, "{out}/p.toml", "-o", "{out}/p.toml"],
+    # p1 has a demo session: its stored order row is 0
+    "plan-stored-order-row-differs": ["plan", "--participant", "p1", "--results", "{in}/results_good",
+                                      "--protocol", PROTOCOL, "--order-row", "2"],
+    "notes-missing": ["notes", "{in}/none"],
+    "notes-file": ["notes", "{in}/good.csv"],
+    "notes-add-not-a-session": ["notes", "{in}/adir", "--add", "text"],
+    "notes-add-empty": ["notes", "{in}/results_good", "--add", " "],
+    "notes-add-control-character": ["notes", "{in}/results_good", "--add", "bell\x07"],
+    "notes-add-with-out": ["notes", "{in}/results_good", "--add", "text", "-o", "{out}/n.csv"],
+    "notes-out-dir": ["notes", "{in}/results_good", "-o", "{in}/adir"],
+}
+
+
+@pytest.mark.parametrize("case", list(PLAN_CASES))
+def test_plan_and_notes_bad_input_is_refused_in_one_line(case, inputs, tmp_path, capsys, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "p.toml").write_text(Path(PROTOCOL).read_text())
+    monkeypatch.chdir(out)
+    before = (_tree(inputs), _tree(out), (out / "p.toml").read_bytes())
+    code = main(_argv(PLAN_CASES[case], inputs, out))
+    err = capsys.readouterr().err
+    assert_refused(code, err, before[:2], (_tree(inputs), _tree(out)))
+    assert (out / "p.toml").read_bytes() == before[2]

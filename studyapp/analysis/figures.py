@@ -5,10 +5,13 @@ same drawing code renders to files (Agg, PNG and SVG) and into the GUI's Qt
 canvas. Boxes follow matplotlib's defaults (median line, quartile box,
 whiskers to the furthest sample within 1.5 IQR of the box); every sample is
 drawn over its box, outliers included, so no separate outlier marks. Conditions run best first, left to right, as in
-the paper. The letters above the boxes are the compact letter display of the
-pairwise rank-sum tests (compact_letters.py), on trials pooled across
-participants as in the paper: two conditions sharing a letter are not
-significantly different. The footnote saying so is the figure's
+the paper. The letters above the boxes are a compact letter display
+(compact_letters.py): two conditions sharing a letter are not significantly
+different. By default they come from the within-subject tests, participants
+as the units (Friedman's test, then Holm-corrected pairwise signed-rank
+tests: study.py); with ``pooled_letters`` (``analyse --pooled-letters``) from
+the paper's pairwise rank-sum tests on trials pooled across participants,
+and the footnote then says they are pooled. The footnote is the figure's
 ``supxlabel``, so the constrained layout keeps room for it below the tick
 labels and the x label instead of drawing it over them.
 """
@@ -118,43 +121,56 @@ def _draw_box_plot(figure, task, study, ylabel, title):
         ax.scatter(x + jitter.uniform(-0.18, 0.18, values.size), values, s=9, color="C0", alpha=0.45,
                    linewidths=0, zorder=3)
     above = blended_transform_factory(ax.transData, ax.transAxes)
+    letters, source = study.figure_letters(task)
     for x, name in zip(positions, names):
-        ax.text(x, 1.01, task.letters[name], transform=above, ha="center", va="bottom", fontsize=9)
+        ax.text(x, 1.01, letters[name], transform=above, ha="center", va="bottom", fontsize=9)
     ax.tick_params(axis="x", labelrotation=30)
     ax.grid(True, axis="y", alpha=0.3)
-    correction = ", Holm-corrected" if study.holm else ""
-    _footnote(
-        figure,
-        f"letters: conditions sharing a letter do not differ (Wilcoxon rank-sum, p < {study.alpha:g}{correction}),\n"
-        f"{POOLED}",
-    )
+    _footnote(figure, letters_footnote(study, task, source))
+
+
+def letters_footnote(study, task, source):
+    """What the letters over a box plot come from, in the figure's words."""
+    if source == "pooled":
+        correction = ", Holm-corrected" if study.holm else ", uncorrected"
+        return (f"letters (pooled, on request): conditions sharing a letter do not differ (Wilcoxon rank-sum, "
+                f"p < {study.alpha:g}{correction}),\n{POOLED}")
+    n = task.within.n_participants
+    return (f"letters: conditions sharing a letter do not differ within subjects ({n} participants: Friedman, "
+            f"then Wilcoxon signed-rank,\nHolm-corrected, p < {study.alpha:g})")
 
 
 def _footnote(figure, text):
     figure.supxlabel(text, x=0.01, ha="left", fontsize=8, color="0.35")
 
 
-# Label positions tried around a point, nearest first: (dx, dy) in points, alignment.
+# Label positions tried around a point, nearest first: (dx, dy) in points from the point to the
+# label's anchor (the corner or edge given by the alignment), and that alignment.
 _LABEL_SPOTS = [
     (dx * sx, dy * sy, "left" if sx > 0 else "right", "bottom" if sy > 0 else "top")
     for dx, dy in ((5, 4), (5, 14), (12, 24))
     for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1))
-]
+] + [(7, 0, "left", "center"), (-7, 0, "right", "center"), (0, 7, "center", "bottom"), (0, -7, "center", "top")]
 
 
 def _place_labels(figure, ax, labels):
-    """Move each point label to the first spot where it meets no earlier label and stays in the axes.
+    """Move each point label to the first spot that is its point's alone, clear of earlier labels, in the axes.
 
-    Measured with the renderer after the layout is done (labels are kept out of
-    the layout, so moving them cannot move the axes). When no spot is free, the
-    one overlapping least is kept.
+    A spot is its point's alone when the label's anchor and the middle of its
+    box are both nearer its own point than any other point, and the box
+    covers no other point: a reader then pairs every label with its marker
+    (two close points each get the side away from the other). Measured with
+    the renderer after the layout is done (labels are kept out of the layout,
+    so moving them cannot move the axes). When no spot is free, the one with
+    the least overlap and ambiguity is kept.
     """
     for label in labels:
         label.set_in_layout(False)
     figure.draw_without_rendering()
     frame = ax.get_window_extent()
+    points = [ax.transData.transform(label.xy) for label in labels]
     placed = []
-    for label in labels:
+    for i, label in enumerate(labels):
         best = None
         for dx, dy, ha, va in _LABEL_SPOTS:
             label.set_position((dx, dy))
@@ -163,6 +179,8 @@ def _place_labels(figure, ax, labels):
             box = label.get_window_extent()
             inside = frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
             clash = sum(_overlap(box, other) for other in placed) + (0.0 if inside else box.width * box.height)
+            if not _alone(i, points, label_anchor(label), box):
+                clash += 4.0 * box.width * box.height
             if best is None or clash < best[0]:
                 best = (clash, dx, dy, ha, va, box)
             if clash == 0.0:
@@ -172,6 +190,24 @@ def _place_labels(figure, ax, labels):
         label.set_horizontalalignment(ha)
         label.set_verticalalignment(va)
         placed.append(box)
+
+
+def label_anchor(label):
+    """Where annotation ``label`` is attached, in display pixels: its point plus its offset in points."""
+    x, y = label.axes.transData.transform(label.xy)
+    dx, dy = label.get_position()
+    scale = label.figure.dpi / 72.0
+    return x + dx * scale, y + dy * scale
+
+
+def _alone(i, points, anchor, box):
+    """True when ``anchor`` and ``box``'s middle are nearest ``points[i]`` and the box holds no other point."""
+    middle = ((box.x0 + box.x1) / 2, (box.y0 + box.y1) / 2)
+    for spot in (anchor, middle):
+        distances = [(spot[0] - px) ** 2 + (spot[1] - py) ** 2 for px, py in points]
+        if min(range(len(points)), key=distances.__getitem__) != i:
+            return False
+    return not any(j != i and box.x0 <= px <= box.x1 and box.y0 <= py <= box.y1 for j, (px, py) in enumerate(points))
 
 
 def _overlap(a, b):

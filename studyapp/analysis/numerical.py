@@ -13,6 +13,9 @@ in perceptual.py). Each estimator's numerical
 score is the median over recordings of its error (or delay) as percent of
 LOWPASS, Fig. 5's normalisation; when those lists are absent or empty, the
 median of the raw ``error`` (``delay``) list. Which one was used is reported.
+The delay counts by its magnitude, |D|, as the evaluation's objective counts
+it: an estimate one sample ahead of the LVT reference is no closer to it than
+one a sample behind.
 
 Both comparisons are oriented so that rho > 0 means the rankings agree:
 noisiness and error are both better when lower (rho of the two medians);
@@ -72,6 +75,8 @@ def numerical_scores(evaluation, quantity):
     scores = {}
     for name, result in estimators.items():
         values = _numbers(result[metric], metric)
+        if quantity == "delay":
+            values = np.abs(values)
         finite = values[np.isfinite(values)]
         if finite.size:
             scores[name.upper()] = float(np.median(finite))

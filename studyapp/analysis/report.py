@@ -92,11 +92,28 @@ def _inputs(study):
         "and pairwise Wilcoxon signed-rank tests, Holm-corrected, with the matched-pairs rank-biserial "
         "correlation as effect size",
         f"Significance at p &lt; {study.alpha:g}",
+        "Letters on Figs. 7-8: " + ("the pooled rank-sum tests', on request (<code>--pooled-letters</code>)"
+                                    if study.pooled_letters else "the within-subject tests'"),
     ]
+    if study.simulated_left_out:
+        items.append(f"Left out: {len(study.simulated_left_out)} simulated participants "
+                     f"({html.escape(', '.join(study.simulated_left_out))}); "
+                     "<code>--include-simulated</code> analyses them too")
+    if study.include_simulated:
+        simulated = ", ".join(_simulated_participants(study)) or "none present"
+        items.append(f'<span class="warn">Simulated participants included (--include-simulated): '
+                     f"{html.escape(simulated)}</span>")
     hashes = study.protocol_hashes()
     if len(hashes) > 1:
         items.append(f'<span class="warn">The responses come from {len(hashes)} different protocols</span>')
     return "<h2>Inputs</h2><ul>" + "".join(f"<li>{item}</li>" for item in items) + "</ul>"
+
+
+def _simulated_participants(study):
+    responses = study.responses
+    if "simulated" not in responses:
+        return []
+    return sorted({str(p) for p in responses.loc[responses["simulated"].astype(bool), "participant"]})
 
 
 def _missing(study):
@@ -115,15 +132,22 @@ def _task_tables(study, task, unit):
     if not task.groups:
         return f"<p>No {task.task} responses.</p>"
     unit_text = f" ({unit})" if unit else ""
+    pooled = study.pooled_letters
     summary = _table(
-        ["condition", "n", f"median{unit_text}", "q1", "q3", "letters"],
+        ["condition", "n", f"median{unit_text}", "q1", "q3", "letters (within-subject)",
+         *(["letters (pooled rank-sum)"] if pooled else [])],
         [
-            [row.condition, row.n, row.median, row.q1, row.q3, task.letters[row.condition]]
+            [row.condition, row.n, row.median, row.q1, row.q3, task.letters[row.condition],
+             *([task.pooled_letters[row.condition]] if pooled else [])]
             for row in task.summary.itertuples()
         ],
     )
+    drawn = "the pooled rank-sum letters (on request)" if pooled else "the within-subject letters"
     return (
-        f"<h3>Summary (best first)</h3>{summary}"
+        f"<h3>Summary (best first)</h3>"
+        "<p>Conditions sharing a letter do not differ. Within-subject letters: Friedman's test rejects and the "
+        f"pair's Holm-corrected signed-rank p &lt; {study.alpha:g} (tests below). The figure shows {drawn}.</p>"
+        f"{summary}"
         f"<h3>Pairwise Wilcoxon rank-sum p-values, {POOLED}</h3>"
         "<p>The paper's test (Figs. 7-8): every response counts as an independent sample, but the responses "
         "of one participant are not independent of each other, so these p-values are too small; the "

@@ -15,8 +15,9 @@ Names are fixed, so scripts and the GUI find them:
     spearman_numerical.csv                         only with an evaluation
     perceptual_correlation.csv                     only with an evaluation: noisiness against audio_distance
     responses_analysed.csv                         the checked responses the numbers come from
-    analysis_settings.json                         source, Holm, alpha, expected trials, evaluation, and
-                                                   under "tests" the test behind each table
+    analysis_settings.json                         source, Holm, alpha, expected trials, evaluation, which
+                                                   rows were kept (include_practice, include_simulated),
+                                                   pooled_letters, and under "tests" the test behind each table
     fig7_adjustment, fig8_rating, fig9_scatter     .png and .svg
     report.html                                    everything above in one file
 
@@ -28,6 +29,8 @@ a responses .csv with the defaults: what the GUI's analysis view shows.
 
 import json
 from pathlib import Path
+
+import pandas as pd
 
 from studyapp.analysis.consistency import SPEARMAN_COLUMNS
 from studyapp.analysis.figures import FIGURES, render, save_figure
@@ -54,22 +57,29 @@ TESTS = {
 }
 
 
-def open_study(path):
-    """``StudyAnalysis`` of a report folder, a results folder or a responses .csv at ``path``."""
+def open_study(path, include_simulated=False):
+    """``StudyAnalysis`` of a report folder, a results folder or a responses .csv at ``path``.
+
+    ``include_simulated`` applies to a results folder or .csv; a report folder keeps its own settings.
+    """
     path = Path(path)
     settings_path = path / SETTINGS_FILE
     if not (path.is_dir() and (path / RESPONSES_FILE).is_file() and settings_path.is_file()):
-        responses, label = load_responses(path)
-        return analyse(responses, source=label)
+        responses, label = load_responses(path, include_simulated=include_simulated)
+        return analyse(responses, source=label, include_simulated=include_simulated)
     try:
         settings = json.loads(settings_path.read_text(encoding="utf-8"))
         source, holm, alpha = str(settings["source"]), bool(settings["holm"]), float(settings["alpha"])
         expected, evaluation = settings.get("expected"), settings.get("evaluation")
+        # what the analysed responses kept (older folders: the defaults)
+        kept = {key: bool(settings.get(key, False)) for key in ("include_practice", "include_simulated")}
+        pooled_letters = bool(settings.get("pooled_letters", False))
     except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError) as exc:
         raise InputDataError(f"{settings_path}: not a valid analysis settings file ({exc})") from None
-    responses, _ = load_responses(path / RESPONSES_FILE)
+    responses, _ = load_responses(path / RESPONSES_FILE, **kept)
     evaluation = load_evaluation(evaluation) if evaluation and Path(evaluation).exists() else None
-    return analyse(responses, source=source, evaluation=evaluation, holm=holm, alpha=alpha, expected=expected)
+    return analyse(responses, source=source, evaluation=evaluation, holm=holm, alpha=alpha, expected=expected,
+                   pooled_letters=pooled_letters, include_simulated=kept["include_simulated"])
 
 
 def write_report_folder(study, directory, progress=None, evaluation_path=None, expected=None):
@@ -108,6 +118,9 @@ def write_report_folder(study, directory, progress=None, evaluation_path=None, e
         "source": study.source,
         "holm": study.holm,
         "alpha": study.alpha,
+        "pooled_letters": study.pooled_letters,
+        "include_simulated": study.include_simulated,
+        "include_practice": bool(study.responses.get("practice", pd.Series(dtype=bool)).astype(bool).any()),
         "expected": expected,
         "evaluation": None if evaluation_path is None else str(Path(evaluation_path).resolve()),
         "tests": {

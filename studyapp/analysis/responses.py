@@ -14,7 +14,10 @@ task, condition, trial, fmax, rating``.
 Practice trials (a ``practice`` column that is True, ``studyapp export``)
 are left out before anything is checked or counted, unless
 ``include_practice``: the paper's statistics are of the real trials only. An
-export without the column (older versions) has no practice rows.
+export without the column (older versions) has no practice rows. Likewise
+the sessions of the simulated participant (a ``simulated`` column that is
+True) are left out unless ``include_simulated``: an in-silico pilot is not a
+participant. When nothing else is left, that is one line naming the option.
 
 A response whose value is empty (a trial begun but never confirmed) is kept
 out of the statistics but not forgotten: the missing-trials check counts it as
@@ -37,9 +40,9 @@ MEASURED_TASKS = tuple(t for t in TASKS if task_type(t).measure is not None)
 _TEXT_COLUMNS = ["participant", "session", "task", "condition", "protocol_hash"]
 
 
-def load_responses(source, problems=None, include_practice=False):
+def load_responses(source, problems=None, include_practice=False, include_simulated=False):
     """Checked responses from ``source``: a ``.csv`` export or a results folder (practice rows left
-    out unless ``include_practice``).
+    out unless ``include_practice``, simulated participants' unless ``include_simulated``).
 
     Returns ``(responses, label)``; ``label`` names the source in messages. A
     results folder is exported with ``studyapp.experiment.export.export_responses``,
@@ -54,7 +57,8 @@ def load_responses(source, problems=None, include_practice=False):
             frame = pd.read_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
             raise InputDataError(f"{path}: not a readable CSV file ({_first_line(exc)})") from None
-        return check_responses(frame, str(path), csv_rows=True, include_practice=include_practice), str(path)
+        return check_responses(frame, str(path), csv_rows=True, include_practice=include_practice,
+                               include_simulated=include_simulated), str(path)
     if path.is_dir():
         try:
             from studyapp.experiment.export import export_responses
@@ -64,15 +68,16 @@ def load_responses(source, problems=None, include_practice=False):
                 "installed; pass an exported responses.csv instead"
             ) from None
         return check_responses(export_responses(path, problems), str(path),
-                               include_practice=include_practice), str(path)
+                               include_practice=include_practice, include_simulated=include_simulated), str(path)
     raise UserError(f"{path}: expected a results folder or an exported responses .csv file")
 
 
-def check_responses(frame, label, csv_rows=False, include_practice=False):
+def check_responses(frame, label, csv_rows=False, include_practice=False, include_simulated=False):
     """A cleaned copy of ``frame``: text columns as str, numbers as float, tasks checked.
 
     ``csv_rows`` numbers rows as lines of the CSV file (header = line 1) in messages.
-    Practice rows are left out unless ``include_practice``.
+    Practice rows are left out unless ``include_practice``; simulated participants' rows
+    unless ``include_simulated``.
     """
     missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
     if missing:
@@ -88,13 +93,23 @@ def check_responses(frame, label, csv_rows=False, include_practice=False):
 
     frame = frame.reset_index(drop=True)
     if "practice" in frame.columns:
-        practice = _practice_flags(frame["practice"], label, where)
+        practice = _flags(frame["practice"], "practice", label, where)
         if not include_practice:
             # the original line numbers stay in the index for the messages below
             frame = frame[~practice]
             if len(frame) == 0:
                 raise InputDataError(f"{label}: no responses but practice ones (allowed: --include-practice)")
         frame = frame.assign(practice=practice[frame.index])
+    left_out = []
+    if "simulated" in frame.columns:
+        simulated = _flags(frame["simulated"], "simulated", label, where)
+        if not include_simulated:
+            left_out = sorted({str(p) for p in frame.loc[simulated, "participant"]})
+            frame = frame[~simulated]
+            if len(frame) == 0:
+                raise InputDataError(f"{label}: every response is from a simulated participant "
+                                     f"({', '.join(left_out)}): allowed is --include-simulated to analyse them")
+        frame = frame.assign(simulated=simulated[frame.index])
     frame = frame.copy()
 
     for column in ["participant", "task", "condition"]:
@@ -133,7 +148,9 @@ def check_responses(frame, label, csv_rows=False, include_practice=False):
             raise InputDataError(
                 f"{label}: column '{measure.column}' at {where(i)} is {values[i]:g}; allowed: {measure.allowed}"
             )
-    return frame.reset_index(drop=True)
+    frame = frame.reset_index(drop=True)
+    frame.attrs["simulated_left_out"] = left_out  # participant IDs, for the report (set last: attrs are fragile)
+    return frame
 
 
 def response_values(responses, task):
@@ -161,8 +178,8 @@ def _first(mask):
     return int(mask.index[np.flatnonzero(mask.to_numpy())[0]])
 
 
-def _practice_flags(series, label, where):
-    """The ``practice`` column as bool: True/False (a CSV's text too); empty is False."""
+def _flags(series, column, label, where):
+    """A True/False ``column`` (``practice``, ``simulated``) as bool (a CSV's text too); empty is False."""
     def flag(v):
         if isinstance(v, (bool, np.bool_)):
             return bool(v)
@@ -174,7 +191,7 @@ def _practice_flags(series, label, where):
     bad = flags.isna()
     if bad.any():
         i = _first(bad)
-        raise InputDataError(f"{label}: column 'practice' at {where(i)} is '{series[i]}'; allowed: True, False")
+        raise InputDataError(f"{label}: column '{column}' at {where(i)} is '{series[i]}'; allowed: True, False")
     return flags.astype(bool)
 
 

@@ -41,10 +41,10 @@ difference: T = 0, p = 1, r = 0.
 Smallest attainable p: without ties the most extreme outcome (every d_i of one
 sign) has probability 2 / 2^n' two-sided, so a test on n participants can
 never give p below 2^(1 - n): p < 0.05 needs n >= 6; after Holm's correction
-over m pairs, m 2^(1 - n) < alpha is needed (36 pairs: n >= 11).
+over m pairs, m 2^(1 - n) < alpha is needed (36 pairs: n = 9 gives at best
+36 x 2^-8 = 0.14, n >= 11 is needed).
 """
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -116,6 +116,15 @@ def minimum_p(n):
 
 
 def participants_needed(alpha, pairs=1):
-    """The fewest participants with which ``pairs`` Holm-corrected tests can reach p < ``alpha``."""
-    # pairs * 2^(1 - n) < alpha  <=>  n > 1 + log2(pairs / alpha)
-    return math.floor(1.0 + math.log2(max(pairs, 1) / alpha)) + 1
+    """The fewest participants with which ``pairs`` Holm-corrected tests can reach p < ``alpha``.
+
+    Holm's first step multiplies the smallest p by the number of pairs, so the
+    smallest n with pairs x 2^(1 - n) < alpha (counted, not solved with a
+    logarithm, so an exact power of two is not lost to rounding).
+    """
+    if not 0.0 < alpha <= 1.0:
+        raise ValueError(f"alpha = {alpha}: allowed is 0 < alpha <= 1")
+    n = 1
+    while max(pairs, 1) * minimum_p(n) >= alpha:
+        n += 1
+    return n

@@ -6,10 +6,16 @@ condition; conditions are ordered best first (highest median). Rating task
 first (lowest median). For each task: median and quartiles, the paper's
 pairwise Wilcoxon rank-sum tests of every pair on the samples pooled across
 participants (optionally Holm-corrected; trials of one participant are not
-independent, so these p-values are too small), the compact letters marking
-which conditions differ, and the within-subject analysis on per-participant
-medians: Friedman's test and Holm-corrected pairwise signed-rank tests with
-effect sizes (within_subject.py). Fig. 9 pairs the two medians per condition.
+independent, so these p-values are too small), and the within-subject
+analysis on per-participant medians: Friedman's test and Holm-corrected
+pairwise signed-rank tests with effect sizes (within_subject.py). The compact
+letters marking which conditions differ (``letters``, drawn on Figs. 7-8)
+come from the within-subject tests: two conditions get no common letter when
+Friedman's test rejects and their Holm-corrected signed-rank p is below alpha
+(``WithinSubject.different_pairs``). The letters of the pooled rank-sum tests
+(``pooled_letters``) are kept for the report and drawn only on request
+(``pooled_letters=True``, ``analyse --pooled-letters``), labelled as such.
+Fig. 9 pairs the two medians per condition.
 Consistency and, given an evaluation, the numerical and perceptual
 comparisons follow (consistency.py, numerical.py, perceptual.py).
 """
@@ -41,8 +47,9 @@ class TaskAnalysis:
     groups: dict  # condition -> float array of samples, best first
     summary: pd.DataFrame  # condition, n, median, q1, q3
     wilcoxon: pd.DataFrame  # condition_a, condition_b, statistic, p_value, significant, p_raw
-    letters: dict  # condition -> compact letters
+    letters: dict  # condition -> compact letters of the within-subject tests
     within: WithinSubject  # per-participant medians, Friedman, pairwise signed-rank tests
+    pooled_letters: dict  # condition -> compact letters of the pooled rank-sum tests (the paper's)
 
     @property
     def conditions(self):
@@ -69,6 +76,15 @@ class StudyAnalysis:
     perceptual_note: str | None = None  # why the perceptual row is empty, when it is
     holm: bool = False
     alpha: float = ALPHA
+    pooled_letters: bool = False  # Figs. 7-8 show the pooled rank-sum letters instead of the within-subject ones
+    include_simulated: bool = False  # the simulated participants' sessions are analysed too
+    simulated_left_out: tuple = ()  # the simulated participants left out (participant IDs)
+
+    def figure_letters(self, task):
+        """(letters drawn on ``task``'s figure, what they come from): within-subject unless ``pooled_letters``."""
+        if self.pooled_letters:
+            return task.pooled_letters, "pooled"
+        return task.letters, "within"
 
     @property
     def participants(self):
@@ -107,11 +123,14 @@ class StudyAnalysis:
         return float(values.mean()) if values.size else float("nan")
 
 
-def analyse(responses, source="responses", evaluation=None, holm=False, alpha=ALPHA, expected=None):
+def analyse(responses, source="responses", evaluation=None, holm=False, alpha=ALPHA, expected=None,
+            pooled_letters=False, include_simulated=False):
     """``StudyAnalysis`` of checked ``responses`` (see responses.py).
 
     ``evaluation`` is a parsed evaluation.json or None; ``expected`` maps a task
     to its responses per condition and participant (see missing_trials.py).
+    ``pooled_letters`` draws the pooled rank-sum letters on Figs. 7-8;
+    ``include_simulated`` records that simulated participants were kept.
     """
     adjustment_values = response_values(responses, "adjustment")
     rating_values = response_values(responses, "rating")
@@ -138,6 +157,9 @@ def analyse(responses, source="responses", evaluation=None, holm=False, alpha=AL
         perceptual_note=perceptual_note,
         holm=holm,
         alpha=alpha,
+        pooled_letters=pooled_letters,
+        include_simulated=include_simulated,
+        simulated_left_out=tuple(responses.attrs.get("simulated_left_out", ())),
     )
 
 
@@ -148,6 +170,8 @@ def _task(values, task, holm, alpha):
     order = sorted(medians.index, key=lambda c: (-medians[c] if higher_is_better else medians[c], c))
     groups = {c: values.loc[values["condition"] == c, "value"].to_numpy(dtype=float) for c in order}
     wilcoxon = pairwise_rank_sum(groups, alpha=alpha, holm=holm)
-    different = wilcoxon.loc[wilcoxon["significant"], ["condition_a", "condition_b"]].itertuples(index=False)
-    letters = compact_letters(order, [tuple(pair) for pair in different])
-    return TaskAnalysis(task, groups, summarise(groups), wilcoxon, letters, within_subject(values, order, alpha))
+    pooled = wilcoxon.loc[wilcoxon["significant"], ["condition_a", "condition_b"]].itertuples(index=False)
+    within = within_subject(values, order, alpha)
+    return TaskAnalysis(task, groups, summarise(groups), wilcoxon,
+                        letters=compact_letters(order, within.different_pairs(alpha)), within=within,
+                        pooled_letters=compact_letters(order, [tuple(pair) for pair in pooled]))

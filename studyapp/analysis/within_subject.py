@@ -14,9 +14,19 @@ compared within participants:
    p_holm < alpha. ``effect_size`` is the matched-pairs rank-biserial
    correlation, positive when ``condition_a`` tends to be larger.
 
+``different_pairs`` is what the compact letters of Figs. 7-8 show: the pairs
+whose Holm-corrected signed-rank p is below alpha, provided Friedman's test
+rejects first (with two conditions there is no omnibus test: the one pair's
+test decides). Asking the omnibus test first is the usual protection; it
+can only take pairs away, never add one.
+
 ``warnings`` says when there are too few participants for a test to mean
-much: the Friedman chi-square below six participants, a signed-rank test that
-cannot reach p < alpha at all (n < 6 for 0.05), or after Holm's correction.
+much: the Friedman chi-square below six participants, and the number of
+participants the pairwise tests as used need: the exact two-sided
+signed-rank p of n participants is at least 2^(1 - n) (every difference of
+one sign), and Holm's correction over the task's m pairs multiplies the
+smallest p by m, so no pair can be significant unless m 2^(1 - n) < alpha
+(36 pairs at 0.05: 11 participants; 28 pairs: 11; one pair: 6).
 """
 
 from dataclasses import dataclass
@@ -69,19 +79,32 @@ class WithinSubject:
             lines.append(line)
         pairs = k * (k - 1) // 2
         smallest = signed_rank_minimum_p(n)
-        needed = participants_needed(alpha)
-        needed_holm = participants_needed(alpha, pairs)
-        if n < needed:
+        needed = participants_needed(alpha, pairs)
+        if n >= needed:
+            return lines
+        if pairs == 1:
             lines.append(
                 f"a signed-rank test on {n} participants cannot reach p < {alpha:g} two-sided: the smallest "
-                f"attainable p is 2^(1-n) = {smallest:.3g}; {needed} participants are needed"
+                f"exact p is 2^(1-n) = {smallest:.3g}; {needed} participants are needed"
             )
-        elif n < needed_holm:
+        else:
             lines.append(
-                f"after Holm's correction over {pairs} pairs no pair can be significant with {n} participants "
-                f"(smallest adjusted p {pairs} x 2^(1-n) = {pairs * smallest:.3g}); {needed_holm} are needed"
+                f"no pair can be significant with {n} participants: the smallest exact two-sided signed-rank p "
+                f"is 2^(1-n) = {smallest:.3g}, and Holm's correction over the {pairs} pairs multiplies it by "
+                f"{pairs}: {pairs * smallest:.3g}, not below {alpha:g}; {needed} participants are needed"
             )
         return lines
+
+    def different_pairs(self, alpha):
+        """The pairs the within-subject tests find different (module docstring), for the compact letters."""
+        table = self.signed_rank
+        if table.empty:
+            return []
+        f = self.friedman
+        if f.n_conditions >= MIN_CONDITIONS and not f.p_value < alpha:  # NaN (not computed) rejects nothing
+            return []
+        rows = table.loc[table["significant"], ["condition_a", "condition_b"]].itertuples(index=False)
+        return [tuple(row) for row in rows]
 
 
 def participant_medians(values, conditions):

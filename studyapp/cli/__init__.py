@@ -34,6 +34,8 @@ COMMANDS = [
     "tradeoff",
     "live",
     "run",
+    "plan",
+    "notes",
     "export",
     "analyse",
     "bench",

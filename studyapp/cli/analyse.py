@@ -1,12 +1,16 @@
-"""``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] [--include-practice] -o REPORT_DIR``:
-the paper's Sec. 9-10.
+"""``studyapp analyse RESULTS_DIR [--evaluation DIR] [--holm] [--include-practice] [--include-simulated]
+[--pooled-letters] -o REPORT_DIR``: the paper's Sec. 9-10.
 
 RESULTS_DIR is a results folder or an exported responses .csv. Writes the
 paper's pooled Wilcoxon rank-sum tables, the within-subject Friedman and
 signed-rank tables, the summary and Spearman tables, Figs. 7-9 (PNG and SVG)
 and report.html into REPORT_DIR (see studyapp/analysis/report_folder.py);
 with --evaluation, the numerical comparisons and perceptual_correlation.csv.
-Practice trials are left out unless --include-practice.
+Practice trials are left out unless --include-practice, and the sessions of
+the simulated participant (export's ``simulated`` column) unless
+--include-simulated; with nothing but simulated sessions that is one line and
+exit 2. The letters on Figs. 7-8 come from the within-subject tests; with
+--pooled-letters from the paper's pooled rank-sum tests, labelled so.
 Participants short of responses, and too few participants for a test, are
 listed on stderr and in the report. An unreadable session or damaged log line
 in RESULTS_DIR is skipped with a warning (refused with --strict).
@@ -33,6 +37,12 @@ def register(subparsers):
     parser.add_argument("--trials", type=int, metavar="N", help="adjustment trials each participant owes per condition (default: the most any participant has)")
     parser.add_argument("--include-practice", action="store_true",
                         help="analyse the practice trials too (by default their rows, practice = True, are left out)")
+    parser.add_argument("--include-simulated", action="store_true",
+                        help="analyse the simulated participants' sessions too (by default their rows, "
+                             "simulated = True, are left out)")
+    parser.add_argument("--pooled-letters", action="store_true",
+                        help="letters on Figs. 7-8 from the paper's rank-sum tests on trials pooled across "
+                             "participants (labelled so) instead of the within-subject tests")
     parser.add_argument("--strict", action="store_true",
                         help="refuse (exit 2) a results folder with an unreadable session or log line; by default "
                              "such data is skipped with a warning")
@@ -55,10 +65,11 @@ def run(args):
     def say(message):
         print(f"studyapp analyse: {message}", file=sys.stderr, flush=True)
 
-    output_paths.check_folder(args.output)
+    output_paths.check_folder(args.output, inputs=[args.results, *filter(None, [args.evaluation])])
     # read before saying anything: bad input is then the one line on stderr
     problems = []
-    responses, label = load_responses(args.results, problems, include_practice=args.include_practice)
+    responses, label = load_responses(args.results, problems, include_practice=args.include_practice,
+                                      include_simulated=args.include_simulated)
     for problem in problems:
         say(f"warning: {problem}")
     if problems and args.strict:
@@ -67,8 +78,12 @@ def run(args):
     evaluation = load_evaluation(args.evaluation) if args.evaluation else None
     say(f"read {args.results}")
     expected = {"adjustment": args.trials} if args.trials else None
-    study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected)
+    study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected,
+                    pooled_letters=args.pooled_letters, include_simulated=args.include_simulated)
     say(f"{len(study.participants)} participants, {len(responses)} responses")
+    if study.simulated_left_out:
+        say(f"left out {len(study.simulated_left_out)} simulated participants ({', '.join(study.simulated_left_out)}): "
+            "--include-simulated analyses them too")
     for line in study.warnings() + study.sample_size_warnings():
         say(f"warning: {line}")
     if study.perceptual_note:

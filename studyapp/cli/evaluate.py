@@ -54,7 +54,7 @@ def run(args):
         raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
     output = Path(args.output) if args.output else None
     if output is not None:
-        output_paths.check_folder(output)
+        output_paths.check_folder(output, inputs=[*args.recordings, *filter(None, [args.params, args.validation])])
     if args.compare_paper and output is None:
         raise UserError("--compare-paper: needs -o DIR, the folder its two tables are written to")
     takes = load_takes(expand_paths(args.recordings), args.reference)

@@ -30,7 +30,7 @@ def run(args):
     from studyapp.errors import UserError
     from studyapp.experiment.export import export_responses, save_responses
 
-    output_paths.check_file(args.output)
+    output_paths.check_file(args.output)  # never into a session folder, whose files are the export's inputs
     problems = []
     frame = export_responses(args.results, problems)
     for problem in problems:

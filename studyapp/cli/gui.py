@@ -65,6 +65,7 @@ def register(sub):
 
 
 def run(args):
+    from studyapp.cli import output_paths
     from studyapp.errors import UserError
     from studyapp.gui.display import require_display
 
@@ -82,6 +83,8 @@ def run(args):
         path = getattr(args, option)
         if path and not path.lower().endswith(".png"):
             raise UserError(f"--{option.replace('_', '-')} {path}: allowed is a file name ending in .png")
+        if path:
+            output_paths.check_file(path, f"--{option.replace('_', '-')}")
     if args.size is not None:
         args.size = parse_size(args.size)
     try:

@@ -44,7 +44,7 @@ def register(sub):
                    help="longest delay searched by the cross-correlation (default 0.02 s)")
     delay_option.add(p)
     p.add_argument("--range", action="append", default=[], metavar="NAME.PARAM=LOW:HIGH",
-                   help="search range of one parameter, within its allowed range (e.g. FOAW.window=1:128)")
+                   help="search range of one parameter, within its allowed range (e.g. FOAW.window=2:128)")
     p.add_argument("--max-sets", type=int, metavar="N", help="also stop an estimator after N new sets")
     p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores; 1: in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -78,7 +78,9 @@ def run(args):
     output = Path(args.output)
     if output.suffix.lower() != ".toml":
         raise UserError(f"-o {output}: expected a .toml file")
-    output_paths.check_file(output)
+    checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
+    output_paths.check_file(output, inputs=args.recordings)
+    output_paths.check_file(checkpoint, "--checkpoint", inputs=[*args.recordings, output])
     if args.max_lag <= 0:
         raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
     if args.patience < 1:
@@ -105,7 +107,6 @@ def run(args):
         rate = min(t.rate for t in takes)
     ranges = parse_ranges(args.range)
     spaces = {name: Space(name, rate, args.tune, ranges=ranges.get(name)) for name in names}
-    checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
     if args.resume and not checkpoint.is_file():
         raise UserError(f"--resume: no checkpoint at {checkpoint}")
 
@@ -177,8 +178,8 @@ def parse_ranges(items):
         try:
             pair = (float(low), float(high))
         except ValueError:
-            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=1:128") from None
+            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=2:128") from None
         if not name or not param:
-            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=1:128")
+            raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=2:128")
         ranges.setdefault(spec(name).name, {})[param] = pair
     return ranges

@@ -5,6 +5,15 @@ above the output: the only way to know a folder is writable (root passes
 ``os.access`` on a read-only mount). The writes themselves are atomic
 (``studyapp.atomic``); an error later (a full disk) is reported by
 ``studyapp.cli.main`` in one line.
+
+Participant data is never an output. No command writes into a session folder
+(one holding ``events.jsonl``, or the ``session.json`` of a session): its
+``events.jsonl``, ``session.json``, ``audio*.wav`` and ``audio_cues.csv`` are
+what the participant did, and ``--resume`` and ``export`` read them. Nor over a
+session lock (``.lock``: replacing it would let a second program in beside the
+holder), nor over one of the command's own inputs: an output file is none of
+them, and an output folder is not an input folder and holds no input file (the
+command's fixed file names could fall on one).
 """
 
 import os
@@ -12,6 +21,7 @@ import tempfile
 from pathlib import Path
 
 from studyapp.errors import UserError
+from studyapp.experiment.session_files import EVENTS_FILE, LOCK_FILE, SESSION_FILE, is_session_folder
 
 
 def _existing_parent(path, option):
@@ -25,25 +35,60 @@ def _existing_parent(path, option):
     _probe(parent, f"{option} {path}: cannot create a file in {parent}")
 
 
+def _refuse_session_data(path, folder, option):
+    """``path`` is an output written in ``folder``: refused when that, or the nearest folder that exists
+    above it (where the missing ones would be made), is a session folder."""
+    folder = Path(os.path.abspath(folder))
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    for place in dict.fromkeys([folder, folder.resolve()]):
+        if is_session_folder(place):
+            raise UserError(f"{option} {path}: inside the session folder {place}, whose {EVENTS_FILE}, "
+                            f"{SESSION_FILE} and audio files are participant data: allowed is a path outside "
+                            "every session folder")
+
+
+def _same(a, b):
+    """One file (or folder) by either name: the same path, or the same inode (a link)."""
+    if os.path.abspath(a) == os.path.abspath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
 def check_file(path, option="-o", inputs=()):
-    """Raise ``UserError`` unless ``path`` can become a file (it is not a folder nor one of ``inputs``)."""
+    """Raise ``UserError`` unless ``path`` can become a file (not a folder, participant data nor one of ``inputs``)."""
     path = Path(path)
     if path.is_dir():
         raise UserError(f"{option} {path}: is a directory: allowed is a file name")
     if path.exists() and not path.is_file():
         raise UserError(f"{option} {path}: is not a regular file")
     for source in inputs:
-        if path.exists() and Path(source).exists() and os.path.samefile(path, source):
-            raise UserError(f"{option} {path}: is the input file: allowed is another file name")
+        if _same(path, source):
+            raise UserError(f"{option} {path}: is {source}, which this command reads or writes: "
+                            "allowed is another file name")
+    _refuse_session_data(path, path.parent, option)
+    if path.name == LOCK_FILE and path.exists():
+        raise UserError(f"{option} {path}: is a session lock: allowed is another file name")
+    if path.is_symlink():  # the atomic write replaces the link itself, but say no to aiming at participant data
+        _refuse_session_data(path, path.resolve().parent, option)
     _existing_parent(path, option)
 
 
-def check_folder(path, option="-o"):
-    """Raise ``UserError`` unless ``path`` is a writable folder or can be created as one."""
+def check_folder(path, option="-o", inputs=()):
+    """Raise ``UserError`` unless ``path`` is a writable folder or can be created as one, holding none of ``inputs``."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise UserError(f"{option} {path}: exists and is not a directory")
+    _refuse_session_data(path, path, option)
     if path.is_dir():
+        for source in inputs:
+            source = Path(source)
+            if _same(path, source) or (not source.is_dir() and _same(path, source.parent)):
+                what = "is the input folder" if _same(path, source) else f"holds the input {source}"
+                raise UserError(f"{option} {path}: {what}: allowed is a folder of its own for the outputs")
         _probe(path, f"{option} {path}: cannot create a file in it")
         return
     _existing_parent(path, option)

@@ -1,6 +1,6 @@
 """``studyapp run --protocol FILE --participant ID [--simulated-participant] [--headless]
-[--resume] [--results DIR] [--seed N] [--experimenter NAME] [--session-number N] [--notes TEXT]
-[--order-row N] [--audio SPEC] [--midi SPEC] [--participant-screen N] [--replay-gesture EVENTS]``:
+[--resume] [--results DIR] [--seed N] [--audio SPEC] [--midi SPEC] [--participant-screen N]
+[--replay-gesture EVENTS] [--experimenter NAME] [--session-number N] [--notes TEXT] [--order-row N]``:
 run one participant's session.
 
 The experimenter's fields and the order row are stored in session.json
@@ -11,6 +11,10 @@ With ``--simulated-participant --headless`` the session runs in this process
 without a display: the closed loop is stepped directly and the simulated
 participant plays every trial (the demo, the end-to-end check, an in-silico
 pilot). Progress goes to stderr; the session folder is printed on stdout.
+``--audio wav`` archives what would have been heard, through the live
+engine's signal chain, as ``audio.wav`` and ``audio_cues.csv`` in the session
+folder, as a live session does (``session.headless_audio``); ``null`` (the
+default headless) renders no audio.
 Without ``--headless`` the session runs in the experimenter console
 (``studyapp.gui.run_session(args)``), with ``--audio``, ``--midi`` and
 ``--participant-screen`` as ``studyapp gui`` takes them; the participant's
@@ -39,7 +43,8 @@ def register(sub):
     parser.add_argument("--seed", type=int, default=None, metavar="N",
                         help="session seed (default: from the study seed and the participant's enrolment)")
     parser.add_argument("--audio", default=None, metavar="SPEC",
-                        help="the console's sound: device | device:NAME | wav:FILE | null (default: device)")
+                        help="headless: wav (audio.wav and audio_cues.csv in the session folder) or null (default); "
+                             "in the console: device | device:NAME | wav:FILE | null, as for gui")
     parser.add_argument("--midi", default=None, metavar="SPEC",
                         help="the console's MIDI input: PORT | first | virtual | none (default: first)")
     parser.add_argument("--participant-screen", type=int, metavar="N",
@@ -84,6 +89,8 @@ def run(args):
         raise UserError(f"--seed {args.seed}: allowed is an integer from 0 to 2**63 - 1")
     if args.headless and not args.simulated_participant:
         raise UserError("--headless: allowed only with --simulated-participant (a person takes part through the GUI)")
+    if args.headless and args.audio not in (None, "wav", "null"):
+        raise UserError(f"--audio {args.audio}: allowed headless is wav (audio.wav in the session folder) or null")
     if args.headless:
         for option in ("midi", "participant_screen"):
             if getattr(args, option) is not None:
@@ -105,21 +112,26 @@ def run(args):
     from studyapp.experiment.session_runner import SessionRunner
     from studyapp.experiment.session_info import order_text
     from studyapp.experiment.simulated_participant import SimulatedParticipant
+    from studyapp.session.headless_audio import ArchivingRunner
 
     def progress(message):
         print(f"studyapp run: {message}", file=sys.stderr, flush=True)
 
+    archive = args.audio == "wav"
     if args.resume:
         session = Session.resume(protocol, args.participant, args.results, seed=args.seed, **session_info_of(args))
     else:
         session = Session.create(protocol, args.participant, args.results, seed=args.seed,
-                                 apparatus={"device": "simulated", "participant": "simulated", "audio": False},
+                                 apparatus={"device": "simulated", "participant": "simulated",
+                                            "audio": "archived (headless)" if archive else False},
                                  **session_info_of(args))
     for note in session.notes:
         progress(f"warning: {note}")
     progress(f"session {session.folder} ({len(session.finished_steps())} of {len(session.schedule)} trials done, "
              f"{order_text(session.info)})")
-    runner = SessionRunner(session, progress=progress)
+    runner = ArchivingRunner(session, progress=progress) if archive else SessionRunner(session, progress=progress)
+    if archive:
+        progress(f"audio: archiving what is heard to {runner.path}")
     try:
         runner.begin()
         player = runner if args.replay is None else ReplayingHand(runner, args.replay)
@@ -130,6 +142,8 @@ def run(args):
             # a log that cannot be written cannot take the note either: the message says why
             with contextlib.suppress(LogWriteError):
                 runner.finish("interrupted")
+        if archive:
+            runner.close()  # the audio up to here stays readable
         session.close()
         raise
     session.close()

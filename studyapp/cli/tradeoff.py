@@ -66,7 +66,7 @@ def run(args):
 
     started = time.monotonic()
     output = Path(args.output)
-    output_paths.check_folder(output)
+    output_paths.check_folder(output, inputs=[args.params] if args.params else [])
     if not 0 < args.duration <= DURATION_MAX:
         raise UserError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
                         f"{DURATION_MAX:g}")

@@ -1,11 +1,14 @@
 """Audio sinks for the string's sound: a PortAudio device, a WAV file, or nothing.
 
-The closed loop renders audio at the haptic rate; a sink resamples it to its
-own rate (``resampler.Resampler``), applies volume and mute, puts in the
-headphone check's reference tone when it is on (``reference_tone``: it
-replaces the string's sound and does not pass through the volume knob), tees
-the result to the session's recorder if one is attached (``audio_recorder``),
-and plays or stores it. Choose one with ``open_sink(spec, haptic_rate)``::
+The closed loop renders audio at the haptic rate; a sink passes it through
+the signal chain (``signal_chain.SignalChain``: silence while the bow is
+lifted and fades at every start, stop and cut, the resampler to the sink's
+rate, volume and mute, the headphone check's reference tone, and a soft
+limiter under ``CEILING_DBFS``), and plays or stores it. The session's
+recorder (``audio_recorder``), if one is attached, gets what reached the
+device: a device sink tees it in its callback, gaps included (an underrun is
+silence in the file, and marked), a file sink as it writes. Choose one with
+``open_sink(spec, haptic_rate)``::
 
     "device" | "device:NAME"   PortAudio output (sounddevice), NAME a substring of the device name
     "wav:FILE"                 16-bit mono WAV at 48 kHz, written atomically when the sink closes; never
@@ -13,8 +16,8 @@ and plays or stores it. Choose one with ``open_sink(spec, haptic_rate)``::
     "null"                     nothing rendered at all
     "discard"                  rendered and resampled, then dropped (what audio costs, for benchmarks)
 
-A device sink plays from a FIFO that the engine keeps filled ``lead`` seconds
-ahead; PortAudio's callback reads it. When the FIFO cannot fill a device
+A device sink (``device_sink.DeviceSink``) plays from a FIFO that the engine
+keeps filled ``lead`` seconds ahead; PortAudio's callback reads it. When the FIFO cannot fill a device
 period the callback plays silence for the rest and counts an *underrun*; when
 the device itself reports one (``output_underflow``, e.g. a JACK xrun) that is
 counted too, and separately as an *xrun*. The device's callback is the audio
@@ -27,18 +30,15 @@ which must take the GIL to run; the worker lowers Python's switch interval so
 that thread waits at most about half a millisecond.
 """
 
-import contextlib
 import os
 import tempfile
-import threading
 import wave
 
 import numpy as np
 
 from studyapp.engine.audio_recorder import numbered
 from studyapp.engine.native_stderr import captured_native_stderr
-from studyapp.engine.reference_tone import ReferenceTone
-from studyapp.engine.resampler import Resampler
+from studyapp.engine.signal_chain import Gain, SignalChain
 from studyapp.errors import ParameterError
 
 DEVICE_RATE = 48_000.0
@@ -77,34 +77,6 @@ def load_sounddevice():
     return sounddevice
 
 
-class Gain:
-    """Volume and mute, ramped linearly over one block on every change so changes never click.
-
-    Settings made before the first block apply at once (there is nothing to click against).
-    """
-
-    def __init__(self, volume=1.0):
-        self.volume = float(volume)
-        self.muted = False
-        self._now = None
-
-    @property
-    def target(self):
-        return 0.0 if self.muted else self.volume
-
-    def apply(self, block):
-        target = self.target
-        if self._now is None:
-            self._now = target
-        if target == self._now:
-            block *= target
-        else:
-            block *= np.linspace(self._now, target, block.shape[0] + 1)[1:]
-            self._now = target
-        np.clip(block, -1.0, 1.0, out=block)
-        return block
-
-
 class Fifo:
     """Single-producer, single-consumer float32 FIFO between the engine thread and the audio callback.
 
@@ -121,6 +93,11 @@ class Fifo:
     @property
     def level(self):
         return self._written - self._read
+
+    @property
+    def read_position(self):
+        """Frames read so far: the position in the written stream of the next frame read."""
+        return self._read
 
     def write(self, samples):
         n = min(samples.shape[0], self.capacity - self.level)
@@ -148,10 +125,12 @@ class Sink:
     paced = False  # does the sink's clock pace the loop?
     rate = DEVICE_RATE
 
-    def __init__(self):
-        self.gain = Gain()
-        self.tone = None  # a sink that renders makes its ReferenceTone at its own rate
-        self.recorder = None  # the session's AudioRecorder, fed every block this sink outputs
+    def __init__(self, haptic_rate=None, rate=None):
+        # a sink that renders has the signal chain at its own rate; the null sink keeps only a volume
+        self.chain = SignalChain(haptic_rate, rate) if self.render else None
+        self.gain = self.chain.gain if self.chain else Gain()
+        self.tone = self.chain.tone if self.chain else None
+        self.recorder = None  # the session's AudioRecorder, fed what this sink outputs
         self.underruns = 0  # device periods played with a gap, for whatever reason
         self.shortfalls = 0  # ... because the FIFO ran dry (the engine was late)
         self.xruns = 0  # ... because the device reported an underflow
@@ -164,17 +143,20 @@ class Sink:
     def start(self):
         pass
 
-    def push(self, audio):
-        """Take one block of the loop's audio (at the haptic rate)."""
+    def push(self, audio, sounding=True, cut=False):
+        """Take one block of the loop's audio (at the haptic rate): ``sounding`` False while the bow is
+        lifted, ``cut`` True when the model's sound jumps at this block (a reset, a new source)."""
+
+    def next_frame(self):
+        """The frame of the sink's output stream at which the next block's first sample is heard."""
+        return self.chain.next_frame() if self.chain else 0
 
     def wait(self, timeout):
         """Block until the sink wants more audio (paced sinks; ``False`` on timeout); return at once otherwise."""
         return True
 
     def set_volume(self, volume):
-        if not 0.0 <= volume <= 4.0:
-            raise ParameterError(f"volume: {volume} is outside 0..4")
-        self.gain.volume = float(volume)
+        self.gain.set_volume(volume)
 
     def set_mute(self, muted):
         self.gain.muted = bool(muted)
@@ -186,11 +168,12 @@ class Sink:
             raise ParameterError(f"reference tone: the {self.description} sink plays no sound")
         self.tone.set(hz, level_dbfs)
 
-    def _heard(self, samples):
-        """What the listener hears of resampled ``samples``: volume and mute, the tone; teed to the recorder."""
-        out = self.tone.mix(self.gain.apply(samples))
-        if self.recorder is not None:
-            self.recorder.write(out)
+    def _heard(self, audio, sounding, cut):
+        """What the listener hears of one block; a file sink tees it to the recorder (a device, in its callback)."""
+        start = self.chain.emitted
+        out = self.chain.process(audio, sounding, cut)
+        if self.recorder is not None and not self.paced:
+            self.recorder.write(out, start)
         return out
 
     def close(self):
@@ -203,17 +186,15 @@ class DiscardSink(Sink):
     render = True
 
     def __init__(self, haptic_rate, rate=DEVICE_RATE):
-        super().__init__()
+        super().__init__(haptic_rate, rate)
         self.rate = float(rate)
-        self.resampler = Resampler(haptic_rate, self.rate)
-        self.tone = ReferenceTone(self.rate)
 
     @property
     def description(self):
         return f"discard ({self.rate:g} Hz)"
 
-    def push(self, audio):
-        self._heard(self.resampler.process(audio))
+    def push(self, audio, sounding=True, cut=False):
+        self._heard(audio, sounding, cut)
 
 
 class WavSink(Sink):
@@ -227,14 +208,12 @@ class WavSink(Sink):
     render = True
 
     def __init__(self, path, haptic_rate, rate=WAV_RATE, say=print):
-        super().__init__()
+        super().__init__(haptic_rate, rate)
         self.say = say
         self.path = str(_free_name(path))
         if self.path != str(path):
             say(f"audio: {path} exists; writing {self.path} (never over an earlier file)")
         self.rate = float(rate)
-        self.resampler = Resampler(haptic_rate, self.rate)
-        self.tone = ReferenceTone(self.rate)
         folder, name = os.path.split(os.path.abspath(self.path))
         fd, self._tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".wav", dir=folder)
         os.fchmod(fd, 0o666 & ~_umask())  # an output's usual permissions, not mkstemp's private ones
@@ -249,18 +228,18 @@ class WavSink(Sink):
     def description(self):
         return f"wav:{self.path} ({self.rate:g} Hz)"
 
-    def _write(self, samples):
-        pcm = np.round(self._heard(samples) * 32767.0).astype("<i2")
+    def _write(self, out):
+        pcm = np.round(out * 32767.0).astype("<i2")
         self._wav.writeframesraw(pcm.tobytes())
         self.frames += pcm.shape[0]
 
-    def push(self, audio):
-        self._write(self.resampler.process(audio))
+    def push(self, audio, sounding=True, cut=False):
+        self._write(self._heard(audio, sounding, cut))
 
     def close(self):
         if self._wav is None:
             return
-        self._write(self.resampler.flush())
+        self._write(self.chain.flush())
         self._wav.close()
         self._wav = None
         chosen = self.path
@@ -300,130 +279,6 @@ def _move_free(source, path):
         return target
 
 
-class DeviceSink(Sink):
-    """A PortAudio output stream fed from a FIFO kept ``lead`` seconds ahead; paces the loop."""
-
-    render = True
-    paced = True
-
-    def __init__(self, haptic_rate, device=None, rate=None, lead=0.03, channels=2):
-        super().__init__()
-        sd = load_sounddevice()
-        self._sd = sd
-        try:
-            with captured_native_stderr() as chatter:
-                index = self._find(sd, device)
-                info = sd.query_devices(index)
-                self.rate = float(rate or info["default_samplerate"] or DEVICE_RATE)
-                channels = max(1, min(channels, int(info["max_output_channels"])))
-                self._stream = sd.OutputStream(
-                    device=index, samplerate=self.rate, channels=channels, dtype="float32",
-                    callback=self._callback, latency="low",
-                )
-        except (sd.PortAudioError, ValueError) as exc:
-            detail = str(exc).strip().splitlines()[0] if str(exc).strip() else "no detail"
-            hint = chatter.text.strip().splitlines()
-            raise AudioUnavailable(f"no usable output device ({detail}{'; ' + hint[0] if hint else ''})") from None
-        self.name = info["name"]
-        self.hostapi = sd.query_hostapis(info["hostapi"])["name"]
-        self.resampler = Resampler(haptic_rate, self.rate)
-        self.tone = ReferenceTone(self.rate)
-        self.lead_frames = int(lead * self.rate)
-        self.fifo = Fifo(max(4 * self.lead_frames, int(self.rate)))
-        self._wanted = threading.Event()
-        self._scratch = np.zeros(0, dtype=np.float32)
-        self.stuck = False
-        self.period_frames = 0
-        self.callbacks = 0
-
-    @staticmethod
-    def _find(sd, device):
-        outputs = [d for d in sd.query_devices() if d["max_output_channels"] > 0]
-        if not outputs:
-            raise sd.PortAudioError("PortAudio sees no output device")
-        if device is None:
-            default = sd.default.device[1]
-            return default if default is not None and default >= 0 else outputs[0]["index"]
-        for d in outputs:
-            if device.lower() in d["name"].lower():
-                return d["index"]
-        names = ", ".join(d["name"] for d in outputs)
-        raise sd.PortAudioError(f"no output device matches {device!r} (have: {names})")
-
-    @property
-    def description(self):
-        return f"{self.name} via {self.hostapi} ({self.rate:g} Hz, lead {1e3 * self.lead_frames / self.rate:.0f} ms)"
-
-    @property
-    def level(self):
-        """Frames queued ahead of the device."""
-        return self.fifo.level
-
-    def _callback(self, outdata, frames, time_info, status):
-        if self._scratch.shape[0] != frames:
-            self._scratch = np.zeros(frames, dtype=np.float32)
-        got = self.fifo.read_into(self._scratch)
-        self.period_frames = max(self.period_frames, frames)
-        short = got < frames
-        if short:
-            self._scratch[got:] = 0.0
-            self.shortfalls += 1
-        if status.output_underflow:
-            self.xruns += 1
-        if short or status.output_underflow:
-            self.underruns += 1
-        outdata[:] = self._scratch[:, None]
-        self.callbacks += 1
-        self.frames_played += frames
-        self._wanted.set()
-
-    def push(self, audio):
-        # volume, mute and tone before the FIFO: the FIFO holds what is heard, as the recorder gets it
-        self.fifo.write(self._heard(self.resampler.process(audio)).astype(np.float32))
-
-    @property
-    def target(self):
-        """Frames to keep queued: the lead, and at least two device periods."""
-        return max(self.lead_frames, 2 * self.period_frames)
-
-    def wait(self, timeout):
-        while self.fifo.level >= self.target:
-            self._wanted.clear()
-            if self.fifo.level < self.target:
-                break
-            if not self._wanted.wait(timeout):
-                return False
-        return True
-
-    def start(self):
-        """Start the stream; call once the FIFO holds ``lead`` (the engine primes it)."""
-        self._stream.start()
-
-    def close(self, timeout=2.0):
-        """Abort and close the stream; ``False`` if PortAudio did not let go within ``timeout``.
-
-        PortAudio's JACK back-end waits up to ten minutes for its callback to
-        acknowledge a stop; a server that has dropped the client (after a long
-        stall) never runs that callback again. So the stream is closed on a
-        helper thread, and a sink that stays stuck is left behind
-        (``self.stuck``): the worker then exits without terminating PortAudio.
-        """
-        if self._stream is None:
-            return not self.stuck
-        stream, self._stream = self._stream, None
-        done = threading.Event()
-
-        def shut():
-            with contextlib.suppress(self._sd.PortAudioError):
-                stream.abort()
-                stream.close()
-            done.set()
-
-        threading.Thread(target=shut, name="studyapp-audio-close", daemon=True).start()
-        self.stuck = not done.wait(timeout)
-        return not self.stuck
-
-
 def open_sink(spec, haptic_rate, say=print, lead=0.03):
     """The sink named by ``spec`` (see module docstring); a null sink, and one line, if a device is unusable."""
     kind, arg = parse(spec)
@@ -433,6 +288,8 @@ def open_sink(spec, haptic_rate, say=print, lead=0.03):
         return DiscardSink(haptic_rate)
     if kind == "wav":
         return WavSink(arg, haptic_rate, say=say)
+    from studyapp.engine.device_sink import DeviceSink
+
     try:
         return DeviceSink(haptic_rate, device=arg, lead=lead)
     except AudioUnavailable as exc:

@@ -1,8 +1,16 @@
 """What the participant heard, kept with the data: a WAV file and its trial cues, written off the real-time thread.
 
-The sink hands every block it outputs (after the volume, the mute and the
-reference tone: what goes to the headphones, engine/audio.py) to ``write``,
-which only copies it into a queue; a writer thread of the worker process turns
+The sink hands what it outputs (the signal chain's output, engine/signal_chain.py:
+what goes to the headphones) to ``write``, which only copies it into a queue:
+a file sink every block, a device sink every device period from its callback,
+as played, so the file is sample-aligned with what reached the device. A
+period the FIFO could not fill (an underrun: the engine was late) is played
+with silence for the rest, and that silence is in the file too, its place
+marked by an ``underrun`` row in the cues (as is a period the device itself
+reported as an underflow). ``write`` also takes the period's place in the
+sink's output *stream* (``start``: the FIFO's read position) and how many of
+its frames came from it (``got``); the writer maps stream positions to file
+frames with them. a writer thread of the worker process turns
 the queue into a 16-bit PCM mono WAV at the sink's rate (the stdlib ``wave``
 module writes integer PCM only; 16 bits keep 96 dB, more than headphones in a
 quiet room show). The file is written as it grows, its header made valid
@@ -11,16 +19,25 @@ last write. If the writer falls ``QUEUE_SECONDS`` behind (a stalled disk),
 blocks are dropped rather than waiting, counted in ``dropped`` and written as
 silence once the writer catches up, so the file's timeline stays the engine's.
 
+Besides the steps' ``start`` and ``end`` the cues mark where the bow was put
+on the string and lifted (``bow_on``, ``bow_off``: the output is silent from
+a ``bow_off`` on, signal_chain.py) and every ``underrun``.
+
 Files are never overwritten (``free_path``): ``audio.wav`` is reserved with an
 exclusive create, else ``audio-2.wav``, ``audio-3.wav``, ...: one file per
-engine run of a session (a resumed session, a restarted engine).
+engine run of a session (a resumed session, a restarted engine). The WAV file
+and ``audio_cues.csv`` are created with the permissions ``mode`` (the session's
+files' mode, 0600 or 0660: participant data), whatever the umask.
 
-Cues. ``cue(...)`` notes a trial boundary at the recording's current frame: the
-worker calls it when it applies an ``AudioCue`` command, at a block boundary,
-so ``sample`` is the file's frame of the first sample of the block run after it.
-The controller sends the cue right after the trial's knob mapping; the two
-usually arrive in the same block, at worst a block (2 ms) apart. The sound
-itself lags by the resampler's short filter delay.
+Cues. ``cue(..., at)`` notes a trial boundary at the stream position ``at``:
+the worker calls it when it applies an ``AudioCue`` command, at a block
+boundary, with the position at which the first sample of the block run after
+it will be heard (``SignalChain.next_frame``: the chain's lookahead and the
+resampler's timing included). The writer turns it into the file's frame once
+the audio reaching that position has been written (a gap before it moves it
+on), so ``sample`` is where the trial's first sample is in the file. The
+controller sends the cue right after the trial's knob mapping; the two
+usually arrive in the same block, at worst a block (2 ms) apart.
 The writer appends it to ``audio_cues.csv`` beside the file (columns
 ``CUE_COLUMNS``), one row per cue, shared by every file of the session.
 """
@@ -46,13 +63,20 @@ def numbered(path, number):
     return path if number == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
 
 
-def free_path(path):
+def create(path, mode):
+    """An fd of the new file ``path`` (``FileExistsError`` if it exists) with permissions ``mode``, not the umask's."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode)
+    os.fchmod(fd, mode)
+    return fd
+
+
+def free_path(path, mode=0o600):
     """``(file object, path)``: ``path`` or the first free numbered name, created exclusively (never overwriting)."""
     number = 1
     while True:
         candidate = numbered(path, number)
         try:
-            return open(candidate, "xb"), candidate  # noqa: SIM115 - the writer thread owns and closes it
+            return open(create(candidate, mode), "wb"), candidate  # noqa: SIM115 - the writer thread closes it
         except FileExistsError:
             number += 1
 
@@ -62,43 +86,55 @@ def pcm16(samples):
 
 
 class AudioRecorder:
-    def __init__(self, path, rate):
+    def __init__(self, path, rate, mode=0o600):
         self.rate = float(rate)
-        self._file, self.path = free_path(path)
+        self.mode = mode
+        self._file, self.path = free_path(path, mode)
         self.cues_path = self.path.parent / CUES_FILE
         self.capacity = int(QUEUE_SECONDS * self.rate)
         self.frames = 0  # frames of the file's timeline so far, dropped ones included
+        self.stream = None  # the stream position after the last write (None: nothing written yet)
         self.dropped = 0  # frames the writer could not take in time (written as silence)
+        self.gaps = 0  # device periods written with a gap (underruns)
         self.error = None  # what stopped the writer (a full disk), or None
         self._queued = 0  # frames handed to the queue (by the real-time thread) ...
         self._taken = 0  # ... and taken from it (by the writer)
-        self._gap = 0  # frames dropped since the last block that got through
         self._stopped = False  # the writer took the end of the queue
         self._queue = queue.SimpleQueue()
+        self._pending = []  # the writer's cues waiting for the audio at their position
+        self._where = None  # the writer's last (file frame, stream position) pair
+        self._context = {"step": "", "task": "", "trial": ""}  # the last cue's trial, for underrun rows
         self._thread = threading.Thread(target=self._run, name="studyapp-audio-recorder", daemon=True)
         self._thread.start()
 
     # the real-time side: never waits ---------------------------------------------------
-    def write(self, samples):
+    def write(self, samples, start=None, got=None, underflow=False):
+        """What was played: ``samples``, the first ``got`` (default: all) from stream position ``start``."""
         n = samples.shape[0]
+        got = n if got is None else int(got)
+        start = (self.stream or 0) if start is None else int(start)
+        frame = self.frames
         self.frames += n
+        self.stream = start + got
+        if got < n or underflow:
+            self.gaps += 1
         if self._queued - self._taken + n > self.capacity or self.error is not None:
             self.dropped += n
-            self._gap += n
             return
-        self._queue.put(("audio", self._gap, np.array(samples, dtype=np.float64)))
+        self._queue.put(("audio", frame, start, got, underflow, np.array(samples, dtype=np.float64)))
         self._queued += n
-        self._gap = 0
 
-    def cue(self, step, task, trial, event):
-        self._queue.put(("cue", {"file": self.path.name, "sample": self.frames,
-                                 "seconds": f"{self.frames / self.rate:.6f}", "step": step, "task": task,
-                                 "trial": trial, "event": event}))
+    def cue(self, step, task, trial, event, at=None):
+        """A row of the cues at stream position ``at`` (default: where the next write starts).
+
+        ``step`` None: the step, task and trial of the cue before it (``bow_on`` and ``bow_off`` rows).
+        """
+        at = (self.stream or 0) if at is None else int(at)
+        self._queue.put(("cue", at, {"step": step, "task": task, "trial": trial, "event": event}))
 
     def stop(self):
         """Let the writer finish what is queued (and a trailing gap) and close the file; ``join`` waits for it."""
-        self._queue.put(("audio", self._gap, np.zeros(0)))
-        self._gap = 0
+        self._queue.put(("end", self.frames))
         self._queue.put(None)
 
     def join(self, timeout=None):
@@ -120,6 +156,7 @@ class AudioRecorder:
             self._discard()
 
     def _write_all(self, wav):
+        written = 0  # frames in the file
         while True:
             items = [self._queue.get()]
             while True:  # take everything queued: one write, one header patch
@@ -127,26 +164,55 @@ class AudioRecorder:
                     items.append(self._queue.get_nowait())
                 except queue.Empty:
                     break
-            chunks, done = [], False
+            chunks, rows, done = [], [], False
             for item in items:
                 if item is None:
                     done = self._stopped = True
                 elif item[0] == "audio":
-                    _, gap, samples = item
-                    chunks.append(bytes(2 * gap) + pcm16(samples))
+                    _, frame, start, got, underflow, samples = item
+                    chunks.append(bytes(2 * (frame - written)) + pcm16(samples))  # dropped frames: silence
+                    written = frame + samples.shape[0]
                     self._taken += samples.shape[0]
-                else:
-                    if chunks:
-                        wav.writeframes(b"".join(chunks))
-                        chunks = []
-                    self._append_cue(item[1])
+                    self._where = (frame, start, start + got)
+                    rows += self._resolve(start + got)
+                    if got < samples.shape[0] or underflow:
+                        at = frame + got if got < samples.shape[0] else frame
+                        rows.append(self._row(at, {**self._context, "event": "underrun"}))
+                elif item[0] == "cue":
+                    self._pending.append(item[1:])
+                    if self._where is not None:
+                        rows += self._resolve(self._where[2])  # a cue for audio already written
+                else:  # the end: a trailing gap, and every cue left at its place on the timeline
+                    chunks.append(bytes(2 * max(item[1] - written, 0)))
+                    written = max(item[1], written)
+                    rows += self._resolve(None)
             if chunks:
                 wav.writeframes(b"".join(chunks))
+            for row in rows:
+                self._append_cue(row)
             if done:
                 return
 
+    def _resolve(self, before):
+        """Rows for the pending cues at stream positions below ``before`` (None: all of them)."""
+        frame, start, _ = self._where or (0, 0, 0)
+        ready = [c for c in self._pending if before is None or c[0] < before]
+        self._pending = [c for c in self._pending if not (before is None or c[0] < before)]
+        rows = []
+        for at, fields in sorted(ready, key=lambda c: c[0]):
+            if fields["step"] is None:
+                fields = {**fields, **self._context}
+            self._context = {k: fields[k] for k in ("step", "task", "trial")}
+            rows.append(self._row(max(frame + at - start, 0), fields))
+        return rows
+
+    def _row(self, sample, fields):
+        return {"file": self.path.name, "sample": sample, "seconds": f"{sample / self.rate:.6f}", **fields}
+
     def _append_cue(self, row):
         new = not self.cues_path.exists() or self.cues_path.stat().st_size == 0
+        with contextlib.suppress(FileExistsError):
+            os.close(create(self.cues_path, self.mode))
         with open(self.cues_path, "a", newline="", encoding="utf-8") as f:
             writer = csv.DictWriter(f, fieldnames=CUE_COLUMNS)
             if new:
@@ -157,4 +223,4 @@ class AudioRecorder:
         """After a write error: keep taking the queue so the real-time side never fills it."""
         while not self._stopped and (item := self._queue.get()) is not None:
             if item[0] == "audio":
-                self._taken += item[2].shape[0]
+                self._taken += item[-1].shape[0]

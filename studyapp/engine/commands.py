@@ -88,9 +88,12 @@ class ReferenceTone(Command):
 @dataclass(frozen=True)
 class RecordAudio(Command):
     """Keep what the participant hears in the WAV file ``path`` (the first free of ``audio.wav``,
-    ``audio-2.wav``, ...: never overwritten; engine/audio_recorder.py); None stops recording."""
+    ``audio-2.wav``, ...: never overwritten; engine/audio_recorder.py); None stops recording. The
+    WAV file and ``audio_cues.csv`` get the permissions ``mode`` (participant data: the session's
+    files' mode, experiment/data_modes.py), whatever the umask."""
 
     path: str | None
+    mode: int = 0o600
 
 
 @dataclass(frozen=True)

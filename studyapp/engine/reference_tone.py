@@ -7,7 +7,8 @@ While on, the sink's output is
 with s the string's sound after the volume knob, fs the sink's rate, c the
 crossfade (0: the string, 1: the tone) and a the tone's peak amplitude,
 A = 10^(level_dbfs / 20) (peak, dB re full scale, so -20 dBFS is a peak of
-0.1). c and a move linearly to their targets over ``RAMP`` seconds, so turning
+0.1; its RMS is 3.01 dB lower), at most the output limiter's knee (-18 dBFS,
+signal_chain.py), so the tone is never bent. c and a move linearly to their targets over ``RAMP`` seconds, so turning
 the tone on or off, changing its level, or muting never clicks. The phase is
 carried from block to block (phi_0 is the phase reached at the end of the
 previous block; 0 when the tone starts from silence): the tone is one sine
@@ -28,6 +29,7 @@ RAMP = 0.005  # s: on, off and level changes are linear ramps this long
 LOWEST_HZ = 20.0
 HIGHEST_HZ = 20_000.0
 LOWEST_DBFS = -96.0  # a 16-bit file's floor
+HIGHEST_DBFS = -18.0  # the limiter's knee (signal_chain: CEILING_DBFS - KNEE_DB): a level check is never bent
 
 
 def check(hz, level_dbfs, rate):
@@ -36,8 +38,9 @@ def check(hz, level_dbfs, rate):
     if not (math.isfinite(hz) and LOWEST_HZ <= hz <= top):
         raise ParameterError(f"reference tone {hz:g} Hz: allowed is {LOWEST_HZ:g} to {top:g} Hz "
                              f"(at the audio rate {rate:g} Hz)")
-    if level_dbfs is not None and not (math.isfinite(level_dbfs) and LOWEST_DBFS <= level_dbfs <= 0.0):
-        raise ParameterError(f"reference tone level {level_dbfs:g} dBFS: allowed is {LOWEST_DBFS:g} to 0 dBFS (peak)")
+    if level_dbfs is not None and not (math.isfinite(level_dbfs) and LOWEST_DBFS <= level_dbfs <= HIGHEST_DBFS):
+        raise ParameterError(f"reference tone level {level_dbfs:g} dBFS: allowed is {LOWEST_DBFS:g} to "
+                             f"{HIGHEST_DBFS:g} dBFS (peak; the output's limiter bends louder sounds)")
 
 
 class ReferenceTone:

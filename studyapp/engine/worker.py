@@ -15,6 +15,11 @@ rate R (period T = B / R):
 3. run the loop for B samples; let the safety layer inspect them;
 4. push the audio to the sink, the telemetry to the ring, the status record.
 
+The sink's signal chain (engine/signal_chain.py) is told, with each block,
+whether the bow is on the string (silence while it is lifted) and whether the
+model's sound jumps at this block (``cut``: a string reset at a trial's start,
+a change of velocity source), so that every start, stop and cut fades.
+
 A block is a *deadline miss* when it finishes after its deadline: t0 + (k+1) T
 on the timer; on the audio clock, when the device had to play silence while
 the block was being made. The load of a block is its compute time (wall
@@ -128,6 +133,8 @@ def main(config, ring_spec, status_name, commands, events_name):
 
 
 class Worker:
+    cut = False  # the model's sound jumps at the next block (the sink fades across it)
+
     def __init__(self, config, ring, status, commands, events):
         from studyapp.model.loop import ClosedLoop, LoopConfig
 
@@ -192,7 +199,9 @@ class Worker:
 
     # commands: one handler per command type ------------------------------------
     def _source(self, c):
+        before = self.loop.source
         self.loop.set_source(c.name)
+        self.cut = self.cut or self.loop.source != before
         self.status.set(source=self.loop.source)
 
     def _fmax(self, c):
@@ -200,7 +209,13 @@ class Worker:
 
     def _reset_string(self, c):
         self.loop.reset_string()
+        self.cut = True
         self.trial_start = self.k * self.block / self.loop.rate
+
+    def _bowing(self, c):
+        if bool(c.on) != self.loop.bowing and self.recorder is not None:
+            self.recorder.cue(None, None, None, "bow_on" if c.on else "bow_off", at=self.sink.next_frame())
+        self.loop.set_bowing(bool(c.on))
 
     def _clear_fault(self, c):
         if self.loop.fault:
@@ -233,19 +248,19 @@ class Worker:
         if not self.sink.render:
             self.notice(f"audio: the {self.sink.description} sink renders no audio: nothing to record", "warning", "audio")
             return
-        self.recorder = self.sink.recorder = AudioRecorder(c.path, self.sink.rate)
+        self.recorder = self.sink.recorder = AudioRecorder(c.path, self.sink.rate, c.mode)
         self.recordings.append(self.recorder)
         self.notice(f"audio: recording what is heard to {self.recorder.path}", "info", "audio")
 
     def _cue(self, c):
         if self.recorder is not None:
-            self.recorder.cue(c.step, c.task, c.trial, c.event)
+            self.recorder.cue(c.step, c.task, c.trial, c.event, at=self.sink.next_frame())
 
     HANDLERS = {
         cmd.SetSource: _source,
         cmd.SetFmax: _fmax,
         cmd.SetHandTarget: lambda self, c: self.loop.set_hand_target(c.metres),
-        cmd.SetBowing: lambda self, c: self.loop.set_bowing(bool(c.on)),
+        cmd.SetBowing: _bowing,
         cmd.SetGesture: lambda self, c: self.loop.set_gesture(c.name),
         cmd.ResetString: _reset_string,
         cmd.SetVolume: lambda self, c: self.sink.set_volume(float(c.gain)),
@@ -345,11 +360,14 @@ class Worker:
         cpu_started = time.thread_time()
         enabled = self.status.force_enable
         self.safety.before_block(enabled, why=None if enabled else self._force_off_text())
+        bowing = self.loop.bowing
         out = self.loop.run(self.block)
         enabled = self.status.force_enable
         self.safety.check(out, force_enable=enabled, why=None if enabled else self._force_off_text())
         if self.sink.render:
-            self.sink.push(out["audio"])
+            # the bow as it was for this block (a fault lifts it): silence while it is off the string
+            self.sink.push(out["audio"], sounding=bowing and self.loop.fault is None, cut=self.cut)
+        self.cut = False
         rows = self._rows
         for i, name in _SAMPLED:
             rows[i] = out[name]

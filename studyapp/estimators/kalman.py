@@ -13,16 +13,22 @@ sample period T, no input (B = 0):
 
 The output at step k is the velocity of the posterior (after the update).
 
-The process noise Q: an ambiguity in the paper. Eq. 19 writes
-Q = Gamma sigma^2 Gamma^T and calls sigma "the power spectral density"; a
-spectral density would need a factor T to become a per-step variance, and the
-authors' public code used Q = q T Gamma Gamma^T. Table 1's Q values were tuned
-with one of the two, and the paper does not say which. Both are offered by the
-parameter ``q_convention``:
+The process noise Q. The paper's eq. 19 writes Q = Gamma sigma^2 Gamma^T and
+calls sigma "the power spectral density"; a spectral density would need a
+factor T to become a per-step variance. The paper does not say how Table 1's
+Q values were tuned; the first author's public code used two conventions, and
+each estimator's default is the one its Table 1 value was tuned in. The
+parameter ``q_convention`` chooses:
 
-    "eq19"    Q = q Gamma Gamma^T      (the paper's eq. 19 as printed; equals filterpy's
-                                        Q_discrete_white_noise(dim, dt=T, var=q)); default
-    "scaled"  Q = q T Gamma Gamma^T    (the authors' code)
+    "eq19"        Q = q Gamma Gamma^T         the paper's eq. 19 as printed (filterpy's
+                                              Q_discrete_white_noise(dim, dt=T, var=q))
+    "scaled"      Q = q T Gamma Gamma^T       the authors' third-order filters: the default
+                                              of KALMAN and the hybrids
+    "continuous"  Q = q int_0^T e^{F s} e_n e_n^T e^{F^T s} ds, continuous white noise of
+                  spectral density q on the highest derivative (filterpy's
+                  Q_continuous_white_noise(dim, dt=T, spectral_density=q)):
+                      KALPOS  q [[T^3/3, T^2/2], [T^2/2, T]]   the authors' KALPOS: its default
+                      KALMAN  q [[T^5/20, T^4/8, T^3/6], [T^4/8, T^3/3, T^2/2], [T^3/6, T^2/2, T]]
 
 Numerics. In metres and seconds, at 40-96 kHz the covariance spans some 15
 orders of magnitude (Var x ~ 1e-10 m^2, Var a ~ 1e4 m^2/s^4, off-diagonals
@@ -31,11 +37,20 @@ The filter therefore runs on the scaled state y = S [x, v, a] with
 S = diag(1, T, T^2), i.e. y = [x, T v, T^2 a], all in metres. Then
 
     F_s = S F S^-1 = [[1, 1, 1/2], [0, 1, 1], [0, 0, 1]]      (constant: binomial-like)
-    Q_s = S Q S^T  = q_T g g^T,  g = [1/2, 1, 1]^T  ([1/2, 1]^T for KALPOS)
-          with q_T = q T^4 ("eq19") or q T^5 ("scaled")
     H_s = e_x for position (R_p unchanged) and e_a for acceleration, the measured
           acceleration entering as T^2 a with R_s = T^4 r_acc,
 
+and the process noise Q_s = S Q S^T, written as a sum of weighted outer
+products (``noise``):
+
+    Q_s = q_g g g^T + q_h h h^T + q_e e_x e_x^T
+    "eq19", "scaled":  g = [1/2, 1, 1]^T ([1/2, 1]^T for KALPOS), q_g = q T^4 ("eq19")
+                       or q T^5 ("scaled"), q_h = q_e = 0
+    "continuous":      KALMAN g = [1/6, 1/2, 1]^T, h = [1/2, 1, 0]^T, q_g = q T^5,
+                       q_h = q T^5 / 12, q_e = q T^5 / 720;
+                       KALPOS g = [1/2, 1]^T, q_g = q T^3, q_h = 0, q_e = q T^3 / 12
+
+(the continuous forms are the U D U^T factors of T^-5 S Q S^T and T^-3 S Q S^T),
 and the posterior, mapped back by S^-1, is the unscaled textbook filter's up
 to rounding.
 
@@ -45,11 +60,13 @@ measurement is far more precise than the process noise (e.g. r_acc / q ~
 larger, and a covariance-form update -- Joseph form included, which we tried
 first -- turns P indefinite within 10^6 samples at 96 kHz. The filter
 therefore keeps P in factored form, P = U D U^T (U unit upper triangular, D
-diagonal): Thornton's weighted Gram-Schmidt time update (P- = W diag(D, q_T)
-W^T with W = [F_s U | g]) and Bierman's scalar measurement update. Every
-new D is a weighted sum of squares or a D times a ratio of positive numbers,
-so P stays symmetric (by construction) and positive definite; D's entries are
-the conditional variances, which is exactly what the subtraction above loses.
+diagonal): Thornton's weighted Gram-Schmidt time update (P- = W diag(D, q_g,
+q_h, q_e) W^T with W = [F_s U | g h e_x]) and Bierman's scalar measurement
+update. Every new D is a weighted sum of squares or a D times a ratio of
+positive numbers, so P stays symmetric (by construction) and positive
+definite; D's entries are the conditional variances, which is exactly what
+the subtraction above loses. A noise weight of 0 adds exact zeros, so "eq19"
+and "scaled" run the rank-one update they always ran, to the last bit.
 Because R is diagonal the two measurements of KALMAN are applied one after
 the other (position, then acceleration), which gives the joint update's
 posterior. The arithmetic is unrolled (no np.linalg, no allocation).
@@ -69,9 +86,9 @@ KALPOS, KALMAN and the hybrids.
 State (KALMAN, ``KALMAN_STATE`` = 10):
 ``[started, y0, y1, y2, u01, u02, u12, d0, d1, d2]`` (scaled units).
 State (KALPOS, ``KALPOS_STATE`` = 6): ``[started, y0, y1, u01, d0, d1]``.
-Parameters (KALMAN, ``KALMAN_PARAMS`` = 8):
-``[rate, T^2, q_T, r_pos, T^4 r_acc, P0_x, T^2 P0_v, T^4 P0_a]``.
-Parameters (KALPOS, ``KALPOS_PARAMS`` = 5): ``[rate, q_T, r_pos, P0_x, T^2 P0_v]``.
+Parameters (KALMAN, ``KALMAN_PARAMS`` = 12):
+``[rate, T^2, q_g, r_pos, T^4 r_acc, P0_x, T^2 P0_v, T^4 P0_a, g_0, g_1, q_h, q_e]``.
+Parameters (KALPOS, ``KALPOS_PARAMS`` = 6): ``[rate, q_g, r_pos, P0_x, T^2 P0_v, q_e]``.
 """
 
 import numpy as np
@@ -85,8 +102,8 @@ P0_ACCELERATION = 100.0  # m/s^2: standard deviation of the initial acceleration
 
 KALMAN_STATE = 10
 KALPOS_STATE = 6
-KALMAN_PARAMS = 8
-KALPOS_PARAMS = 5
+KALMAN_PARAMS = 12
+KALPOS_PARAMS = 6
 
 
 def q_param(default):
@@ -101,27 +118,39 @@ def r_acc_param(default):
     return Param("r_acc", default, "(m/s^2)^2", 1e-9, 1e12, doc="acceleration measurement covariance R_a")
 
 
-def scaled_q(rate, params):
-    """q_T, the factor of g g^T in the scaled process noise Q_s."""
+def noise(rate, params, order):
+    """``(q_g, g_0, g_1, q_h, q_e)``: the scaled process noise Q_s of the filter of ``order`` 2 (KALPOS) or 3.
+
+    Q_s = q_g g g^T + q_h h h^T + q_e e_x e_x^T with g = [g_0, g_1, 1] (order 3)
+    or [g_0, 1] (order 2) and h = [1/2, 1, 0] (module docstring).
+    """
     t = 1.0 / rate
-    q = params["q"] * t**4
-    return q * t if params["q_convention"] == "scaled" else q
+    q = params["q"]
+    convention = params["q_convention"]
+    if convention == "continuous":
+        if order == 2:
+            return q * t**3, 0.5, 1.0, 0.0, q * t**3 / 12.0
+        return q * t**5, 1.0 / 6.0, 0.5, q * t**5 / 12.0, q * t**5 / 720.0
+    q_g = q * t**4 * (t if convention == "scaled" else 1.0)
+    return q_g, 0.5, 1.0, 0.0, 0.0
 
 
 def kalman_params(rate, params):
     """The KALMAN block of a parameter vector (also the head of the hybrids')."""
     t = 1.0 / rate
     r_pos = params["r_pos"]
+    q_g, g0, g1, q_h, q_e = noise(rate, params, 3)
     return np.array([
-        rate, t * t, scaled_q(rate, params), r_pos, t**4 * params["r_acc"],
-        r_pos, t * t * P0_VELOCITY**2, t**4 * P0_ACCELERATION**2,
+        rate, t * t, q_g, r_pos, t**4 * params["r_acc"],
+        r_pos, t * t * P0_VELOCITY**2, t**4 * P0_ACCELERATION**2, g0, g1, q_h, q_e,
     ])
 
 
 def build_kalpos(rate, params):
     t = 1.0 / rate
     r_pos = params["r_pos"]
-    return np.array([rate, scaled_q(rate, params), r_pos, r_pos, t * t * P0_VELOCITY**2]), KALPOS_STATE
+    q_g, _, _, _, q_e = noise(rate, params, 2)
+    return np.array([rate, q_g, r_pos, r_pos, t * t * P0_VELOCITY**2, q_e]), KALPOS_STATE
 
 
 def build_kalman(rate, params):
@@ -168,6 +197,10 @@ def kalman_step(s, p, x, a):
         s[9] = p[7]
         return 0.0
     q = p[2]
+    g0 = p[8]
+    g1 = p[9]
+    qh = p[10]
+    qe = p[11]
     u01 = s[4]
     u02 = s[5]
     u12 = s[6]
@@ -178,24 +211,26 @@ def kalman_step(s, p, x, a):
     y0 = s[1] + s[2] + 0.5 * s[3]
     y1 = s[2] + s[3]
     y2 = s[3]
-    # P- = W diag(d0, d1, d2, q_T) W^T with W = [F_s U | g], g = [1/2, 1, 1]^T;
-    # Thornton's weighted Gram-Schmidt, last row first, gives P- = U D U^T
+    # P- = W diag(d0, d1, d2, q_g, q_h, q_e) W^T with W = [F_s U | g h e_x],
+    # g = [g0, g1, 1]^T, h = [1/2, 1, 0]^T; Thornton's weighted Gram-Schmidt,
+    # last row first, gives P- = U D U^T (w0k, w1k: rows 0 and 1 of W, column k)
     w01 = u01 + 1.0
     w02 = u02 + u12 + 0.5
     w12 = u12 + 1.0
     d2n = d2 + q
-    u02n = (w02 * d2 + 0.5 * q) / d2n
-    u12n = (w12 * d2 + q) / d2n
+    u02n = (w02 * d2 + g0 * q) / d2n
+    u12n = (w12 * d2 + g1 * q) / d2n
     w02 -= u02n
-    w03 = 0.5 - u02n
+    w03 = g0 - u02n
     w12 -= u12n
-    w13 = 1.0 - u12n
-    d1n = d1 + d2 * w12 * w12 + q * w13 * w13
-    u01n = (w01 * d1 + w02 * w12 * d2 + w03 * w13 * q) / d1n
+    w13 = g1 - u12n
+    d1n = d1 + d2 * w12 * w12 + q * w13 * w13 + qh
+    u01n = (w01 * d1 + w02 * w12 * d2 + w03 * w13 * q + 0.5 * qh) / d1n
     w01 -= u01n
     w02 -= u01n * w12
     w03 -= u01n * w13
-    d0n = d0 + d1 * w01 * w01 + d2 * w02 * w02 + q * w03 * w03
+    w04 = 0.5 - u01n
+    d0n = d0 + d1 * w01 * w01 + d2 * w02 * w02 + q * w03 * w03 + qh * w04 * w04 + qe
     # Bierman's update with the position, H = e_0: f = U^T e_0 = [1, u01, u02]
     r = p[3]
     alpha = r + d0n
@@ -263,7 +298,8 @@ def step_kalpos(s, p, x, a, v):
     u01 = s[3]
     d0 = s[4]
     d1 = s[5]
-    # predict: y = F_s y with F_s = [[1, 1], [0, 1]]; W = [F_s U | g], g = [1/2, 1]^T
+    # predict: y = F_s y with F_s = [[1, 1], [0, 1]]; W = [F_s U | g e_x], g = [1/2, 1]^T,
+    # weights diag(d0, d1, q_g, q_e)
     y0 = s[1] + s[2]
     y1 = s[2]
     w01 = u01 + 1.0
@@ -271,7 +307,7 @@ def step_kalpos(s, p, x, a, v):
     u01n = (w01 * d1 + 0.5 * q) / d1n
     w01 -= u01n
     w02 = 0.5 - u01n
-    d0n = d0 + d1 * w01 * w01 + q * w02 * w02
+    d0n = d0 + d1 * w01 * w01 + q * w02 * w02 + p[5]  # p[5] = q_e
     # Bierman's update with the position: f = [1, u01]
     r = p[2]
     alpha = r + d0n
@@ -295,12 +331,12 @@ def step_kalpos(s, p, x, a, v):
 
 SPEC_KALPOS = EstimatorSpec(
     name="KALPOS", kind=kinds.KALPOS, description="2nd-order Kalman filter [x, v], position measurement.",
-    inputs=("position",), params=(q_param(0.191), r_pos_param(), q_convention()), build=build_kalpos,
-    reference="paper Sec. 5.6, eqs. 16-19; Table 1 (Q = 0.191)",
+    inputs=("position",), params=(q_param(0.191), r_pos_param(), q_convention("continuous")),
+    build=build_kalpos, reference="paper Sec. 5.6, eqs. 16-19; Table 1 (Q = 0.191, continuous white noise)",
 )
 SPEC_KALMAN = EstimatorSpec(
     name="KALMAN", kind=kinds.KALMAN, description="3rd-order Kalman filter [x, v, a], position and acceleration.",
     inputs=("position", "acceleration"),
-    params=(q_param(108.0), r_acc_param(6.28e4), r_pos_param(), q_convention()), build=build_kalman,
-    reference="paper Sec. 5.6, eqs. 16-19; Table 1 (Q = 108, R_a = 6.28e4)",
+    params=(q_param(108.0), r_acc_param(6.28e4), r_pos_param(), q_convention("scaled")), build=build_kalman,
+    reference="paper Sec. 5.6, eqs. 16-19; Table 1 (Q = 108 with Q = q T Gamma Gamma^T, R_a = 6.28e4)",
 )

@@ -177,11 +177,15 @@ def cutoff(name, default, doc=""):
     return Param(name, default, "Hz", 1.0, 40_000.0, below_nyquist=True, doc=doc)
 
 
-Q_CONVENTIONS = ("eq19", "scaled")
+Q_CONVENTIONS = ("eq19", "scaled", "continuous")
+Q_CONVENTION_DOC = (
+    "eq19: Q = q Gamma Gamma^T (paper eq. 19 as printed); scaled: Q = q T Gamma Gamma^T (the authors' "
+    "third-order filters); continuous: continuous white noise of spectral density q, for [x, v] "
+    "Q = q [[T^3/3, T^2/2], [T^2/2, T]] (the authors' KALPOS)"
+)
 
 
-def q_convention():
-    return Param(
-        "q_convention", "eq19", kind="choice", choices=Q_CONVENTIONS, scale="linear",
-        doc="eq19: Q = Gamma q Gamma^T (paper eq. 19); scaled: Q = q T Gamma Gamma^T (authors' code)",
-    )
+def q_convention(default):
+    """The Kalman filters' process-noise convention (``kalman.py``); ``default`` is the one Table 1 was tuned in."""
+    return Param("q_convention", default, kind="choice", choices=Q_CONVENTIONS, scale="linear",
+                 doc=Q_CONVENTION_DOC)

@@ -8,7 +8,7 @@
     report.evaluate, tradeoff.tradeoff   Fig. 5's comparison; cost against accuracy per rate
     perceptual.audio_distance, perceptual_scores.perceptual_scores   Sec. 10: the sound with each
                                    estimator in the loop against TRUE's (specific loudness in Bark bands)
-    paper_comparison.findings      Table 1 and the Sec. 7 findings beside the paper's, with rules
+    paper_comparison, findings     Table 1 and the Sec. 7 findings beside the paper's, with rules
     retune.retune                  the optimiser re-run at one rate (``tradeoff --tune``)
 
 Command line: ``studyapp optimise``, ``studyapp evaluate``, ``studyapp tradeoff``.

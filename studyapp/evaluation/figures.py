@@ -1,8 +1,12 @@
 """Figures of the evaluation: Fig. 5-style box plots and the speed/accuracy trade.
 
 Fig. 5 (paper): for one group of recordings, three panels of box plots across
-recordings, the per-recording objective, the error and the delay as percent
-of LOWPASS, each with its estimators ordered best (lowest median) to worst.
+recordings, the per-recording objective, the error and the delay magnitude
+|D| as percent of LOWPASS, each with its estimators ordered best (lowest
+median) to worst (``panel_order``). The delay panel shows |D|, as the
+objective counts it: a lead of the band-limited LVT is as much a mismatch as
+a lag, so an estimator one sample ahead of the LVT is not better than one
+in step with it.
 Boxes of the best estimator and of those not significantly different from it
 (Wilcoxon rank-sum, p >= 0.05) are filled; the others are hollow.
 
@@ -22,7 +26,7 @@ from studyapp.evaluation.significance import not_different_from_best
 PANELS = (
     ("objective", "objective per recording"),
     ("error_pct_lowpass", "error E (% of LOWPASS)"),
-    ("delay_pct_lowpass", "delay D (% of LOWPASS)"),
+    ("abs_delay_pct_lowpass", "delay |D| (% of LOWPASS)"),
 )
 
 
@@ -54,6 +58,14 @@ def save(fig, stem):
     return paths
 
 
+def panel_order(samples):
+    """(names best to worst by median, the best and those not significantly different from it)."""
+    def median(name):
+        return np.nanmedian(samples[name]) if np.isfinite(samples[name]).any() else np.inf
+
+    return sorted(samples, key=median), not_different_from_best(samples)
+
+
 def boxplots(measures, title, stem):
     """One Fig. 5-style figure: ``measures`` is measure -> name -> values."""
     plt = _pyplot()
@@ -61,9 +73,8 @@ def boxplots(measures, title, stem):
     fig, axes = plt.subplots(1, 3, figsize=(max(9.0, 1.25 * len(names)), 4.6))
     for ax, (key, label) in zip(axes, PANELS):
         samples = {n: np.asarray(measures[key][n], dtype=np.float64) for n in names}
-        order = sorted(names, key=lambda n: np.nanmedian(samples[n]) if np.isfinite(samples[n]).any() else np.inf)
+        order, best = panel_order(samples)
         data = [samples[n][np.isfinite(samples[n])] for n in order]
-        best = not_different_from_best(samples)
         parts = ax.boxplot(data, patch_artist=True, widths=0.6, showfliers=True)
         for name, box in zip(order, parts["boxes"]):
             box.set_facecolor("#8fb8de" if name in best else "white")

@@ -13,14 +13,21 @@ The file is flat TOML, one table per estimator plus two tables of metadata:
     [objective]           # F_g of each estimator under the final scale
     KALMAN = 3.21
 
+    [conventions]         # what the numbers mean (studyapp.estimators.conventions)
+    KALMAN = "q_convention = scaled: Q = q T Gamma Gamma^T (the authors' third-order filters)"
+
     [KALMAN]
     q = 108.0
     r_acc = 62800.0
     r_pos = 2e-10
-    q_convention = "eq19"
+    q_convention = "scaled"
 
 Every other table must be named after an estimator, and its keys are that
-estimator's parameters (``studyapp estimators`` lists them). ``read`` uses the
+estimator's parameters (``studyapp estimators`` lists them). ``[conventions]``
+is written for the reader, from the estimator tables, one line per estimator
+that has conventions: the choice parameters (``q_convention``, ``start``) and
+fixed meanings (FOAW's ``window`` is the paper's Size). What runs is what the
+estimator tables say; ``read`` accepts the table and does not use it. ``read`` uses the
 standard library's ``tomllib`` (through ``studyapp.small_files``: a regular
 file of at most 1 MB); ``write`` writes the flat structure by hand
 (strings, numbers, booleans and flat lists of them), atomically.
@@ -34,7 +41,7 @@ from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.small_files import read_toml
 
-META_TABLES = ("provenance", "objective")
+META_TABLES = ("provenance", "objective", "conventions")
 
 
 def read(path):
@@ -92,11 +99,17 @@ def dumps(params, provenance=None, objective=None, comment=None):
     lines = []
     if comment:
         lines += [f"# {line}" for line in comment.splitlines()] + [""]
+    from studyapp.estimators import conventions
+
     tables = []
     if provenance:
         tables.append(("provenance", provenance))
     if objective:
         tables.append(("objective", objective))
+    meanings = {name: conventions.text(name, values) for name, values in params.items()}
+    meanings = {name: line for name, line in meanings.items() if line}
+    if meanings:
+        tables.append(("conventions", meanings))
     tables += list(params.items())
     for name, table in tables:
         lines.append(f"[{_key(name)}]")

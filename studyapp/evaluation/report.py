@@ -91,16 +91,26 @@ class Evaluation:
         return np.array([in_group(f, group) for f in self.fmax], dtype=bool)
 
     def measures(self, group):
-        """measure -> name -> values over the group's recordings (for plots and tests)."""
+        """measure -> name -> values over the group's recordings (Fig. 5's panels and wilcoxon.csv).
+
+        The delay by its magnitude, |D| as % of LOWPASS's |D| (``abs_delay_pct_lowpass``),
+        as the objective counts it: a lead of the band-limited LVT is no better than a lag.
+        """
         mask = self.group_mask(group)
         return {
             "objective": {n: self.recording_objective[n][mask] for n in self.names},
             "error_pct_lowpass": {n: self.error_pct(n)[mask] for n in self.names},
-            "delay_pct_lowpass": {n: self.delay_pct(n)[mask] for n in self.names},
+            "abs_delay_pct_lowpass": {n: np.abs(self.delay_pct(n)[mask]) for n in self.names},
         }
 
     def to_json(self):
-        """The ``studyapp evaluate --json`` structure (NaN becomes null)."""
+        """The ``studyapp evaluate --json`` structure (NaN becomes null).
+
+        ``parameters``: what each estimator ran with; ``conventions``: what
+        those numbers mean (``estimators.conventions.record``).
+        """
+        from studyapp.estimators import conventions
+
         return {
             "estimators": {
                 name: {
@@ -113,6 +123,8 @@ class Evaluation:
                 for name in self.names
             },
             "ranking": self.ranking,
+            "parameters": {name: dict(self.params[name]) for name in self.names},
+            "conventions": conventions.record({name: self.params[name] for name in self.names}),
             "delay_method": self.delay_method,
             "recordings": [
                 {"file": r, "fmax": f, "rate": rate}

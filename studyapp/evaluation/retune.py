@@ -13,7 +13,7 @@ rate, with the estimators evaluated there, and returns its ``Result``.
   duration unless ``windows="samples"``).
 - Search space: the paper's tuned parameters (Table 2) within the ranges the
   estimators allow at the rate (cut-offs below 0.49 x rate). The narrowed
-  window ranges of ``space.SEARCH_RANGES`` (FOAW's 1-64 samples, set at the
+  window ranges of ``space.SEARCH_RANGES`` (FOAW's sizes 2-64 samples, set at the
   paper's 5 kHz) keep their duration too: their upper end scales with
   rate / 5 kHz, within the estimator's own range.
 - Stopping rule: ``patience`` new sets in a row without improvement. The paper

@@ -21,7 +21,7 @@ the paper's 17 and 0.1 mm), and long windows only add delay on stick-slip, so
 the optimiser searches windows up to 64 and margins from 0.1 um to 1 cm, which
 hold the paper's optimum and the LVDT noise (15 um RMS) with orders of
 magnitude to spare. ``ranges`` overrides any range (``--range
-FOAW.window=1:256``), within the spec's. A search starts from Table 1's
+FOAW.window=2:256``), within the spec's. A search starts from Table 1's
 values, each moved to the nearest end of its range where it lies outside.
 """
 
@@ -53,7 +53,7 @@ PAPER_TUNED = {
     "LVT": (),
 }
 
-_FOAW_RANGES = {"window": (1, 64), "margin": (1e-7, 1e-2), "margin_vel": (1e-4, 1e2)}
+_FOAW_RANGES = {"window": (2, 64), "margin": (1e-7, 1e-2), "margin_vel": (1e-4, 1e2)}
 SEARCH_RANGES = {name: dict(_FOAW_RANGES) for name in ("FOAW", "KALFOAW", "KALFOAWACC")}
 
 # The thirteen estimators of the paper's Table 2 (BDIFF and LVT are ours).

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from studyapp.errors import ParameterError, UserError
+from studyapp.estimators import conventions
 from studyapp.evaluation.pareto import pareto_front
 from studyapp.evaluation.report import evaluate
 from studyapp.evaluation.retune import retune
@@ -129,6 +130,7 @@ def _rows(rate, result, costs, source):
             "error_pct_lowpass_median": _median(result.error_pct(name)),
             "delay_pct_lowpass_median": _median(result.delay_pct(name)),
             "parameters": {p.name: result.params[name][p.name] for p in spec(name).params},
+            "conventions": conventions.of(name, result.params[name]),  # tradeoff.json only
         }
     return rows
 

@@ -4,7 +4,9 @@ Participant data stays private to the experimenter's account by default:
 every folder the app creates under the results folder (the results folder
 itself when it has to create it, the study, participant and session folders)
 gets mode 0700 and every file in them (``session.json``, ``events.jsonl``,
-the lock and the set-aside copies) mode 0600, whatever the umask.
+the lock, the set-aside copies, and ``audio*.wav`` and ``audio_cues.csv``,
+which the session controller asks the engine to create with ``file_mode()``)
+mode 0600, whatever the umask.
 
 On a lab machine where the experimenters share a Unix group, set the
 environment variable ``STUDYAPP_GROUP_SHARED=1``: folders then get 0770 and

@@ -7,7 +7,7 @@ One row per response, first the columns of the "Study results" contract:
 then ``study, step, practice, value, knob, peak_fmax, duration, app_version``,
 the trial's engine health ``deadline_misses, underruns, faults,
 events_dropped``, and the session's ``experimenter, session_number,
-order_row``.
+order_row, simulated``.
 
 - ``task`` names the task type; ``trial``, ``fmax``, ``time``, ``step`` and
   ``duration`` come from the response event, the rest from the task type's
@@ -33,6 +33,10 @@ order_row``.
   records of its step, summed over its attempts); empty for a session without
   a real-time engine (``studyapp run``).
 
+- ``simulated``: True when the simulated participant played the session
+  (``enrolment.is_simulated``: session.json's ``simulated``, or its
+  ``apparatus.participant`` for older sessions); the analysis leaves these
+  rows out by default (``studyapp analyse --include-simulated``).
 - ``experimenter``, ``session_number``, ``order_row``: from session.json
   (``session_info``); empty when not given, or for a session stored before
   they were. The experimenter's ``notes`` stay in session.json: free text of
@@ -43,7 +47,10 @@ Incomplete sessions are exported too: every confirmed response is data. A
 session that cannot be read is skipped, and a damaged line of a log left out
 (the valid lines after it are kept); each is reported, naming the file and
 line (``studyapp export`` prints them as warnings, and with ``--strict``
-refuses to write anything). The
+refuses to write anything). A session whose log two programs wrote at once (a
+step with two responses, a repeated ``seq``: ``written_twice``) is skipped the
+same way: which answer counts cannot be told. A complete session is exported
+whole whether or not its ``session_end`` was written. The
 CSV (``studyapp export``) reads as is in pandas and R; empty cells are missing.
 """
 
@@ -53,6 +60,7 @@ import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
 from studyapp.experiment import response_event
+from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
@@ -61,7 +69,7 @@ HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
 SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
            "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS,
-           *SESSION_COLUMNS]
+           *SESSION_COLUMNS, "simulated"]
 
 
 def _session_rows(folder, problems):
@@ -80,6 +88,7 @@ def _session_rows(folder, problems):
             "study": info["study"],
             "app_version": info["app_version"],
             **{column: info.get(column) for column in SESSION_COLUMNS},
+            "simulated": is_simulated(info),
         }
     except UserError as exc:
         problems.append(f"{folder}: skipped, {exc}")
@@ -97,6 +106,11 @@ def _session_rows(folder, problems):
         number, _, raw = log.malformed[0]
         raise InputDataError(f"{events_file} line {number}: {raw.strip()[:40]!r} is not an event: "
                              "allowed is a JSON object with a 'type'")
+    twice = written_twice(log)
+    if twice:
+        problems.append(f"{folder}: skipped, {events_file}: {twice}: two programs wrote this log at once, so "
+                        "which answer counts cannot be told")
+        return []
     health = _trial_health(log.events)
     rows = []
     for event in log.events:
@@ -112,6 +126,33 @@ def _session_rows(folder, problems):
         base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
+
+
+def _repeats(values, lines):
+    """{value: [line numbers]} of the values (whole numbers) that occur more than once."""
+    seen = {}
+    for value, line in zip(values, lines):
+        if isinstance(value, int) and not isinstance(value, bool):
+            seen.setdefault(value, []).append(line)
+    return {value: at for value, at in seen.items() if len(at) > 1}
+
+
+def written_twice(log):
+    """What shows that two programs appended to one log (a ``LogScan``), or None.
+
+    Each program numbers its events ``seq`` from the end of the log it opened, and
+    a step is answered once (resume skips answered steps); a repeated ``seq`` or a
+    second ``response`` for a step means two writers at once (issue 21, item 1)."""
+    found = []
+    seqs = _repeats([e.get("seq") for e in log.events], log.lines)
+    responses = [(e.get("step"), line) for e, line in zip(log.events, log.lines) if e.get("type") == "response"]
+    steps = _repeats([s for s, _ in responses], [line for _, line in responses])
+    for what, repeats in (("step", steps), ("seq", seqs)):
+        if repeats:
+            value, lines = min(repeats.items(), key=lambda item: item[1][0])
+            kind = "steps with more than one response" if what == "step" else "seq values repeated"
+            found.append(f"{len(repeats)} {kind} (first: {what} {value}, lines {', '.join(map(str, lines))})")
+    return "; ".join(found) or None
 
 
 def _trial_health(events):
@@ -159,6 +200,7 @@ def export_responses(results_dir, problems=None):
     frame = frame.sort_values(["study", "participant", "session", "step", "knob"], kind="stable")
     frame["trial"] = frame["trial"].astype("int64")
     frame["practice"] = frame["practice"].astype(bool)
+    frame["simulated"] = frame["simulated"].astype(bool)
     frame["step"] = frame["step"].astype("int64")
     frame["knob"] = frame["knob"].astype("Int64")
     frame["value"] = frame["value"].astype("Int64")  # empty for a task without a knob answer

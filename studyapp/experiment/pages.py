@@ -13,8 +13,12 @@ ones (Sec. 8.2). A protocol lists its pages as an array of tables:
   leads into, and a ``break`` the task whose breaks it is (without ``task``:
   every transition, every break);
 - ``calibration`` is the headphone level check: a reference tone of
-  ``tone_hz`` (20 .. 20000 Hz) at ``level_dbfs`` (-60 .. 0 dB re full scale,
-  peak); the experimenter confirms it, not the participant.
+  ``tone_hz`` (20 .. 20000 Hz) at ``level_dbfs`` (-60 .. -18 dB re full
+  scale, peak: -18 dBFS is the output limiter's knee, engine/signal_chain.py);
+  without ``level_dbfs`` the tone is as loud as the stimulus (its RMS the
+  bowed string's typical RMS at the protocol's F_max, computed from the model
+  when the schedule is made and stated on the page: ``level_check``). The
+  experimenter confirms it, not the participant.
 
 Pages are Markdown: single line breaks (a TOML triple-quoted string's) join
 into one paragraph, a blank line starts another.
@@ -39,7 +43,7 @@ from studyapp.errors import UserError
 KINDS = ("welcome", "instructions", "transition", "break", "goodbye", "calibration")
 WHO = ("participant", "experimenter")
 TONE_HZ = (20.0, 20000.0)
-LEVEL_DBFS = (-60.0, 0.0)
+LEVEL_DBFS = (-60.0, -18.0)  # peak; the top is the output limiter's knee (a level check is never bent)
 TITLES = {"welcome": "Welcome", "instructions": "Instructions", "transition": "Next part", "break": "Break",
           "goodbye": "Thank you", "calibration": "Headphone level"}
 BREAK_TEXT = "Take a short break. Press Continue when you are ready to go on."
@@ -103,7 +107,8 @@ def parse_pages(source, document, tasks):
                 table.fail("task", f"= {task!r}", f"a task after the first (a transition leads into it): {later}")
         if kind == "calibration":
             tone = table.number("tone_hz", *TONE_HZ, "Hz")
-            level = table.number("level_dbfs", *LEVEL_DBFS, "dBFS")
+            # without it, the stimulus's level (level_check.calibrated, when the schedule is made)
+            level = table.number("level_dbfs", *LEVEL_DBFS, "dBFS") if "level_dbfs" in values else None
         table.finish()
         pages.append(Page(kind, text, title, task, tone, level))
     return tuple(pages)

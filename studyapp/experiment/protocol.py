@@ -62,7 +62,15 @@ class Protocol:
         return dict(self.estimators.get(name, {}))
 
     def settings(self):
-        """A JSON-ready summary of the validated protocol (stored in session.json)."""
+        """A JSON-ready summary of the validated protocol (stored in session.json).
+
+        ``conventions``: what the estimators' numbers mean, for every estimator
+        that has conventions, with this protocol's parameters
+        (``studyapp.estimators.conventions``).
+        """
+        from studyapp import estimators
+        from studyapp.estimators import conventions
+
         out = {
             "study": self.study,
             "title": self.title,
@@ -74,6 +82,7 @@ class Protocol:
             "pads": self.pads,
             "gesture": self.gesture,
             "estimators": {k: dict(v) for k, v in self.estimators.items()},
+            "conventions": conventions.record({n: self.estimator_params(n) for n in estimators.names()}),
             "pages": [page.to_dict() for page in self.pages],
         }
         for name in self.tasks:

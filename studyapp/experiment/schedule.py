@@ -20,7 +20,8 @@ The session's procedure (paper Sec. 8.2), step by step:
     goodbye page(s)
 
 Pages (``studyapp.experiment.pages``) are steps of task ``page`` with the
-whole ``page`` stored in the step; ``trial`` numbers them from 1. Practice
+whole ``page`` stored in the step (a calibration page with its tone's level
+made concrete: ``level_check``); ``trial`` numbers them from 1. Practice
 trials (``practice`` true, ``trial`` 1..N) are the first N trials the task
 type schedules for participants p + 1, p + 2, ... (p the enrolment index,
 or the session's ``order_row`` when set): the task's own conditions,
@@ -33,6 +34,7 @@ from dataclasses import asdict, dataclass
 
 from studyapp.experiment import pages as page_kinds
 from studyapp.experiment.latin_square import balanced_latin_square, task_seed
+from studyapp.experiment.level_check import calibrated
 from studyapp.experiment.pages import Page
 from studyapp.experiment.tasks import task_type
 
@@ -109,7 +111,8 @@ def build_schedule(protocol, participant_index, order_row=None):
             steps.append(Trial(len(steps), "page", next(numbered), (), None, page=page))
 
     first, last = protocol.tasks[0], protocol.tasks[-1]
-    show(*page_kinds.pages_of(pages, "welcome", pads[first]), *page_kinds.pages_of(pages, "calibration", pads[first]))
+    show(*page_kinds.pages_of(pages, "welcome", pads[first]),
+         *(calibrated(p, protocol) for p in page_kinds.pages_of(pages, "calibration", pads[first])))
     n = len(protocol.tasks)
     for k, task in enumerate(protocol.tasks, start=1):
         spec, kind, pad = protocol.task(task), task_type(task), pads[task]

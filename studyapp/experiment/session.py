@@ -7,7 +7,9 @@ Layout (DESIGN.md "Results layout"):
 
 ``session.json`` is written once, atomically, when the session is created:
 the protocol (its text, validated settings and SHA-256), the app version, the
-seed, the participant's enrolment index and Latin-square rows, the order row
+seed, the participant's enrolment index (counted among participants of the
+same kind, real or simulated: ``enrolment``) and Latin-square rows, whether
+the simulated participant plays (``simulated``), the order row
 (``order_row``, ``order_rows``, ``order_row_source``), the schedule, the
 apparatus (device, rate), and what the experimenter tells (``experimenter``,
 ``session_number``, ``notes``; ``session_info`` checks them, before anything
@@ -29,11 +31,15 @@ Data safety (docs/experiment.md "Data safety"):
   before they read or write anything, and the session holds it until
   ``close``: a second program starting the same participant is refused with
   one line naming the holder, and writes nothing. ``create`` also holds the
-  study's lock while it enrols, so two participants never get one index.
+  study's lock while it enrols, so two participants never get one index. A
+  ``create`` that fails removes what it made, a lock file only while it holds
+  that lock (never the winner's), and says that there is nothing to resume.
 - The first event of ``events.jsonl`` (``session_created``) repeats the whole
   description. A ``session.json`` that is missing or damaged is rebuilt from it
   on resume (the damaged file is kept as ``session.json.damaged-<time>``);
   without it the session is refused with one line.
+- Resuming a session whose every trial is answered writes its ``session_end``
+  if a kill kept that from being written, and says it is complete.
 - Folders and files get the modes of ``data_modes`` (private by default).
 """
 
@@ -49,8 +55,10 @@ from studyapp import __version__
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, make_folders
+from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
+from studyapp.experiment.session_files import EVENTS_FILE, FORMAT, SESSION_FILE
 from studyapp.experiment.session_info import (
     check_experimenter,
     check_notes,
@@ -58,13 +66,11 @@ from studyapp.experiment.session_info import (
     check_session_number,
     order_rows,
 )
-from studyapp.experiment.session_lock import LOCK_FILE, ParticipantLock, StudyLock
+from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
 from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
 
-SESSION_FILE = "session.json"
-EVENTS_FILE = "events.jsonl"
-FORMAT = "studyapp-session/1"
 CREATED = "session_created"
+SESSION_END = "session_end"
 
 
 def check_participant(participant):
@@ -136,14 +142,6 @@ def _write_description(folder, info):
         f.flush()
         os.fsync(f.fileno())
     fsync_directory(folder)
-
-
-def enrolled_participants(study_folder):
-    """The participant IDs with at least one session under ``study_folder``."""
-    folder = Path(study_folder)
-    if not folder.is_dir():
-        return []
-    return sorted(p.name for p in folder.iterdir() if p.is_dir() and session_folders(p))
 
 
 def default_seed(protocol_seed, participant_index):
@@ -235,7 +233,7 @@ class Session:
         try:
             lock = ParticipantLock(participant_folder, participant)
         except BaseException:
-            _remove_made(made)
+            _remove_made(made)  # the winner's lock stays: only a free lock file is removed
             raise
         try:
             existing = session_folders(participant_folder)
@@ -257,20 +255,20 @@ class Session:
                 raise
             return session
         except BaseException as failure:
-            lock.release()
             if folder is not None:
                 shutil.rmtree(folder, ignore_errors=True)  # only just made: it holds no response yet
-            _remove_made(made)
-            if isinstance(failure, OSError):
-                raise UserError(f"{folder or participant_folder}: cannot create the session "
-                                f"({failure.strerror or failure}): allowed is a writable results folder "
-                                "with free space") from None
+            _remove_made(made, lock)
+            lock.release()
+            if isinstance(failure, (OSError, LogWriteError)):
+                left = folder is not None and folder.exists()
+                raise _not_created(folder or participant_folder, left, failure) from None
             raise
 
     @staticmethod
     def _describe(protocol, participant, study_folder, participant_folder, seed, apparatus, order_row):
         """(the new session's folder, its description): enrolment index, seed, order row, schedule, protocol."""
-        index = len([p for p in enrolled_participants(study_folder) if p != participant])
+        simulated = apparatus_is_simulated(apparatus)
+        index = enrolment_index(study_folder, participant, simulated)  # counted per kind (enrolment.py)
         seed = default_seed(protocol.seed, index) if seed is None else int(seed)
         rows = order_rows(protocol)
         source = "enrolment" if order_row is None else "set"
@@ -287,6 +285,7 @@ class Session:
             "study": protocol.study,
             "participant": participant,
             "participant_index": index,
+            "simulated": simulated,
             "session": folder.name,
             "started": wall_time(),
             "app_version": __version__,
@@ -338,24 +337,50 @@ class Session:
             if order_row is not None and check_order_row(protocol, order_row) != info.get("order_row"):
                 raise UserError(f"order row {order_row}: session {folder} has order row {info.get('order_row')}: "
                                 "allowed is to leave it out when resuming")
-            done = {e.get("step") for e in read_events(folder / EVENTS_FILE) if e.get("type") == "response"}
+            events = read_events(folder / EVENTS_FILE)
+            done = {e.get("step") for e in events if e.get("type") == "response"}
             if all(t["step"] in done for t in info["schedule"]):
-                # resuming is the way to repair a session: its session.json too, when it is complete
-                repaired = " (its session.json rebuilt from events.jsonl)" if rebuild else ""
+                # resuming is the way to repair a session, a complete one too: its session.json,
+                # and the session_end a kill after the last response kept from being written
+                repaired = []
                 if rebuild:
                     _rebuild_description(folder, info)
-                raise UserError(f"session {folder} is already complete{repaired}: nothing to resume")
+                    repaired.append("its session.json rebuilt from events.jsonl")
+                if not any(e.get("type") == SESSION_END for e in events):
+                    with SessionLog(folder / EVENTS_FILE) as log:
+                        log.append({"type": SESSION_END, "recovered": True})
+                    repaired.append(f"its missing {SESSION_END} event written")
+                said = f" ({'; '.join(repaired)})" if repaired else ""
+                raise UserError(f"session {folder} is already complete{said}: nothing to resume")
         except BaseException:
             lock.release()
             raise
         return cls(folder, lock)
 
 
-def _remove_made(made):
-    """Remove the folders ``make_folders`` made (newest first) if nothing but a lock is in them."""
+def _not_created(folder, left, failure):
+    """What is true after a failed create (a full disk): its folder removed (unless ``left``), so a start
+    again, not a resume."""
+    reason = failure.reason if isinstance(failure, LogWriteError) else failure.strerror or failure
+    if left:
+        return UserError(f"{folder}: cannot create the session ({reason}), and its partial folder could not be "
+                         "removed: allowed is to remove that folder, free disk space and start the session again")
+    return UserError(f"{folder}: cannot create the session ({reason}): nothing was kept, so there is nothing to "
+                     "resume: allowed is a writable results folder with free space, then start the session again "
+                     "(without --resume)")
+
+
+def _remove_made(made, lock=None):
+    """Remove the folders ``make_folders`` made (newest first) while nothing but a free lock is in them.
+
+    The participant's lock file goes only if ``lock`` (ours) holds it; another folder's
+    only if no one holds it (``remove_if_free``): never a lock another program holds."""
     for folder in reversed(made):
         try:
-            (folder / LOCK_FILE).unlink(missing_ok=True)
+            if lock is not None and lock.held and lock.path.parent == folder:
+                lock.release(remove=True)
+            elif not remove_if_free(folder):
+                return
             folder.rmdir()
         except OSError:
             return

@@ -16,6 +16,12 @@ folder shared between machines on one machine's disk.
 ``StudyLock(folder)`` is the same lock held on a study folder for the moment
 it takes to enrol a participant, so two participants started at once get
 different enrolment indices (and Latin-square rows).
+
+A lock file is removed (a start that failed cleans up the folders it made)
+only by a program that holds its lock at that moment: ``release(remove=True)``
+by the holder, ``remove_if_free`` by anyone who can take it. Unlinking a
+lock another program holds would let a third start take a fresh lock on a new
+file beside the holder, and write the same log at once.
 """
 
 import fcntl
@@ -27,9 +33,8 @@ from pathlib import Path
 
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import open_file
+from studyapp.experiment.session_files import LOCK_FILE
 from studyapp.experiment.session_log import wall_time
-
-LOCK_FILE = ".lock"
 
 
 def _acquire(path, blocking):
@@ -43,13 +48,36 @@ def _acquire(path, blocking):
             return None
         # The file may have been replaced while we waited (a participant folder
         # removed after a failed start): a lock on an unlinked file locks nothing.
-        try:
-            same = os.stat(path).st_ino == os.fstat(fd).st_ino
-        except FileNotFoundError:
-            same = False
-        if same:
+        if _same_file(path, fd):
             return fd
         os.close(fd)
+
+
+def _same_file(path, fd):
+    try:
+        return os.stat(path).st_ino == os.fstat(fd).st_ino
+    except FileNotFoundError:
+        return False
+
+
+def remove_if_free(folder):
+    """Remove ``folder``'s lock file if no program holds it (taken for the moment); False if one does."""
+    path = Path(folder) / LOCK_FILE
+    try:
+        fd = os.open(path, os.O_RDWR)
+    except FileNotFoundError:
+        return True
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        return False
+    try:
+        if _same_file(path, fd):
+            path.unlink()
+    finally:
+        os.close(fd)  # a program that opened the file meanwhile finds it unlinked, and takes a new one
+    return True
 
 
 def _holder(path):
@@ -85,8 +113,11 @@ class ParticipantLock:
         except OSError:
             pass  # a full disk: the lock holds all the same, only its holder goes unnamed
 
-    def release(self):
+    def release(self, remove=False):
+        """Drop the lock; with ``remove``, first unlink its file (while still held, so no one else's)."""
         if self._fd is not None:
+            if remove and _same_file(self.path, self._fd):
+                self.path.unlink()
             os.close(self._fd)  # closing the last fd of the open file drops the flock
             self._fd = None
 

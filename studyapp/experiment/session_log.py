@@ -9,20 +9,17 @@ key, ``crc``: the CRC-32 (8 hex digits) of the line's bytes without the
 ``os.fsync``s the file before returning, so an event that ``append`` returned
 from survives a crash of the program or of the machine.
 
-Reading (``read_log``) checks every line and never lets one bad line hide
-the others:
+Reading (``read_log``, ``log_scan``) checks every line, its checksum first,
+and never lets one bad line hide the others. Opening the log for appending
+(``SessionLog``) repairs only what was never confirmed:
 
-- a complete line that is not valid JSON or fails its checksum is *damaged*:
-  it is left out, reported by its line number, and the valid lines after it
-  are kept. Valid JSON that is not an event object is *malformed* (not
-  corruption: an edited file): the export refuses it, resuming treats it as damaged. Opening the log for appending leaves it in place (nothing
-  but a torn last line is ever removed), copies it to ``events.jsonl.damaged``
-  and logs a ``log_damaged`` event the first time it is seen.
-- the bytes after the last newline are a *torn* last line (the machine lost
-  power, or the disk filled, during a write; the event was never confirmed).
-  Opening the log for appending copies them to ``events.jsonl.torn-<time>``,
-  truncates them and logs a ``log_repaired`` event. A torn line that passes
-  its checksum lacks only its newline, which is added instead.
+- a damaged or malformed line stays in place (nothing but the bytes after the
+  last confirmed event is ever removed); it is copied to
+  ``events.jsonl.damaged`` and a ``log_damaged`` event is logged the first
+  time it is seen.
+- a torn last line (or the damaged newline of the last confirmed event) is
+  copied to ``events.jsonl.torn-<time>`` and truncated, and ``log_repaired``
+  logged; a last confirmed event that lacks its newline gets one.
 
 Every such finding is also a line in ``SessionLog.notes`` for the program to
 show. A write that fails (disk full, file too large, I/O error) is undone by
@@ -32,24 +29,28 @@ truncating the file back to its last complete line, and raises
 
 import json
 import os
-import re
 import time
 import zlib
-from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, open_file
+from studyapp.experiment.log_scan import read_events, read_log, scan  # noqa: F401 - the log's readers, here too
 
 DAMAGED_SUFFIX = ".damaged"
 TORN_SUFFIX = ".torn-"
-_CRC_TAIL = re.compile(rb',"crc":"([0-9a-f]{8})"\}$')
 
 
 class LogWriteError(UserError):
-    """The session log could not be written (disk full, a write error); nothing was torn."""
+    """The session log could not be written (disk full, a write error); nothing was torn.
+
+    ``reason`` is the system's word for it (e.g. "No space left on device")."""
+
+    def __init__(self, message, reason=None):
+        super().__init__(message)
+        self.reason = reason
 
 
 def wall_time():
@@ -61,74 +62,6 @@ def encode(record):
     """The log line (bytes, newline included) of ``record``, its CRC-32 appended as key ``crc``."""
     body = json.dumps(record, separators=(",", ":"), allow_nan=False).encode("utf-8")
     return body[:-1] + b',"crc":"%08x"}\n' % zlib.crc32(body)
-
-
-def decode(line):
-    """(event, None) for a valid line (bytes, no newline), else (None, why it is damaged)."""
-    try:
-        event = json.loads(line)
-    except ValueError:
-        return None, "not valid JSON"
-    if not isinstance(event, dict) or "type" not in event:
-        return None, "not an event"
-    if "crc" in event:
-        match = _CRC_TAIL.search(line)
-        if match is None or zlib.crc32(line[: match.start()] + b"}") != int(match.group(1), 16):
-            return None, "checksum mismatch"
-        del event["crc"]
-    return event, None
-
-
-@dataclass
-class LogScan:
-    """What ``scan`` found in a log's bytes."""
-
-    events: list = field(default_factory=list)
-    lines: list = field(default_factory=list)      # the 1-based line number of each event
-    damaged: list = field(default_factory=list)    # (line number, reason, raw bytes with newline)
-    malformed: list = field(default_factory=list)  # the same, for valid JSON that is not an event
-    torn: bytes = b""                              # an incomplete last line
-    completed: bool = False                        # the last line was whole but for its newline
-
-    def messages(self, name):
-        """One line per damaged line, naming ``name`` (e.g. the file) and the line number."""
-        return [f"{name} line {n}: damaged ({why}), left out; the lines after it are kept"
-                for n, why, _ in self.damaged]
-
-
-def scan(data):
-    """Check every line of ``data`` (the bytes of a log); see the module docstring."""
-    result = LogScan()
-    *complete, tail = data.split(b"\n")
-    for number, line in enumerate(complete, start=1):
-        event, why = decode(line)
-        if event is None:
-            (result.malformed if why == "not an event" else result.damaged).append((number, why, line + b"\n"))
-        else:
-            result.events.append(event)
-            result.lines.append(number)
-    if tail:
-        event, _ = decode(tail)
-        if event is not None and _CRC_TAIL.search(tail):
-            result.events.append(event)
-            result.lines.append(len(complete) + 1)
-            result.completed = True
-        else:
-            result.torn = tail
-    return result
-
-
-def read_log(path):
-    """``scan`` of the log at ``path`` (empty when there is none)."""
-    try:
-        return scan(Path(path).read_bytes())
-    except FileNotFoundError:
-        return LogScan()
-
-
-def read_events(path):
-    """The valid events of the log at ``path`` (damaged lines and a torn tail left out)."""
-    return read_log(path).events
 
 
 def fsync_directory(path):
@@ -166,20 +99,24 @@ class SessionLog:
             fsync_directory(self.path.parent)
         data = self.path.read_bytes()
         log = scan(data)
-        self._size = len(data) - len(log.torn)
+        self._size = len(data) - len(log.cut)
         self.seq = max((e["seq"] for e in log.events if isinstance(e.get("seq"), int)), default=-1) + 1
         repairs = []
-        if log.torn:
+        if log.cut:
             stamp = datetime.now().strftime("%Y%m%dT%H%M%S")
             copy = self.path.with_name(f"{self.path.name}{TORN_SUFFIX}{stamp}")
-            self._guard(lambda: _write_copy(copy, log.torn))
+            self._guard(lambda: _write_copy(copy, log.cut))
             self._guard(lambda: (os.ftruncate(self._fd, self._size), os.fsync(self._fd)))
-            self.notes.append(f"{self.path}: a torn last line ({len(log.torn)} bytes, an event never "
-                              f"confirmed) removed; a copy is kept in {copy.name}")
-            repairs.append({"type": "log_repaired", "dropped_bytes": len(log.torn), "copy": copy.name})
-        elif log.completed:
+            what = (f"a torn last line ({len(log.torn)} bytes, an event never confirmed)" if log.torn else "")
+            if log.completed:
+                what = " and ".join(filter(None, ["the damaged newline of the last confirmed event", what]))
+            self.notes.append(f"{self.path}: {what} removed; a copy is kept in {copy.name}")
+            repairs.append({"type": "log_repaired", "dropped_bytes": len(log.cut), "copy": copy.name})
+        if log.completed:
             self._write(b"\n")
-            self.notes.append(f"{self.path}: the last line lacked its newline (checksum valid): completed")
+            self.notes.append(f"{self.path}: the last line lacked its newline (checksum valid: confirmed): completed")
+        self.notes.extend(f"{self.path} line {n}: confirmed events run together (a damaged newline): all kept"
+                          for n in log.mended)
         bad = sorted(log.damaged + log.malformed)
         if bad:
             side = self.path.with_name(self.path.name + DAMAGED_SUFFIX)
@@ -198,7 +135,7 @@ class SessionLog:
             action()
         except OSError as exc:
             raise LogWriteError(f"{self.path}: cannot repair the session log ({exc.strerror or exc}): "
-                                "allowed is to free disk space and try again") from None
+                                "allowed is to free disk space and try again", exc.strerror or str(exc)) from None
 
     def _write(self, line):
         try:
@@ -212,7 +149,7 @@ class SessionLog:
             except OSError:
                 pass  # then the next open removes it as a torn last line, keeping a copy
             raise LogWriteError(f"{self.path}: cannot write the session log ({exc.strerror or exc}): the session "
-                                "stopped, nothing torn: free disk space, then resume it") from None
+                                "stopped, nothing torn: free disk space, then resume it", exc.strerror or str(exc)) from None
         self._size += len(line)
 
     def append(self, event):

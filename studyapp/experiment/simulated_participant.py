@@ -10,7 +10,8 @@ way whether or not the session was interrupted before it.
 How it plays a trial is its task type's ``simulate`` (``studyapp.experiment.tasks``:
 the rating and adjustment strategies are described there; a page it
 acknowledges at once, and a headphone level check as the experimenter would,
-so a headless session runs through); this class holds
+after listening to its tone for ``level_check_time``, so a headless session
+runs through and its archived audio holds the tone); this class holds
 the participant's traits (the times and jitters below, and a personal
 criterion of ``criterion_spread`` knob positions drawn once per session) and
 the hand's and ear's common moves: turning a knob as a hand does, measuring a
@@ -30,7 +31,7 @@ from studyapp.model.fmax_knob import KNOB_MAX
 class SimulatedParticipant:
     def __init__(self, seed, bow_time=0.25, probe_time=1.2, reaction_time=0.05, rest_time=1.0,
                  retries=12, adjust_gesture="hold", rating_jitter=0.05,
-                 hand_jitter=1.5, criterion_spread=2.0):
+                 hand_jitter=1.5, criterion_spread=2.0, level_check_time=1.0):
         self.seed = int(seed)
         self.bow_time = bow_time
         self.probe_time = probe_time
@@ -40,6 +41,7 @@ class SimulatedParticipant:
         self.adjust_gesture = adjust_gesture
         self.rating_jitter = rating_jitter
         self.hand_jitter = hand_jitter
+        self.level_check_time = level_check_time  # s the experimenter listens to the level check's tone
         self.criterion = float(np.random.default_rng([self.seed, 0x5EED]).normal(0.0, criterion_spread))
         self.knob_values = {}
 

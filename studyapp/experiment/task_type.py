@@ -109,6 +109,10 @@ class TaskType(Protocol):
 
     def start(self, spec, trial) -> TrialState: ...
 
+    def typical_duration(self, spec, trial) -> float:
+        """Seconds a person typically takes for ``trial``: the run sheet's estimate (``run_plan``) until
+        the study has recorded trials of its own; ``spec`` is None for a page."""
+
     def describe(self, trial) -> str:
         """One line for the experimenter's progress (may name the condition)."""
 

@@ -2,7 +2,9 @@
 
 A plain ``QWidget`` for the experimenter console to embed. ``load(path)``
 takes a report folder written by ``studyapp analyse`` (same settings, so the
-same figures), a results folder, or an exported responses .csv. The figures
+same figures), a results folder, or an exported responses .csv; simulated
+participants are left out of the latter two unless "Include simulated
+participants" is ticked (as ``analyse --include-simulated``). The figures
 are drawn by ``studyapp.analysis.figures`` on matplotlib Qt canvases, so they
 are the report's figures, with zoom and pan from matplotlib's toolbar. Bad
 input is shown in the view's status line, never raised to the event loop.
@@ -13,6 +15,7 @@ from pathlib import Path
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg, NavigationToolbar2QT
 from matplotlib.figure import Figure
 from PySide6.QtWidgets import (
+    QCheckBox,
     QFileDialog,
     QHBoxLayout,
     QLabel,
@@ -41,7 +44,10 @@ class AnalysisView(QWidget):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.study = None
+        self.path = None
         self.canvases = {}
+        self.include_simulated = QCheckBox("Include simulated participants")
+        self.include_simulated.toggled.connect(lambda _: self.path is not None and self.load(self.path))
         self.open_button = QPushButton("Open results…")
         self.open_button.clicked.connect(self._choose_folder)
         self.source_label = QLabel("No study loaded.")
@@ -62,6 +68,7 @@ class AnalysisView(QWidget):
         top = QHBoxLayout()
         top.addWidget(self.open_button)
         top.addWidget(self.source_label, 1)
+        top.addWidget(self.include_simulated)
         layout = QVBoxLayout(self)
         layout.addLayout(top)
         layout.addWidget(self.status_label)
@@ -69,8 +76,9 @@ class AnalysisView(QWidget):
 
     def load(self, path):
         """Analyse ``path`` and show it; returns the ``StudyAnalysis``, or None after showing the error."""
+        self.path = path
         try:
-            study = open_study(Path(path))
+            study = open_study(Path(path), include_simulated=self.include_simulated.isChecked())
         except UserError as exc:
             self.status_label.setText(f"Cannot analyse {path}: {exc}")
             return None

@@ -2,8 +2,9 @@
 
 Left: session set-up and the apparatus found, and the session's progress
 (task, trial x of y, the page the participant sees with the headphone level
-check's confirm (``PageControls``), the current condition), in a scroll area; below them, always in view, the
-tick that hides the condition (blinding), the session's
+check's confirm (``PageControls``), the current condition), the run sheet,
+notes and master volume (``SessionTools``), in a scroll area; below them,
+always in view, the tick that hides the condition (blinding), the session's
 buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
 scope with the on-screen knobs and pads and the bowing pad; the analysis view
 (``AnalysisView``) of a results folder; the session's log. Bottom: the status
@@ -63,6 +64,7 @@ from studyapp.gui.knobs import KnobPanel
 from studyapp.gui.page_controls import PageControls
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.scope import Scope
+from studyapp.gui.session_tools import SessionTools
 from studyapp.gui.setup_panel import SetupPanel
 from studyapp.gui.status_bar import StatusBar
 from studyapp.session.controller import GESTURES, REST, State
@@ -155,6 +157,8 @@ class Console(QMainWindow):
         dv.setContentsMargins(0, 0, 0, 0)
         dv.addWidget(self.setup)
         dv.addWidget(progress)
+        self.tools = SessionTools(controller, self.setup, self.blind.isChecked)  # run sheet, notes, sound
+        dv.addWidget(self.tools)
         dv.addStretch(1)
         scroll = QScrollArea()
         scroll.setWidget(details)

@@ -62,6 +62,13 @@ the worker writes it to audio_cues.csv at its own audio frame counter
 (engine/audio_recorder.py), so no sample position crosses the process
 boundary.
 
+Notes and sound. ``add_note`` logs the experimenter's note (``note`` event,
+experiment/session_notes.py) in the running session, or after it in the
+latest session's log; ``set_volume`` (dB) and ``set_mute`` hold the
+console's master volume (session/master_sound.py: the engine's own
+``SetVolume`` and ``SetMute``, sent again to every engine that comes up),
+each change logged as a ``volume`` or ``mute`` event during a session.
+
 Engines. A protocol gets a *preview* engine with every condition it names.
 Starting a session starts a fresh engine seeded with the session's seed; once
 the session ends it stays as the preview engine.
@@ -107,16 +114,19 @@ from studyapp.engine.config import EngineConfig
 from studyapp.engine.events import Learned
 from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
+from studyapp.experiment.data_modes import file_mode
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.schedule import counted
 from studyapp.experiment.session import Session, check_participant
 from studyapp.experiment.session_info import order_text
+from studyapp.experiment.session_notes import add_note, note_event
 from studyapp.experiment.session_runner import SessionRunner
 from studyapp.experiment.tasks import task_type
 from studyapp.session.engine_host import EngineHost
 from studyapp.session.engine_loop import EngineLoop
 from studyapp.session.evented import EventGroup
 from studyapp.session.knob_latency import KnobLatency
+from studyapp.session.master_sound import MasterSound
 
 AUDIO_FILE = "audio.wav"  # what the participant heard, in the session folder (audio-2.wav, ... per engine run)
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
@@ -230,6 +240,8 @@ class SessionController:
         self._health = None  # the engine and its counters when the current trial started
         self._page_shown = 0.0  # self.clock() when the current page appeared
         self._tone = False  # a calibration page's reference tone is playing
+        self.sound = MasterSound()  # the console's master volume and mute (master_sound.py)
+        self.last_session = None  # the folder of the latest session started here (notes after it ends)
 
     # the state machine ----------------------------------------------------------
     def fire(self, event):
@@ -317,6 +329,7 @@ class SessionController:
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
                                      **(details or {}))
         self.session = session
+        self.last_session = session.folder
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
         self.fire("open")
@@ -507,7 +520,8 @@ class SessionController:
                          "note": "one real-time engine per session: its seed, not the trials' loop_seed, "
                                  "seeds the sensor noise"})
         self.fed = self.host.position
-        self._send(cmd.RecordAudio(str(self.session.folder / AUDIO_FILE)))  # one file per engine run
+        # one file per engine run; participant data, with the mode of the session's other files
+        self._send(cmd.RecordAudio(str(self.session.folder / AUDIO_FILE), file_mode()))
 
     def _make_loop(self, estimators, source, seed):
         self.trial_serial += 1
@@ -778,6 +792,35 @@ class SessionController:
         else:
             self.engine.send(cmd.SetHandTarget(float(x_m)))
 
+    # the experimenter's notes and sound ------------------------------------------------
+    def add_note(self, text):
+        """Log a note (``UserError`` when refused): in the session running, else in the latest one's log."""
+        event = note_event(text)
+        if self.session is not None:
+            record = self._log_session(event)
+        elif self.last_session is not None:
+            record = add_note(self.last_session, text)
+        else:
+            raise UserError("no session to add a note to: start one first")
+        self.message(f"note logged at {record['wall']}")
+        return record
+
+    def set_volume(self, db):
+        """The master volume, in dB (master_sound.py); logged during a session."""
+        self._sound_event(self.sound.set_db(db))
+
+    def set_mute(self, on):
+        self._sound_event(self.sound.set_muted(on))
+
+    def _sound_event(self, record):
+        self._send(*self.sound.commands())
+        if self.session is not None:
+            self._log_session(record)
+
+    def _log_session(self, record):
+        """Log ``record`` in the session's log (with the current step once its trials run)."""
+        return self.runner.log(record) if self.runner is not None else self.session.log.append(record)
+
     # the timer ----------------------------------------------------------------------
     def poll(self):
         """Called by a timer: messages, engine state, telemetry, controls, status. Never waits."""
@@ -811,6 +854,7 @@ class SessionController:
             if self.state in REST:  # a session's engine stays on as the preview's
                 self._send(cmd.InstallActions(self._preview_actions()))
         if state == "running":
+            self._send(*self.sound.commands())  # the console's volume holds for every engine
             self.fire("engine_up")
         elif state == "failed":
             self.fire("engine_failed")

@@ -138,6 +138,12 @@ class ParticipantProxy:
         self.act(lambda: self.controller.acknowledge_page(by))
 
     def advance(self, seconds):
+        if self.loop is None:  # a page: nothing runs for the participant, time passes
+            end = time.monotonic() + seconds
+            while time.monotonic() < end:
+                self._check()
+                time.sleep(WAIT_STEP)
+            return None
         n = max(1, int(round(seconds * self.loop.rate)))
         c = self.controller
         while True:

@@ -86,8 +86,10 @@ def test_within_subject_tables_beside_the_pooled_ones(report):
     assert f"Pairwise Wilcoxon rank-sum p-values, {POOLED}" in html
     assert "Friedman test across conditions" in html and "Wilcoxon signed-rank tests, Holm-corrected" in html
     # nine participants and 36 pairs: 36 x 2^-8 = 0.14, so no Holm-corrected pair can be significant
-    assert "after Holm&#x27;s correction over 36 pairs no pair can be significant with 9 participants" in html
-    assert "warning: adjustment: after Holm's correction over 36 pairs" in err
+    assert ("no pair can be significant with 9 participants: the smallest exact two-sided signed-rank p is "
+            "2^(1-n) = 0.00391, and Holm&#x27;s correction over the 36 pairs multiplies it by 36: 0.141, not below 0.05; "
+            "11 participants are needed") in html
+    assert "warning: adjustment: no pair can be significant with 9 participants" in err
     settings = json.loads((out / "analysis_settings.json").read_text())
     assert POOLED in settings["tests"]["wilcoxon_adjustment.csv"]
     assert "signed-rank" in settings["tests"]["signed_rank_rating.csv"]
@@ -107,9 +109,11 @@ def test_two_participants_pooled_p_is_labelled_and_within_subject_p_is_honest(tm
     assert not within["significant"].any()
     assert (pd.read_csv(out / "friedman.csv")["n_participants"] == 2).all()
     lines = err.getvalue().splitlines()
-    for task in ("adjustment", "rating"):
-        assert (f"studyapp analyse: warning: {task}: a signed-rank test on 2 participants cannot reach p < 0.05 "
-                "two-sided: the smallest attainable p is 2^(1-n) = 0.5; 6 participants are needed") in lines
+    for task, pairs in (("adjustment", 36), ("rating", 28)):
+        # the test used is Holm over the task's pairs: 11 participants are needed, not 6 (issue 22 item 14)
+        assert (f"studyapp analyse: warning: {task}: no pair can be significant with 2 participants: the smallest "
+                f"exact two-sided signed-rank p is 2^(1-n) = 0.5, and Holm's correction over the {pairs} pairs "
+                f"multiplies it by {pairs}: {pairs * 0.5:g}, not below 0.05; 11 participants are needed") in lines
         assert any(line.startswith(f"studyapp analyse: warning: {task}: Friedman's test with 2 participants")
                    for line in lines)
 

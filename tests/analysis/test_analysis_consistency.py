@@ -70,6 +70,22 @@ def test_numerical_comparison_by_hand(tmp_path):
     assert table.loc["max F_max vs delay", "rho"] == pytest.approx(0.8)
 
 
+def test_numerical_delay_ranks_by_magnitude(tmp_path):
+    """A lead of the LVT (D < 0) is as far from it as a lag: KALMAN 1 sample ahead ranks with a 1-sample lag."""
+    from studyapp.analysis.numerical import numerical_scores
+
+    estimators = {
+        "LOWPASS": {"error": [1], "delay": [3], "error_pct_lowpass": [100], "delay_pct_lowpass": [100]},
+        "KALMAN": {"error": [1], "delay": [-2], "error_pct_lowpass": [30], "delay_pct_lowpass": [-66.7]},
+        "LEASTSQ": {"error": [1], "delay": [0], "error_pct_lowpass": [90], "delay_pct_lowpass": [0]},
+        "KALPOS": {"error": [1], "delay": [1], "error_pct_lowpass": [70], "delay_pct_lowpass": [33.3]},
+    }
+    scores, metric = numerical_scores(load_evaluation(_evaluation(tmp_path, estimators)), "delay")
+    assert metric == "delay_pct_lowpass"
+    assert list(scores.sort_values().index) == ["LEASTSQ", "KALPOS", "KALMAN", "LOWPASS"]
+    assert scores["KALMAN"] == pytest.approx(66.7)
+
+
 def test_numerical_comparison_falls_back_to_raw_lists(tmp_path):
     estimators = {n: {"error": [e], "delay": [d]} for n, e, d in [("A", 1, 3), ("B", 2, 2), ("C", 3, 1)]}
     evaluation = load_evaluation(_evaluation(tmp_path, estimators) / "evaluation.json")

@@ -70,7 +70,7 @@ def conditions():
 def test_every_output_present_and_the_report_opens(study, conditions, source):
     rating_conditions, adjustment_conditions = conditions
     out = study / f"report_{source}"
-    code, err = analyse(study / source, "-o", out)
+    code, err = analyse(study / source, "-o", out, "--include-simulated")  # every participant here is simulated
     assert code == 0, err
     for name, columns in TABLES.items():
         table = pd.read_csv(out / name)
@@ -99,6 +99,16 @@ def test_every_output_present_and_the_report_opens(study, conditions, source):
     assert set(PARTICIPANTS) <= set(page.text.split())
 
 
+@pytest.mark.parametrize("source", ["responses.csv", "results"])
+def test_only_simulated_participants_are_refused_in_one_line_naming_the_option(study, source):
+    assert pd.read_csv(study / "responses.csv")["simulated"].all()  # export's column (issue 22 item 11)
+    out = study / f"refused_{source}"
+    code, err = analyse(study / source, "-o", out)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    assert "every response is from a simulated participant (SIM1, SIM2, SIM3)" in err
+    assert "--include-simulated" in err and not out.exists()
+
+
 def test_a_session_short_of_a_response_is_reported(study):
     results = study / "results_short"
     shutil.copytree(study / "results", results)
@@ -106,7 +116,7 @@ def test_a_session_short_of_a_response_is_reported(study):
     lines = events.read_text().splitlines(keepends=True)
     last_response = max(i for i, line in enumerate(lines) if '"response"' in line and '"adjustment"' in line)
     events.write_text("".join(lines[:last_response]))
-    code, err = analyse(results, "-o", study / "report_short")
+    code, err = analyse(results, "-o", study / "report_short", "--include-simulated")
     assert code == 0, err
     missing = pd.read_csv(study / "report_short" / "missing_trials.csv")
     assert missing["participant"].tolist() == ["SIM2"] and missing["present"].tolist() == [0]

@@ -79,15 +79,22 @@ def test_warnings_say_what_the_number_of_participants_allows():
     two = _warnings(2)
     assert "Friedman's test with 2 participants" in two and "unreliable below 6" in two
     assert "(smallest p (k!)^(1-n) = 0.167)" in two  # 3! ^ -1: an exact test could not reach 0.05 either
-    assert "a signed-rank test on 2 participants cannot reach p < 0.05" in two
-    assert "smallest attainable p is 2^(1-n) = 0.5; 6 participants are needed" in two
+    # the test used is Holm over the 3 pairs, so the count needed is 7 (3 x 2^-6 < 0.05), not 6 (issue 22 item 14)
+    assert ("no pair can be significant with 2 participants: the smallest exact two-sided signed-rank p is "
+            "2^(1-n) = 0.5, and Holm's correction over the 3 pairs multiplies it by 3: 1.5, not below 0.05; "
+            "7 participants are needed") in two
     five = _warnings(5)
     assert "2^(1-n) = 0.0625" in five and "Friedman's test with 5" in five and "(k!)^(1-n)" not in five
+    assert "7 participants are needed" in five
     six = _warnings(6)  # 3 pairs: 3 x 2^-5 = 0.094 after Holm
-    assert "Friedman" not in six and "cannot reach" not in six
-    assert "after Holm's correction over 3 pairs no pair can be significant with 6 participants" in six
-    assert "7 are needed" in six
+    assert "Friedman" not in six
+    assert "no pair can be significant with 6 participants" in six and "multiplies it by 3: 0.0938, not below 0.05" in six
+    assert "7 participants are needed" in six
     assert _warnings(7) == ""
+    two_conditions = _warnings(5, "AB")  # one pair: no Holm, the plain signed-rank bound (6)
+    assert "Friedman's test needs 3 or more conditions (here 2)" in two_conditions
+    assert "a signed-rank test on 5 participants cannot reach p < 0.05" in two_conditions
+    assert "6 participants are needed" in two_conditions
     assert "Friedman's test needs 3 or more conditions (here 2)" in _warnings(7, "AB")
 
 

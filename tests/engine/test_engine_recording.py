@@ -14,6 +14,8 @@ from studyapp.engine.audio import open_sink
 from studyapp.engine.audio_recorder import CUE_COLUMNS, AudioRecorder, pcm16
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
+from studyapp.engine.resampler import Resampler
+from studyapp.engine.signal_chain import FADE_S
 
 FS = 48000.0
 
@@ -83,7 +85,8 @@ def test_two_wav_sinks_on_one_file_both_keep_their_take_and_say_which_file(tmp_p
     third.push(np.zeros(100))
     third.close()
     lengths = {p.name: wavfile.read(p)[1].size for p in sorted(tmp_path.iterdir())}
-    assert lengths == {"take.wav": 4800, "take-2.wav": 9600, "take-3.wav": 960}
+    tail = round(FADE_S * 5000.0) * 48 // 5  # the fades' lookahead, played out (faded) when the sink closes
+    assert lengths == {"take.wav": 4800 + tail, "take-2.wav": 9600 + tail, "take-3.wav": 960 + tail}
     assert wavfile.read(path)[1][1000] > 0  # the first take intact
     assert said == [f"audio: {path} appeared meanwhile; wrote {tmp_path / 'take-2.wav'} (never over an earlier file)",
                     f"audio: {path} exists; writing {tmp_path / 'take-3.wav'} (never over an earlier file)"]
@@ -126,8 +129,11 @@ def test_the_engine_records_what_is_heard_with_cues_at_the_trials_first_samples(
     assert np.std(recorded) > 100  # the bowed string, not silence
     cues = _cues(record.parent)
     assert [(r["file"], r["trial"], r["event"]) for r in cues] == [("audio.wav", "1", "start"), ("audio.wav", "2", "start")]
-    # each cue sits where the telemetry says its trial's first sample is, give or take a block
-    start = recorded.size - (summary["samples"] - first[1]) * ratio  # frame of trial 1's first sample
+    # each cue sits where the telemetry says its trial's first sample is heard, give or take a block: the
+    # recording ends with the resampler's last available output (its filter delay before the newest input)
+    # and a sample is heard the fades' lookahead after it was computed
+    lag = Resampler(5000.0, FS).latency * ratio + round(FADE_S * 5000.0) * ratio
+    start = recorded.size - (summary["samples"] - first[1]) * ratio + lag  # frame of trial 1's first sample
     for cue, trial in zip(cues, (1, 2)):
         assert int(cue["sample"]) == pytest.approx(start + (first[trial] - first[1]) * ratio, abs=block + 1)
     assert any(f"recording what is heard to {record}" in n for n in notices)

@@ -38,13 +38,13 @@ def test_the_tone_is_one_sine_across_blocks_of_any_size_with_a_linear_ramp_in():
 
 def test_off_ramps_the_string_back_and_then_leaves_it_untouched():
     tone = ReferenceTone(FS)
-    tone.set(500.0, -6.0)
+    tone.set(500.0, -18.0)
     tone.mix(np.zeros(5000))
     tone.set(500.0, None)
     faded = tone.mix(np.ones(1000))
     j = np.arange(1000)
     fade = np.maximum(1 - (j + 1) / int(round(RAMP * FS)), 0.0)  # the tone's share, ramped down linearly
-    amplitude = 10 ** (-6 / 20)
+    amplitude = 10 ** (-18 / 20)
     expected = (1 - fade) + amplitude * fade * np.sin(2 * np.pi * 500.0 * (5000 + j) / FS)
     np.testing.assert_allclose(faded, expected, atol=1e-9)
     block = np.ones(10)
@@ -53,7 +53,7 @@ def test_off_ramps_the_string_back_and_then_leaves_it_untouched():
 
 def test_mute_silences_the_tone_with_a_ramp():
     tone = ReferenceTone(FS)
-    tone.set(1000.0, 0.0)
+    tone.set(1000.0, -18.0)
     tone.mix(np.zeros(1000))
     tone.set_muted(True)
     out = tone.mix(np.ones(1000))
@@ -62,7 +62,7 @@ def test_mute_silences_the_tone_with_a_ramp():
 
 
 @pytest.mark.parametrize("hz, level, words", [
-    (5.0, -20.0, "20 to 20000 Hz"), (30000.0, -20.0, "20 to 20000 Hz"), (1000.0, 3.0, "-96 to 0 dBFS"),
+    (5.0, -20.0, "20 to 20000 Hz"), (30000.0, -20.0, "20 to 20000 Hz"), (1000.0, -12.0, "-96 to -18 dBFS"),
     (float("nan"), -20.0, "Hz"), (1000.0, float("inf"), "dBFS")])
 def test_a_tone_the_sink_cannot_play_is_refused_in_one_line(hz, level, words):
     with pytest.raises(ParameterError, match=words) as info:
@@ -86,14 +86,14 @@ def test_the_wav_sink_replaces_the_string_and_ignores_the_volume_knob(tmp_path):
     path = tmp_path / "tone.wav"
     sink = open_sink(f"wav:{path}", 5000.0)
     sink.set_volume(0.25)
-    sink.set_reference_tone(1000.0, -12.0)
+    sink.set_reference_tone(1000.0, -20.0)
     string = 0.9 * np.sin(2 * np.pi * 196.0 * np.arange(10000) / 5000.0)
     for start in range(0, string.size, 10):
         sink.push(string[start:start + 10])
     sink.close()
     fs, pcm = wavfile.read(path)
     steady = pcm[int(0.1 * fs):int(1.9 * fs)] / 32767.0
-    assert np.max(np.abs(steady)) == pytest.approx(10 ** (-12 / 20), abs=2e-4)  # the level asked, not x 0.25
+    assert np.max(np.abs(steady)) == pytest.approx(10 ** (-20 / 20), abs=2e-4)  # the level asked, not x 0.25
     spectrum = np.abs(np.fft.rfft(steady * np.hanning(steady.size)))
     freqs = np.fft.rfftfreq(steady.size, 1 / fs)
     assert spectrum[np.argmin(np.abs(freqs - 196.0))] < 1e-4 * spectrum.max()  # the string is gone

@@ -4,13 +4,14 @@ import numpy as np
 import pytest
 import scipy.linalg
 import scipy.signal
-from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
 from studyapp.estimators import create, foaw
 from studyapp.estimators.dispatch import GUARD
 from studyapp.estimators.hybrids import Z_A
 from studyapp.estimators.kalman import P0_ACCELERATION, P0_VELOCITY
+from studyapp.estimators.spec import Q_CONVENTIONS
+from tests.estimators.test_estimators_kalman import filterpy_q
 
 RATE = 5000.0
 
@@ -50,13 +51,13 @@ def highpass(rate, hpf_hz, a):
 
 
 def kalman_reference(rate, params, x, za):
-    """filterpy's textbook KALMAN (eq. 19) fed with position and the given acceleration measurement."""
+    """filterpy's textbook KALMAN (Q in the estimator's convention) fed with position and the given acceleration."""
     t = 1.0 / rate
     kf = KalmanFilter(dim_x=3, dim_z=2)
     kf.F = np.array([[1.0, t, t * t / 2], [0.0, 1.0, t], [0.0, 0.0, 1.0]])
     kf.H = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     kf.R = np.diag([params["r_pos"], params["r_acc"]])
-    kf.Q = Q_discrete_white_noise(3, dt=t, var=params["q"])
+    kf.Q = filterpy_q(3, t, params["q"], params["q_convention"])
     kf.P = np.diag([params["r_pos"], P0_VELOCITY**2, P0_ACCELERATION**2])
     kf.x = np.array([x[0], 0.0, 0.0])
     v = np.zeros(len(x))
@@ -91,17 +92,18 @@ def test_kalfoaw_measurements_are_foaw_twice():
     np.testing.assert_allclose(seen, chain + highpass(RATE, 50.0, a), rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("convention", Q_CONVENTIONS)
 @pytest.mark.parametrize("name", ["KALLEV", "KALLEVACC", "KALFOAW", "KALFOAWACC"])
-def test_kalman_part_equals_filterpy_fed_with_the_chain(name):
+def test_kalman_part_equals_filterpy_fed_with_the_chain(name, convention):
     x, a = noisy_motion(RATE, 2000)
-    est = create(name, RATE)
+    est = create(name, RATE, q_convention=convention)
     out = est.process(x, a)
-    za = measurements_seen(name, RATE, x, a)
+    za = measurements_seen(name, RATE, x, a, q_convention=convention)
     ref = kalman_reference(RATE, est.params, x, za)
     np.testing.assert_allclose(out, ref, rtol=1e-9, atol=1e-9 * np.sqrt(np.mean(ref**2)))
 
 
-def acceleration_to_velocity_gain(rate, q, r_acc, r_pos):
+def acceleration_to_velocity_gain(rate, q, r_acc, r_pos, convention):
     """l1 norm of the steady-state KALMAN's impulse response from the acceleration measurement to v.
 
     From scipy's discrete Riccati solution (on the state [x, T v, T^2 a], where it is well
@@ -109,10 +111,10 @@ def acceleration_to_velocity_gain(rate, q, r_acc, r_pos):
     """
     t = 1.0 / rate
     f = np.array([[1.0, 1.0, 0.5], [0.0, 1.0, 1.0], [0.0, 0.0, 1.0]])
-    g = np.array([0.5, 1.0, 1.0]) * t * t
+    s = np.array([1.0, t, t * t])
     h = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     r = np.diag([r_pos, r_acc * t**4])
-    p = scipy.linalg.solve_discrete_are(f.T, h.T, q * np.outer(g, g), r)
+    p = scipy.linalg.solve_discrete_are(f.T, h.T, filterpy_q(3, t, q, convention) * np.outer(s, s), r)
     k = p @ h.T @ np.linalg.inv(h @ p @ h.T + r)
     closed = (np.eye(3) - k @ h) @ f
     assert np.abs(np.linalg.eigvals(closed)).max() < 0.999
@@ -152,7 +154,7 @@ def test_kallev_tracks_a_clean_slow_sine(rate):
     p = est.params
     exact = create("KALMAN", rate, q=p["q"], r_acc=p["r_acc"], r_pos=p["r_pos"]).process(x, a_true)
     bound = (np.abs(exact - v_true)[settled].max()
-             + acceleration_to_velocity_gain(rate, p["q"], p["r_acc"], p["r_pos"]) * e_a)
+             + acceleration_to_velocity_gain(rate, p["q"], p["r_acc"], p["r_pos"], p["q_convention"]) * e_a)
     assert bound < 0.05 * amp * w  # the bound itself is a meaningful tolerance: 5 % of the amplitude
     assert np.abs(out - v_true)[settled].max() <= bound
 

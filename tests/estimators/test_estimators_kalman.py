@@ -1,16 +1,17 @@
-"""KALPOS and KALMAN against filterpy's textbook KalmanFilter, and their covariance at the extremes."""
+"""KALPOS and KALMAN against filterpy's textbook KalmanFilter (every q convention), and their covariance at the extremes."""
 
 import itertools
 
 import numpy as np
 import pytest
-from filterpy.common import Q_discrete_white_noise
+from filterpy.common import Q_continuous_white_noise, Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
 from studyapp.errors import ParameterError
 from studyapp.estimators import create
 from studyapp.estimators.dispatch import GUARD
 from studyapp.estimators.kalman import P0_ACCELERATION, P0_VELOCITY, unscaled_posterior
+from studyapp.estimators.spec import Q_CONVENTIONS
 
 
 def signals(rate, duration, seed=0):
@@ -24,13 +25,19 @@ def signals(rate, duration, seed=0):
     return x, a
 
 
+def filterpy_q(dim, t, q, convention):
+    """Q by filterpy's own functions: eq. 19 as printed, the same times T, or continuous white noise."""
+    if convention == "continuous":
+        return Q_continuous_white_noise(dim, dt=t, spectral_density=q)
+    return Q_discrete_white_noise(dim, dt=t, var=q * (t if convention == "scaled" else 1.0))
+
+
 def filterpy_reference(name, rate, params, x, a):
     """The unscaled textbook filter: start at [x0, 0, 0] with P0, then predict/update per sample."""
     t = 1.0 / rate
     dim = 2 if name == "KALPOS" else 3
     kf = KalmanFilter(dim_x=dim, dim_z=dim - 1)
-    var = params["q"] * (t if params.get("q_convention") == "scaled" else 1.0)
-    kf.Q = Q_discrete_white_noise(dim, dt=t, var=var)
+    kf.Q = filterpy_q(dim, t, params["q"], params["q_convention"])
     if dim == 2:
         kf.F = np.array([[1.0, t], [0.0, 1.0]])
         kf.H = np.array([[1.0, 0.0]])
@@ -60,7 +67,7 @@ CASES = [
 
 
 @pytest.mark.parametrize("rate", [5000.0, 40000.0])
-@pytest.mark.parametrize("convention", ["eq19", "scaled"])
+@pytest.mark.parametrize("convention", Q_CONVENTIONS)
 @pytest.mark.parametrize("name,given", CASES)
 def test_equals_filterpy_step_by_step(name, given, convention, rate):
     est = create(name, rate, q_convention=convention, **given)
@@ -84,6 +91,20 @@ def test_conventions_differ_by_a_factor_t_on_q():
     np.testing.assert_allclose(scaled, eq19, rtol=1e-12, atol=1e-12 * np.abs(eq19).max())
 
 
+def test_table_1_defaults_are_the_conventions_they_were_tuned_in():
+    """KALPOS's q = 0.191 was tuned with continuous white noise, the third-order family's with q T Gamma Gamma^T."""
+    assert create("KALPOS", 5000.0).params["q_convention"] == "continuous"
+    for name in ("KALMAN", "KALLEV", "KALLEVACC", "KALFOAW", "KALFOAWACC"):
+        assert create(name, 5000.0).params["q_convention"] == "scaled"
+
+
+def test_continuous_white_noise_q_is_the_closed_form():
+    """KALPOS's Q = q [[T^3/3, T^2/2], [T^2/2, T]]: filterpy's function checked against the closed form."""
+    t, q = 1 / 5000.0, 0.191
+    expected = q * np.array([[t**3 / 3, t**2 / 2], [t**2 / 2, t]])
+    np.testing.assert_allclose(Q_continuous_white_noise(2, dt=t, spectral_density=q), expected, rtol=1e-15)
+
+
 def test_stream_equals_block():
     rate = 40000.0
     x, a = signals(rate, 0.02)
@@ -101,7 +122,7 @@ def test_unknown_convention_is_a_parameter_error():
 EXTREMES = [
     (name, q, r_pos, r_acc, conv)
     for name, q, r_pos, r_acc, conv in itertools.product(
-        ["KALPOS", "KALMAN"], [1e-9, 1e15], [1e-16, 1.0], [1e-9, 1e12], ["eq19", "scaled"])
+        ["KALPOS", "KALMAN"], [1e-9, 1e15], [1e-16, 1.0], [1e-9, 1e12], Q_CONVENTIONS)
     if name == "KALMAN" or r_acc == 1e-9
 ]
 

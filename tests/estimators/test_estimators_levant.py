@@ -11,10 +11,10 @@ from studyapp.estimators import create
 from studyapp.estimators.levant import LEVANT_STATE, levant_core
 
 
-def euler_reference(x, c, rate):
+def euler_reference(x, c, rate, start="zero"):
     """Eqs. 10-12 with alpha = 1.1 C, lambda = sqrt(C), written out plainly (DESIGN.md conventions)."""
     alpha, lam, period = 1.1 * c, math.sqrt(c), 1.0 / rate
-    w, u1 = float(x[0]), 0.0
+    w, u1 = (float(x[0]) if start == "first" else 0.0), 0.0
     out = np.empty(len(x))
     for k, xk in enumerate(x.tolist()):
         e = w - xk
@@ -35,16 +35,24 @@ def stick_slip():
     return rate, x + 6.4e-5 * rng.standard_normal(t.size)
 
 
+@pytest.mark.parametrize("start", ["zero", "first"])
 @pytest.mark.parametrize("c", [0.5, 19.7, 1e4])
-def test_levant_is_the_euler_recursion_of_eqs_10_to_12(stick_slip, c):
+def test_levant_is_the_euler_recursion_of_eqs_10_to_12(stick_slip, c, start):
     rate, x = stick_slip
-    got = create("LEVANT", rate, c=c).process(x)
-    np.testing.assert_allclose(got, euler_reference(x, c, rate), rtol=1e-12, atol=1e-12 * c)
-    assert got[0] == 0.0
+    got = create("LEVANT", rate, c=c, start=start).process(x)
+    np.testing.assert_allclose(got, euler_reference(x, c, rate, start), rtol=1e-12, atol=1e-12 * c)
 
 
-def test_levant_starts_at_the_first_sample():
+def test_levant_starts_at_zero_by_default_as_the_authors():
+    """The authors' observer starts at w = 0, u1 = 0: a position away from 0 is a step it must first follow."""
+    assert create("LEVANT", 5000.0).params["start"] == "zero"
     out = create("LEVANT", 40_000.0, c=50.0).process(np.full(1000, 0.0137))
+    assert out[0] == pytest.approx(math.sqrt(50.0 * 0.0137), rel=1e-15)  # -lambda sqrt|w - x| sgn(w - x), w = 0
+    assert np.abs(out).max() > 0.1
+
+
+def test_levant_can_start_at_the_first_sample():
+    out = create("LEVANT", 40_000.0, c=50.0, start="first").process(np.full(1000, 0.0137))
     assert np.all(out == 0.0)
 
 
@@ -85,8 +93,8 @@ def _double_levant(xs, c, rate):
     s = np.zeros(2 * LEVANT_STATE)
     out = np.empty_like(xs)
     for i in range(xs.shape[0]):
-        u = levant_core(s[0:LEVANT_STATE], 1.1 * c, np.sqrt(c), 1.0 / rate, xs[i])
-        out[i] = levant_core(s[LEVANT_STATE:], 1.1 * c, np.sqrt(c), 1.0 / rate, u)
+        u = levant_core(s[0:LEVANT_STATE], 1.1 * c, np.sqrt(c), 1.0 / rate, 0.0, xs[i])
+        out[i] = levant_core(s[LEVANT_STATE:], 1.1 * c, np.sqrt(c), 1.0 / rate, 0.0, u)
     return out
 
 

@@ -46,6 +46,37 @@ def test_leastsq_equals_savgol(rate, order, window):
     np.testing.assert_allclose(out[window - 1:], expected[window - 1:], rtol=0, atol=1e-9 * scale)
 
 
+def exact_taps(order, window):
+    """LEASTSQ's taps per sample in exact rational arithmetic: taps[j] multiplies x_{k-j}.
+
+    The degree-``order`` least-squares polynomial through x_{k-j} at t = -j (j = 0 .. M-1) has
+    coefficients c = G^-1 A^T x with G = A^T A, A[j, a] = (-j)^a; its derivative at t = 0 is c_1,
+    so taps[j] = sum_a (G^-1)[1, a] (-j)^a. G is solved with fractions.Fraction: no rounding at all.
+    """
+    from fractions import Fraction
+
+    n = order + 1
+    rows = [[Fraction(sum((-j) ** (a + b) for j in range(window))) for b in range(n)] + [Fraction(int(a == 1))]
+            for a in range(n)]
+    for c in range(n):  # Gauss-Jordan; G is positive definite, so no pivot is zero
+        for r in range(n):
+            if r != c:
+                f = rows[r][c] / rows[c][c]
+                rows[r] = [x - f * y for x, y in zip(rows[r], rows[c])]
+    w = [rows[a][n] / rows[a][a] for a in range(n)]  # row 1 of G^-1 (G is symmetric)
+    return np.array([float(sum(w[a] * (-j) ** a for a in range(n))) for j in range(window)])
+
+
+@pytest.mark.parametrize("order, window", [(1, 2), (2, 33), (4, 512), (5, 400), (6, 257), (6, 512)])
+def test_leastsq_taps_equal_the_exact_rational_taps(order, window):
+    """Ours to 1e-13 everywhere in range; scipy's savgol_coeffs is 100 % off at (5, 400), (6, 257), (6, 512)."""
+    from studyapp.estimators.leastsq import taps
+
+    exact = exact_taps(order, window)
+    scale = np.abs(exact).max()
+    np.testing.assert_allclose(taps(order, window, 1.0), exact, rtol=0, atol=1e-13 * scale)
+
+
 @pytest.mark.parametrize("rate", [1000.0, 96_000.0])
 @pytest.mark.parametrize("order, window", [(1, 5), (2, 33), (3, 40), (5, 64)])
 def test_leastsq_is_exact_on_polynomials(rate, order, window):

@@ -52,3 +52,19 @@ def test_scheduler_without_dask(short_recording, tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # importing it now fails, as when it is not installed
     fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(tmp_path / "P.toml"), "--scheduler",
                     "tcp://127.0.0.1:8786"], "dask.distributed")
+
+
+def test_evaluation_json_records_parameters_and_conventions(short_recording, capsys):
+    """evaluation.json carries what each estimator ran with and what those numbers mean."""
+    import json
+
+    from studyapp.cli import main
+
+    assert main(["evaluate", str(short_recording), "--estimators", "KALPOS,KALMAN,FOAW,LEVANT,LOWPASS",
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["parameters"]["KALPOS"]["q"] == 0.191
+    assert data["conventions"] == {
+        "KALPOS": {"q_convention": "continuous"}, "KALMAN": {"q_convention": "scaled"},
+        "FOAW": {"window": "size"}, "LEVANT": {"start": "zero"},
+    }

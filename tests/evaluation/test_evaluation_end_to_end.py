@@ -46,7 +46,7 @@ def _csv(path):
 
 def test_optimise_writes_params_with_provenance(recordings, optimised):
     data = tomllib.loads(optimised.read_text())
-    assert [k for k in data if k not in ("provenance", "objective")] == ESTIMATORS
+    assert [k for k in data if k not in ("provenance", "objective", "conventions")] == ESTIMATORS
     prov = data["provenance"]
     files = sorted((recordings / "train").glob("*.npz"), key=lambda p: float(p.stem[5:]))
     assert prov["recordings"] == [str(p) for p in files]
@@ -54,7 +54,8 @@ def test_optimise_writes_params_with_provenance(recordings, optimised):
     assert prov["seed"] == 1 and prov["patience"] == 6 and prov["reference"] == "lvt"
     assert prov["studyapp_version"] and prov["numpy_version"] and prov["iterations"] >= 6
     assert 1.0 <= data["LOWPASS"]["cutoff_hz"] <= 2450.0
-    assert data["KALMAN"]["q_convention"] == "eq19" and data["KALMAN"]["r_pos"] == 2e-10
+    assert data["KALMAN"]["q_convention"] == "scaled" and data["KALMAN"]["r_pos"] == 2e-10  # Table 1's convention
+    assert data["conventions"]["KALMAN"].startswith("q_convention = scaled: Q = q T Gamma Gamma^T")
     assert isinstance(data["LEASTSQ"]["window"], int) and data["LEASTSQ"]["window"] > data["LEASTSQ"]["order"]
     assert set(data["objective"]) == set(ESTIMATORS)
     checkpoint = json.loads(optimised.with_name("PARAMS.toml.checkpoint.json").read_text())

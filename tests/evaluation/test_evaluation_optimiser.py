@@ -102,7 +102,7 @@ def test_search_stays_in_range_and_in_natural_scale():
 
 def test_space_follows_table_2_and_keeps_choices_fixed():
     assert Space("KALMAN", RATE).names == ["q", "r_acc"]
-    assert Space("KALMAN", RATE).fixed == {"r_pos": 2e-10, "q_convention": "eq19"}
+    assert Space("KALMAN", RATE).fixed == {"r_pos": 2e-10, "q_convention": "scaled"}  # Table 1's convention
     assert Space("KALLEV", RATE, tune="all").names == ["q", "r_acc", "r_pos", "c"]
     cutoff = Space("LOWPASS", 5000.0).dims[0]
     assert cutoff.log and cutoff.low == 1.0 and cutoff.high == pytest.approx(NYQUIST_FRACTION * 5000.0)
@@ -112,7 +112,7 @@ def test_space_follows_table_2_and_keeps_choices_fixed():
 
 def test_search_ranges_narrow_foaw_and_follow_range_options():
     foaw = {d.name: d for d in Space("FOAW", RATE).dims}
-    assert (foaw["window"].low, foaw["window"].high) == (1.0, 64.0)
+    assert (foaw["window"].low, foaw["window"].high) == (2.0, 64.0)  # sizes: a line through at least 2 samples
     assert (foaw["margin"].low, foaw["margin"].high) == (1e-7, 1e-2)
     from studyapp.cli.optimise import parse_ranges
 

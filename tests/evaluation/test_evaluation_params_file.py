@@ -25,6 +25,22 @@ def test_round_trip(tmp_path):
     assert path.read_text().startswith("# two\n# lines\n")
 
 
+def test_the_file_records_the_conventions(tmp_path):
+    """[conventions]: one line per estimator that has some (choice parameters, FOAW's size); read skips it."""
+    path = tmp_path / "PARAMS.toml"
+    params = {"KALPOS": {"q": 0.191, "r_pos": 2e-10, "q_convention": "continuous"},
+              "FOAW": {"window": 17, "margin": 1.001e-4}, "LEVANT": {"c": 19.7, "start": "zero"},
+              "LOWPASS": {"cutoff_hz": 256.0}}
+    params_file.write(path, params)
+    data = tomllib.loads(path.read_text())
+    assert set(data["conventions"]) == {"KALPOS", "FOAW", "LEVANT"}
+    assert data["conventions"]["KALPOS"].startswith("q_convention = continuous: continuous white noise")
+    assert data["conventions"]["FOAW"].startswith("window = size: the most samples a line is fitted to")
+    assert data["conventions"]["LEVANT"].startswith("start = zero: the observer starts at w = 0")
+    read, _ = params_file.read(path)
+    assert read == params
+
+
 def test_parameter_sets_validate_values_and_name_the_file(tmp_path):
     path = tmp_path / "P.toml"
     path.write_text("[LOWPASS]\ncutoff_hz = 300.0\n[FOAW]\nwindow = 9\n")

@@ -95,11 +95,11 @@ def test_narrowed_window_ranges_keep_their_duration():
         dims = {d.name: d for d in search_spaces(["FOAW"], rate, windows)["FOAW"].dims}
         return dims["window"].low, dims["window"].high
 
-    assert foaw_window(5000.0) == (1, 64)
-    assert foaw_window(10000.0) == (1, 128)
-    assert foaw_window(1000.0) == (1, 13)  # 64 / 5 = 12.8
-    assert foaw_window(40000.0) == (1, 256)  # 512, capped at FOAW's own range
-    assert foaw_window(40000.0, "samples") == (1, 64)
+    assert foaw_window(5000.0) == (2, 64)  # sizes: a line through at least 2 samples
+    assert foaw_window(10000.0) == (2, 128)
+    assert foaw_window(1000.0) == (2, 13)  # 64 / 5 = 12.8
+    assert foaw_window(40000.0) == (2, 256)  # 512, capped at FOAW's own range
+    assert foaw_window(40000.0, "samples") == (2, 64)
 
 
 def test_optimiser_starts_from_the_given_sets():

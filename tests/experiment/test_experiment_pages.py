@@ -154,7 +154,7 @@ def test_a_schedule_stored_before_pages_existed_still_loads():
     ('[[pages]]\nkind = "calibration"\ntext = "x"\ntone_hz = 10\nlevel_dbfs = -20',
      "tone_hz = 10.0: allowed is a number from 20 to 20000 Hz"),
     ('[[pages]]\nkind = "calibration"\ntext = "x"\ntone_hz = 1000\nlevel_dbfs = 3',
-     "level_dbfs = 3.0: allowed is a number from -60 to 0 dBFS"),
+     "level_dbfs = 3.0: allowed is a number from -60 to -18 dBFS"),
     ('[[pages]]\nkind = "calibration"\ntext = "x"\ntone_hz = nan\nlevel_dbfs = -20', "tone_hz = nan"),
     ('[[pages]]\nkind = "welcome"\ntext = "x"\ntone_hz = 1000', "tone_hz is not a known field"),
     ("pages = 3", "pages = 3: allowed is an array of tables"),
@@ -212,7 +212,7 @@ def test_an_adjustment_confirm_waits_for_the_listening_time_with_the_bow_on():
     assert refused["reason"] == "listen longer with the bow on: the string needs 0.6 s more"
     assert refused["listen_short"] == {"LVT": pytest.approx(0.6)}
     trial.knob(0, 0)
-    trial.tick(5.0, bowing=True)  # F_max 0: no friction, nothing to hear
+    trial.tick(5.0, bowing=True)  # F_max 0: no force on the handle, the condition not yet in play
     trial.knob(0, 30)
     trial.tick(0.6, bowing=True)
     accepted, response = trial.pad(0)

@@ -82,8 +82,11 @@ def test_sinclair2014_is_the_paper_study():
     assert set(p.task("rating").conditions) == {"LOWPASS", "LEASTSQ", "FOAW", "LEVANT", "LEVANTLP", "KALPOS", "KALLEV", "LVT"}
     assert set(p.task("adjustment").conditions) == set(p.task("rating").conditions) | {"KALFOAW"}
     assert p.task("rating").fmax == 1.0 and p.task("adjustment").trials == 6 and p.knobs == 8
-    assert p.estimator_params("LEVANT") == {"c": 19.7}
+    assert p.estimator_params("LEVANT") == {"c": 19.7, "start": "zero"}
     assert p.estimator_params("KALLEV")["q"] == 6.38e4
+    # Table 1's numbers with the conventions they were tuned in, stated in the file
+    assert p.estimator_params("KALPOS")["q_convention"] == "continuous"
+    assert p.estimator_params("KALLEV")["q_convention"] == p.estimator_params("KALFOAW")["q_convention"] == "scaled"
 
 
 def test_demo_is_short():
@@ -175,3 +178,15 @@ def test_hash_is_sha256_of_the_bytes(tmp_path):
     b.write_bytes(a.read_bytes() + b"# a comment changes the hash\n")
     assert load_protocol(a).sha256 == hashlib.sha256(a.read_bytes()).hexdigest()
     assert load_protocol(b).sha256 != load_protocol(a).sha256
+
+
+def test_session_settings_record_the_estimators_conventions(tmp_path):
+    """session.json's protocol settings say what the numbers mean: the protocol's choices, else the defaults."""
+    given = {**BASE, "estimators": {"KALPOS": {"q": 0.191, "q_convention": "eq19"}, "LEVANT": {"start": "first"}}}
+    conventions = load_protocol(write(tmp_path, given)).settings()["conventions"]
+    assert conventions["KALPOS"] == {"q_convention": "eq19"} and conventions["LEVANT"] == {"start": "first"}
+    assert conventions["KALMAN"] == {"q_convention": "scaled"} and conventions["FOAW"] == {"window": "size"}
+    assert "LOWPASS" not in conventions
+    shipped = load_protocol(SHIPPED / "sinclair2014.toml").settings()["conventions"]
+    assert shipped["KALPOS"] == {"q_convention": "continuous"} and shipped["LEVANT"] == {"start": "zero"}
+    json.dumps(conventions)

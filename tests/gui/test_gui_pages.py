@@ -47,14 +47,14 @@ def test_a_pages_markdown_is_rendered_not_shown(qapp):
 def test_a_toml_paragraph_with_hard_line_breaks_is_one_paragraph(qapp):
     protocol = load_protocol(ROOT / "protocols" / "sinclair2014.toml")
     steps, _ = build_schedule(protocol, 0)
-    instructions = protocol.task("adjustment").instructions  # three hard-broken lines, one paragraph
-    assert instructions.strip().count("\n") == 2
+    instructions = protocol.task("adjustment").instructions  # four hard-broken lines, one paragraph
+    assert instructions.strip().count("\n") == 3
     view = PageView()
     view.show_page("instructions", "Instructions", markdown(instructions), "participant")
     document = view.text.document()
     assert document.blockCount() == 1
-    assert "to the right\nto increase" not in document.toPlainText()
-    assert "turn the knob to the right to increase the friction" in " ".join(document.toPlainText().split())
+    assert "the\nhandle" not in document.toPlainText()
+    assert "when you bow, but the handle feels no force" in " ".join(document.toPlainText().split())
     shipped = [t.page for t in steps if t.page and t.page.kind == "instructions"]
     view.show_page("instructions", shipped[1].title, shipped[1].text, "participant")
     assert view.text.document().blockCount() == 3  # the shipped page: three paragraphs as written
@@ -101,7 +101,7 @@ def test_the_console_and_participant_window_walk_through_the_pages(paged_console
     assert c.runner.trial.page.kind == "calibration"
     assert participant.page_view.continue_button.isHidden()
     assert not window.page_controls.confirm_button.isHidden()
-    assert "440 Hz at -12 dBFS" in window.page_controls.label.text()
+    assert "440 Hz at -20 dBFS" in window.page_controls.label.text()
     window.page_controls.confirm_button.click()
     assert c.host.engine.sent_of(cmd.ReferenceTone)[-1] == cmd.ReferenceTone(level_dbfs=None)
     participant.page_view.continue_button.click()  # the rating instructions

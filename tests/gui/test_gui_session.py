@@ -69,6 +69,9 @@ def test_simulated_participant_plays_the_demo_through_the_console(idle_console, 
     # the analysis tab shows the study just run
     console.analyse_results()
     assert console.tabs.currentWidget() is console.analysis
+    # SIM01 is simulated: left out, and the view says how to include it (issue 22 item 11)
+    assert console.analysis.study is None and "--include-simulated" in console.analysis.status_label.text()
+    console.analysis.include_simulated.setChecked(True)
     assert console.analysis.study is not None and list(console.analysis.study.participants) == ["SIM01"]
     console.tabs.setCurrentIndex(0)
 

@@ -43,7 +43,7 @@ text = "Welcome, **reader**."
 kind = "calibration"
 text = "Listen to the tone."
 tone_hz = 440.0
-level_dbfs = -12.0
+level_dbfs = -20.0
 """
 
 
@@ -113,7 +113,7 @@ def test_the_level_check_plays_its_tone_until_the_experimenter_confirms_it(c):
     start(c)
     c.acknowledge_page("participant")  # the welcome page's Continue
     engine = c.host.engine
-    assert page(c) == "calibration" and tones(engine) == [cmd.ReferenceTone(440.0, -12.0)]
+    assert page(c) == "calibration" and tones(engine) == [cmd.ReferenceTone(440.0, -20.0)]
     assert c.seen["page"][-1]["by"] == "experimenter" and c.seen["page"][-1]["tone_hz"] == 440.0
     c.pad(0)
     c.poll()
@@ -122,10 +122,10 @@ def test_the_level_check_plays_its_tone_until_the_experimenter_confirms_it(c):
     assert c.seen["refused"] == [{"reason": "the experimenter confirms this page"}] * 2
     assert "confirm refused: the experimenter confirms this page" in [m["text"] for m in c.seen["message"]]
     c.acknowledge_page("experimenter")
-    assert tones(engine) == [cmd.ReferenceTone(440.0, -12.0), cmd.ReferenceTone(level_dbfs=None)]
+    assert tones(engine) == [cmd.ReferenceTone(440.0, -20.0), cmd.ReferenceTone(level_dbfs=None)]
     assert page(c) == "instructions"
     (confirmed,) = [e for e in log(c) if e["type"] == "response" and e["kind"] == "calibration"]
-    assert (confirmed["by"], confirmed["tone_hz"], confirmed["level_dbfs"]) == ("experimenter", 440.0, -12.0)
+    assert (confirmed["by"], confirmed["tone_hz"], confirmed["level_dbfs"]) == ("experimenter", 440.0, -20.0)
 
 
 def test_the_tone_stops_on_pause_and_at_an_abort_and_resume_skips_acknowledged_pages(c):
@@ -137,12 +137,12 @@ def test_the_tone_stops_on_pause_and_at_an_abort_and_resume_skips_acknowledged_p
     c.acknowledge_page("experimenter")  # paused: nothing happens
     assert page(c) == "calibration"
     c.resume()
-    assert tones(engine)[-1] == cmd.ReferenceTone(440.0, -12.0) and engine.trial == c.trial_serial
+    assert tones(engine)[-1] == cmd.ReferenceTone(440.0, -20.0) and engine.trial == c.trial_serial
     c.abort()
     assert c.state == State.ABORTED and tones(engine)[-1] == cmd.ReferenceTone(level_dbfs=None)
     start(c, resume=True)
     assert page(c) == "calibration" and c.runner.trial.step == 1  # not the welcome page again
-    assert tones(c.host.engine) == [cmd.ReferenceTone(440.0, -12.0)]
+    assert tones(c.host.engine) == [cmd.ReferenceTone(440.0, -20.0)]
 
 
 def through_pages(c):

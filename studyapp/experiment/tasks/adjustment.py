@@ -8,8 +8,9 @@ starts at F_max = 0. The adjustment knob sets F_max through the one knob law
 turns it up until the string "breaks down" (the margin of stability), turns
 back if they overshot, and confirms with the pad. The response is the F_max
 at the confirm; the highest F_max reached during the trial is kept too, as a
-record of the overshoot. A confirm at F_max = 0 is refused (no friction
-cannot break down: it is a slip of the hand). Other knobs are ignored.
+record of the overshoot. A confirm at F_max = 0 is refused (no force on the
+handle, so nothing can break down: it is a slip of the hand; the string
+still sounds when bowed, F_max scaling only the force fed back). Other knobs are ignored.
 
 An interrupted trial starts again from F_max = 0 (a sudden return to a high
 F_max could be unsafe on a real device): nothing is restored.
@@ -143,6 +144,11 @@ class Adjustment:
     def start(self, spec, trial):
         return AdjustmentTrial(trial.condition, trial.trial, spec.ceiling, spec.decades, spec.knob, spec.confirm_pad,
                                spec.min_listen_s)
+
+    def typical_duration(self, spec, trial):
+        # no figure in the paper: our guess of a slow turn to breakdown, a turn back and the confirm
+        # (the simulated participant takes 20-40 s of loop time); or min_listen_s and a confirm
+        return max(45.0, spec.min_listen_s + 15.0)
 
     def describe(self, trial):
         return f"adjustment {trial.condition} trial {trial.trial}"

@@ -9,7 +9,8 @@ Accepted, it logs ``{"type": "response", "task": ..., **answer()}``.
 
 The trial's clock (``elapsed``, s) advances with ``tick(dt, bowing)``, i.e.
 with the samples the loop really ran. A condition is *heard* while the bow
-is on the string and F_max is above 0 (no friction, no sound): ``heard[c]``
+is on the string and F_max is above 0 (at F_max = 0 the string sounds but the
+handle feels no force from it: the condition is not yet in play): ``heard[c]``
 adds up those seconds for the condition in the loop. With the task's
 ``min_listen_s`` = L above 0 a confirm is refused, after the task's own
 checks, until every condition c of the trial has heard[c] >= L; the refusal

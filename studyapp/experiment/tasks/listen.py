@@ -106,6 +106,9 @@ class Listen:
     def start(self, spec, trial):
         return ListenTrial(trial.condition, trial.trial, spec.fmax, spec.duration_s)
 
+    def typical_duration(self, spec, trial):
+        return spec.duration_s  # the trial ends by itself
+
     def describe(self, trial):
         return f"listen to {trial.condition}"
 

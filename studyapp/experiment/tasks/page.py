@@ -105,6 +105,10 @@ class PageType:
     def start(self, spec, trial):
         return PageTrial(trial.page, trial.trial)
 
+    def typical_duration(self, spec, trial):
+        # our guesses: a break is a rest; the level check waits for the experimenter; a page is read
+        return {"break": 120.0, "calibration": 60.0}.get(trial.page.kind, 30.0)
+
     def describe(self, trial):
         return f"page: {trial.page.kind}, {trial.page.title}"
 
@@ -136,6 +140,8 @@ class PageType:
         return []
 
     def simulate(self, participant, runner, rng):
+        if runner.task.page.kind == "calibration":
+            runner.advance(participant.level_check_time)  # the experimenter listens to the tone first
         runner.acknowledge_page(runner.task.page.by)
 
 

@@ -154,6 +154,11 @@ class Rating:
     def start(self, spec, trial):
         return RatingTrial(trial.conditions, spec.fmax, spec.confirm_pad, trial.trial, spec.min_listen_s)
 
+    def typical_duration(self, spec, trial):
+        # "All participants finished this task in less than 5 minutes" (paper Sec. 8.1): the upper bound,
+        # or longer when min_listen_s makes every condition be heard that long
+        return max(300.0, len(trial.conditions) * spec.min_listen_s + 60.0)
+
     def describe(self, trial):
         return f"rating of {len(trial.conditions)} conditions"
 

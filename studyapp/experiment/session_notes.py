@@ -1,0 +1,96 @@
+"""The experimenter's notes on a session: free text logged with its time as a ``note`` event.
+
+A note is one event in the session's events.jsonl, ``{"type": "note",
+"text": ..., "by": "experimenter"}``, stamped like every event with ``seq``,
+``mono`` and ``wall`` (session_log.py); during a session it also carries the
+``step`` and ``task`` shown when it was written. Notes at the start
+(``--notes``, the console's Notes field) stay in session.json as before;
+these are the ones added as things happen, and after.
+
+- During a session: the console's note box (``SessionController.add_note``)
+  appends to the open log.
+- After it (finished, aborted, or a crash): ``add_note(folder, text)`` takes
+  the participant's lock (``session_lock``: refused, naming the holder, while
+  a session of theirs runs in another program), appends, and lets go;
+  ``studyapp notes SESSION_DIR --add TEXT`` and the console (its last
+  session) use it.
+- ``list_notes(results)``: every note under a results folder, for
+  ``studyapp notes RESULTS_DIR`` (a table on stdout, or CSV with ``-o``).
+  Notes are not responses, so ``export`` carries none: a note of several
+  lines would break the table's one-line cells, as session.json's notes would.
+
+The text is checked as session.json's notes (``session_info.check_notes``:
+at most 2000 characters, line breaks and tabs but no other control
+characters); an empty note is refused.
+"""
+
+from pathlib import Path
+
+import pandas as pd
+
+from studyapp.errors import UserError
+from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description, session_folders
+from studyapp.experiment.session_info import check_notes
+from studyapp.experiment.session_lock import ParticipantLock
+from studyapp.experiment.session_log import SessionLog, read_log
+
+NOTE = "note"
+NOTE_COLUMNS = ["study", "participant", "session", "wall", "step", "task", "text"]
+
+
+def note_event(text):
+    """The ``note`` event of ``text`` (checked), without its stamps."""
+    text = check_notes(text)
+    if not text:
+        raise UserError("note: empty: allowed is some text")
+    return {"type": NOTE, "text": text, "by": "experimenter"}
+
+
+def session_folder_of(path):
+    """The session folder ``path`` names: a session folder, or a participant folder (its latest session)."""
+    path = Path(path)
+    if (path / SESSION_FILE).exists() or (path / EVENTS_FILE).exists():
+        return path
+    sessions = session_folders(path)
+    if sessions:
+        return sessions[-1]
+    raise UserError(f"{path}: not a session folder (no {SESSION_FILE} or {EVENTS_FILE}) nor a participant folder "
+                    "holding one: allowed is a session's folder under results/<study>/<participant>/")
+
+
+def add_note(folder, text):
+    """Append a note to the session in ``folder`` that no program has open; returns the stamped event."""
+    event = note_event(text)
+    folder = session_folder_of(folder)
+    info, _ = read_description(folder)
+    lock = ParticipantLock(folder.parent, info["participant"])
+    try:
+        with SessionLog(folder / EVENTS_FILE) as log:
+            return log.append(event)
+    finally:
+        lock.release()
+
+
+def list_notes(results):
+    """DataFrame ``NOTE_COLUMNS``: every note of every session at or below ``results``, oldest first per session."""
+    from studyapp.experiment.export import session_folders_under
+
+    root = Path(results)
+    if root.exists() and not root.is_dir():
+        raise UserError(f"{root}: is a file: allowed is a results folder (or any folder inside it)")
+    if not root.is_dir():
+        raise UserError(f"{root}: no such results folder")
+    rows = []
+    for folder in session_folders_under(root):
+        try:
+            info, _ = read_description(folder)
+        except UserError:
+            continue
+        for event in read_log(folder / EVENTS_FILE).events:
+            if event.get("type") == NOTE:
+                rows.append({"study": info.get("study"), "participant": info.get("participant"),
+                             "session": info.get("session"), "wall": event.get("wall"), "step": event.get("step"),
+                             "task": event.get("task"), "text": event.get("text")})
+    frame = pd.DataFrame(rows, columns=NOTE_COLUMNS)
+    frame["step"] = frame["step"].astype("Int64")
+    return frame

@@ -1,0 +1,72 @@
+"""How loud the stimulus is: the typical RMS of the bowed string, for the headphone level check.
+
+The experimenter sets the headphones on the level check's reference tone, so
+the tone must be as loud as what the participant will mostly hear: the string
+bowed with the protocol's gesture at the protocol's F_max. That level is
+computed from the model itself (it follows any change to the device, the
+string or the gestures), never written down by hand:
+
+    for each condition c:  a = the loop's audio (ClosedLoop, bow on, F_max, gesture), after SETTLE_S
+                           L_c = median over 100 ms windows w of 20 log10 sqrt(mean(a_w^2))   (dBFS)
+    level = median over c of L_c
+
+The median of short-term (100 ms) RMS is the level of the string while it
+sounds, not pulled down by the reversals of the strokes nor up by a burst.
+Full scale is the audio's 1.0, as in the engine's output at volume 1 (the
+resampler to the device's rate keeps the RMS of this band-limited signal:
+tests/engine check it against the signal chain's output).
+
+A sine's RMS is its peak / sqrt(2), so a tone of that RMS has its peak
+3.01 dB higher (``tone_peak_dbfs``).
+"""
+
+import math
+from functools import lru_cache
+
+import numpy as np
+
+WINDOW_S = 0.1  # short-term RMS window
+SETTLE_S = 1.0  # the start of bowing left out (the string building up)
+SECONDS = 6.0  # bowed per condition (several strokes)
+SINE_CREST_DB = 20.0 * math.log10(math.sqrt(2.0))  # 3.01 dB: a sine's peak over its RMS
+
+
+def short_term_rms_dbfs(audio, rate, window_s=WINDOW_S):
+    """The median over ``window_s`` windows of the RMS of ``audio`` (dBFS; -inf for silence)."""
+    n = max(1, int(round(window_s * rate)))
+    whole = np.asarray(audio, dtype=np.float64)[: len(audio) // n * n].reshape(-1, n)
+    if whole.size == 0:
+        return -math.inf
+    level = float(np.median(np.sqrt(np.mean(whole**2, axis=1))))
+    return 20.0 * math.log10(level) if level > 0 else -math.inf
+
+
+@lru_cache(maxsize=16)
+def _typical(rate, gesture, fmax, conditions, seed, seconds):
+    from studyapp.model.loop import ClosedLoop, LoopConfig
+    from studyapp.model.sources import is_pseudo
+
+    levels = []
+    for name, params in conditions:
+        estimators = {} if is_pseudo(name) else {name: dict(params)}
+        loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=name, fmax=fmax,
+                                     gesture=gesture, seed=seed, audio=True))
+        audio = loop.run(int(round(seconds * rate)))["audio"][int(round(SETTLE_S * rate)):]
+        levels.append(short_term_rms_dbfs(audio, rate))
+    return float(np.median(levels))
+
+
+def typical_rms_dbfs(rate, gesture, fmax, conditions, seed=0, seconds=SECONDS):
+    """The typical RMS (dBFS) of the string bowed with ``gesture`` at ``fmax`` N.
+
+    ``conditions``: velocity sources, a list of names or a dict name -> estimator parameters.
+    """
+    if not isinstance(conditions, dict):
+        conditions = {name: {} for name in conditions}
+    frozen = tuple((name, tuple(sorted(params.items()))) for name, params in conditions.items())
+    return _typical(float(rate), str(gesture), float(fmax), frozen, int(seed), float(seconds))
+
+
+def tone_peak_dbfs(rms_dbfs):
+    """The peak level of a sine whose RMS is ``rms_dbfs``."""
+    return rms_dbfs + SINE_CREST_DB

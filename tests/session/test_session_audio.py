@@ -1,0 +1,78 @@
+"""A headless simulated sinclair2014 session archives its audio through the live signal chain (``studyapp run
+... --simulated-participant --headless --audio wav``), and the archive passes the hearing-safety checks of
+tests/audio_checks.py: no sample above the documented peak, no step starting louder than what follows, silence
+with the bow lifted, and the level check's tone as loud as the bowed string."""
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from studyapp.cli import main
+from studyapp.engine.signal_chain import CEILING_DBFS
+from tests import audio_checks as checks
+
+ROOT = Path(__file__).resolve().parents[2]
+SINCLAIR = ROOT / "protocols" / "sinclair2014.toml"
+DEMO = ROOT / "protocols" / "demo.toml"
+
+
+def _run(results, protocol, *extra):
+    code = main(["run", "--protocol", str(protocol), "--participant", "P01", "--simulated-participant", "--headless",
+                 "--results", str(results), *extra])
+    assert code == 0
+    (folder,) = {p.parent for p in Path(results).glob("*/*/*/session.json")}
+    return folder
+
+
+@pytest.fixture(scope="module")
+def sinclair(tmp_path_factory):
+    return _run(tmp_path_factory.mktemp("results"), SINCLAIR, "--audio", "wav", "--seed", "11")
+
+
+def test_the_session_folder_holds_the_audio_and_a_cue_for_every_step(sinclair):
+    assert (sinclair / "audio.wav").exists() and (sinclair / "audio_cues.csv").exists()
+    info = json.loads((sinclair / "session.json").read_text())
+    with open(sinclair / "audio_cues.csv", newline="") as f:
+        cues = list(csv.DictReader(f))
+    steps = len(info["schedule"])
+    assert sorted(int(c["step"]) for c in cues if c["event"] == "start") == list(range(steps))
+    assert sorted(int(c["step"]) for c in cues if c["event"] == "end") == list(range(steps))
+    assert {"bow_on", "bow_off"} <= {c["event"] for c in cues}
+
+
+def test_no_sample_above_the_documented_peak(sinclair):
+    assert checks.check_peak(checks.read_archive(sinclair)) <= CEILING_DBFS
+
+
+def test_no_step_starts_louder_than_the_stimulus_that_follows_it(sinclair):
+    onsets = checks.check_start_transients(checks.read_archive(sinclair))
+    assert len(onsets) > 60
+
+
+def test_the_bow_lifted_is_silent(sinclair):
+    loudest, seconds = checks.check_silences(checks.read_archive(sinclair))
+    assert seconds > 1.0 and loudest <= checks.SILENCE_DBFS
+
+
+def test_the_level_check_is_as_loud_as_the_bowed_string(sinclair):
+    tone, stimulus = checks.check_level_check(checks.read_archive(sinclair), tolerance_db=1.5)
+    info = json.loads((sinclair / "session.json").read_text())
+    (page,) = [s["page"] for s in info["schedule"] if s.get("page") and s["page"]["kind"] == "calibration"]
+    assert page["level_dbfs"] == pytest.approx(tone + 3.01, abs=0.1)  # the tone played is the page's
+    assert f"{tone:.1f} dBFS RMS" in page["text"]  # and the page says so
+
+
+def test_without_audio_nothing_is_archived(tmp_path):
+    folder = _run(tmp_path, DEMO)
+    assert not (folder / "audio.wav").exists() and not (folder / "audio_cues.csv").exists()
+
+
+@pytest.mark.parametrize("value", ["device", "wav:x.wav", "loud"])
+def test_a_bad_audio_option_is_one_line_and_writes_nothing(tmp_path, capsys, value):
+    code = main(["run", "--protocol", str(DEMO), "--participant", "P01", "--simulated-participant", "--headless",
+                 "--results", str(tmp_path), "--audio", value])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and f"--audio {value}" in err and "wav" in err
+    assert not any(tmp_path.iterdir())

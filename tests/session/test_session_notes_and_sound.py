@@ -1,0 +1,45 @@
+"""Issue 22 item 16: the console's notes and master volume/mute, through the controller (fake engine)."""
+
+import pytest
+
+from studyapp.engine import commands as cmd
+from studyapp.errors import UserError
+from tests.session.test_session_controller import S, controller, log, play_rating, reach, start, up  # noqa: F401
+
+
+def test_notes_during_and_after_a_session_are_logged_with_the_step(controller):
+    c = controller
+    with pytest.raises(UserError, match="no session to add a note to"):
+        c.add_note("before any session")
+    start(c)
+    up(c)
+    record = c.add_note("participant asked about the knobs")
+    assert record["wall"] and record["step"] == c.runner.trial.step
+    play_rating(c)
+    c.abort()
+    c.add_note("aborted: the participant felt unwell")  # after the session, in its log
+    notes = [e for e in log(c) if e["type"] == "note"]
+    assert [n["text"] for n in notes] == ["participant asked about the knobs", "aborted: the participant felt unwell"]
+    assert notes[0]["task"] == "rating" and "step" not in notes[1]
+    with pytest.raises(UserError, match="empty"):
+        c.add_note("  ")
+
+
+def test_volume_and_mute_send_the_engines_commands_are_logged_and_survive_a_new_engine(controller):
+    c = controller
+    c.set_volume(-6.0)
+    sent = c.host.engine.sent
+    assert sent[-2] == cmd.SetVolume(pytest.approx(10 ** (-6 / 20))) and sent[-1] == cmd.SetMute(False)
+    start(c)  # a new engine for the session: it gets the console's volume as it comes up
+    up(c)
+    engine = c.host.engine
+    assert cmd.SetVolume(pytest.approx(10 ** (-6 / 20))) in engine.sent
+    c.set_mute(True)
+    c.set_volume(-20.0)
+    assert engine.sent[-1] == cmd.SetMute(True) and engine.sent[-2] == cmd.SetVolume(pytest.approx(0.1))
+    events = [e for e in log(c) if e["type"] in ("mute", "volume")]
+    assert [(e["type"], e.get("on"), e.get("db")) for e in events] == [("mute", True, None), ("volume", None, -20.0)]
+    assert events[1]["gain"] == pytest.approx(0.1) and all(e["step"] == c.runner.trial.step for e in events)
+    for bad in (3.0, -41.0, float("nan")):
+        with pytest.raises(UserError, match="allowed is -40 to 0 dB"):
+            c.set_volume(bad)
