@@ -1,20 +1,27 @@
-"""The figures docs/model.md quotes about the shipped model (5 kHz, seed 0), and the breakdown spectrogram.
+"""The figures docs/model.md quotes about the shipped model (5 kHz, Table 1), and the breakdown spectrograms.
 
-    PYTHONPATH=. python scripts/model_figures.py [--png docs/breakdown_strokes.png] [--source LOWPASS]
+    PYTHONPATH=. python scripts/model_figures.py [--png docs/breakdown_strokes.png] [--source LVT] [--seeds 3]
+    PYTHONPATH=. python scripts/model_figures.py --only-png --png docs/breakdown_strokes_lowpass.png --source LOWPASS
 
-Prints, for the model as calibration.py sets it:
+Prints, for the model as calibration.py sets it, with sinclair2014's Table 1 parameters:
 
-- breakdown: per source (LVT, LOWPASS, KALPOS, LEVANTLP, TRUE), the hand holding, the force's spectral
-  peak at 1.1, 1.5 and 1.85 x its breakdown F_max (what frequency the loop oscillates at); the stability
-  monitor's level and cv for a held handle at 10 mN and for two limit cycles;
-- hearing it: on strokes at 0.5 and 1.5 x, the audio's 100-400 Hz level, its total level (0-2.5 kHz),
-  and the audio's spectral peak; and the band level at 0.5, 0.7, 0.9, 1.1 and 1.5 x, held and on strokes;
-- bowing: with LVT and TRUE at 1, 2, 4, 8 and 12 N on strokes, the ripple (um RMS), the stick fraction
-  and the Helmholtz formation times (bowing_measures.py); the sources the monitor flags on strokes at 20 N;
-  the string's pitch over the strokes' cruise at 5, 20 and 48 kHz;
+- breakdown while bowing (strokes) for LVT, LOWPASS, KALPOS, LEVANT, FOAW and TRUE, seed 0, and the
+  frequency the loop buzzes at (the handle's velocity's spectral peak at 1.25 x, above 50 Hz: below it
+  lie the strokes themselves);
+- the handle's velocity per band (mm/s RMS) with TRUE at 4 N and at 1.25 x LVT's breakdown, and with
+  LVT, LOWPASS and KALPOS at 1.25 x theirs: what the bowing verdict's band holds;
+- hearing it, seeds 0..N-1 (each with its own breakdown): the audio's 100-400 Hz level at 1.25 x minus
+  its level at 0.8 x (dB), and three other measures of the same two sounds: the contact microphone's
+  own band (the audio's 50-400 Hz), the audio's level outside the string's harmonics (the spectrum with
+  +-3 % around each multiple of f0 removed, 50-2500 Hz) and the loudness distance from TRUE's sound at
+  the same F_max and seed (evaluation.perceptual.audio_distance; the rise as 20 log10 of the ratio);
+- the paper's signals on the data set's settings (LVT in the loop, strokes, data_set.TRAINING's seeds):
+  max |dv/dt| of ``velocity_lvt`` at 12.1 N, ``velocity_lvt`` high-passed at 100 Hz (RMS) at 7.7 N and
+  FOAW (Table 1) at its maximum window at 7.7 N;
+- the string's pitch on the strokes with LVT at 2 N at 5, 20 and 48 kHz;
 
 and with ``--png``, a spectrogram of the audio while ``--source`` steps through 0.5, 0.75, 1, 1.25 and
-1.5 x its breakdown on strokes, 3 s each (the steps' band levels printed beside it).
+1.5 x its bowing breakdown on strokes, 3 s each (the steps' band levels printed beside it).
 """
 
 import argparse
@@ -22,13 +29,19 @@ import argparse
 import numpy as np
 from scipy import signal
 
-from studyapp.model import bowing_measures as bm
+import tomllib
+from pathlib import Path
+
+from studyapp.estimators.foaw import window_sizes
 from studyapp.model import calibration
-from studyapp.model.breakdown import breakdown_fmax, is_broken, sources
+from studyapp.model.bowing_reference import pitch
+from studyapp.model.breakdown import breakdown_fmax
+from studyapp.model.data_set import TRAINING
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.simulate import simulate
 
 RATE = 5000.0
+TABLE1 = tomllib.loads((Path(__file__).resolve().parents[1] / "protocols" / "sinclair2014.toml").read_text())["estimators"]
 STEPS = (0.5, 0.75, 1.0, 1.25, 1.5)
 STEP_SECONDS = 3.0
 
@@ -48,9 +61,13 @@ def peak_hz(x, rate=RATE, fmin=30.0):
     return float(f[int(np.argmax(spec))])
 
 
-def loop(source, fmax, gesture, rate=RATE):
-    estimators = {} if source in ("LVT", "TRUE") else {source: {}}
-    return ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture))
+def estimators(source):
+    return {} if source in ("LVT", "TRUE") else {source: TABLE1.get(source, {})}
+
+
+def loop(source, fmax, gesture, rate=RATE, seed=0):
+    return ClosedLoop(LoopConfig(rate=rate, estimators=estimators(source), source=source, fmax=fmax,
+                                 gesture=gesture, seed=seed))
 
 
 def stepping(source, level):
@@ -71,78 +88,98 @@ def spectrogram_figure(source, level, parts):
     ax = fig.add_subplot()
     f, t, sxx = signal.spectrogram(audio, fs=RATE, nperseg=512, noverlap=384)
     keep = f <= 1000.0
-    mesh = ax.pcolormesh(t, f[keep], 10.0 * np.log10(sxx[keep] + 1e-16), shading="auto", cmap="magma",
-                         vmin=-120.0, vmax=-40.0)
+    db = 10.0 * np.log10(sxx[keep] + 1e-16)
+    top = float(np.ceil(np.percentile(db, 99.9) / 10.0) * 10.0)  # the scale follows the audio's level
+    mesh = ax.pcolormesh(t, f[keep], db, shading="auto", cmap="magma", vmin=top - 70.0, vmax=top)
     fig.colorbar(mesh, ax=ax, label="dB")
     ax.axhspan(100.0, 400.0, color="white", alpha=0.08)
     for i, fraction in enumerate(STEPS):
         ax.axvline(i * STEP_SECONDS, color="white", lw=0.6)
-        ax.text(i * STEP_SECONDS + 0.1, 930.0, f"{fraction:g} x", color="white", fontsize=8)
+        ax.text(i * STEP_SECONDS + 0.1, 930.0, f"{fraction:g} x", color="white", fontsize=8,
+                bbox=dict(facecolor="black", alpha=0.6, pad=1.5, lw=0))
     ax.set_xlabel("time (s)")
     ax.set_ylabel("frequency (Hz)")
-    ax.set_title(f"{source} on strokes, F_max stepping through its breakdown ({level:.3g} N)", fontsize=10)
+    ax.set_title(f"{source} bowing strokes, F_max stepping through its breakdown ({level:.3g} N)", fontsize=10)
     return fig
+
+
+def inharmonic_db(audio, f0, rate=RATE):
+    """Level (dB) of the audio at 50-2500 Hz outside +-3 % of every multiple of f0."""
+    f, p = signal.welch(audio, fs=rate, nperseg=4096)
+    n = np.round(f / f0)
+    keep = (f >= 50.0) & (f <= 2500.0) & ((n < 1) | (np.abs(f - n * f0) > 0.03 * n * f0))
+    return 10.0 * np.log10(np.sum(p[keep]) * (f[1] - f[0]))
+
+
+def hearing(source, seed):
+    """(band rise, 50-400 Hz rise, inharmonic rise, distance-from-TRUE rise) in dB, 0.8 -> 1.25 x breakdown."""
+    from studyapp.evaluation.perceptual import audio_distance
+
+    level = breakdown_fmax(source, tolerance=0.05, seed=seed, estimators=estimators(source))
+    rows = []
+    for fraction in (0.8, 1.25):
+        fmax = fraction * level
+        audio = simulate(fmax, rate=RATE, duration=5.0, source=source, seed=seed,
+                         estimators=estimators(source)).columns["audio"][int(0.25 * RATE):]
+        true = simulate(fmax, rate=RATE, duration=5.0, source="TRUE", seed=seed).columns["audio"][int(0.25 * RATE):]
+        rows.append((level_db(audio), level_db(audio, 50.0, 400.0), inharmonic_db(audio, calibration.F0),
+                     20.0 * np.log10(max(audio_distance(true, audio, RATE), 1e-9))))
+    return level, [hi - lo for lo, hi in zip(*rows)]
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--png", help="write the spectrogram here")
-    parser.add_argument("--source", default="LOWPASS")
+    parser.add_argument("--source", default="LVT")
+    parser.add_argument("--seeds", type=int, default=3)
+    parser.add_argument("--only-png", action="store_true", help="only the spectrogram")
     args = parser.parse_args(argv)
+    if args.only_png:
+        return png(args.source, args.png, {})
     print(f"f0 {calibration.F0:g} Hz, beta {calibration.BOW_POSITION:g}, velocity scale "
-          f"{calibration.VELOCITY_SCALE:g}, contact microphone {calibration.CONTACT_MIC_GAIN:g}")
+          f"{calibration.VELOCITY_SCALE:g}, end-effector {calibration.DEVICE_MASS:g} kg on a grip of "
+          f"{calibration.GRIP_STIFFNESS:g} N/m, {calibration.GRIP_DAMPING:g} N s/m")
     levels = {}
-    for source in ("LVT", "LOWPASS", "KALPOS", "LEVANTLP", "TRUE"):
-        levels[source] = breakdown_fmax(source, tolerance=0.05)
-        peaks = []
-        for fraction in (1.1, 1.5, 1.85):
-            lp = loop(source, min(fraction * levels[source], 200.0), "hold")
-            lp.run(int(RATE))
-            peaks.append(peak_hz(lp.run(int(4 * RATE))["force"], fmin=2.0))
-        print(f"{source}: breakdown {levels[source]:.3g} N; force peak at 1.1/1.5/1.85 x: "
-              + "/".join(f"{p:.0f}" for p in peaks) + " Hz")
-    for source, fmax in (("LVT", 0.01), ("LOWPASS", 0.01), ("LOWPASS", 9.8), ("LVT", 13.3)):
-        lp = loop(source, fmax, "hold")
-        for _ in range(20):
-            lp.run(500)
-        print(f"monitor, {source} held at {fmax:g} N: level {1e3 * lp.monitor.level:.3f} mm/s, "
-              f"cv {lp.monitor.cv:.3f}, broken {lp.monitor.broken}")
-    for source in ("LVT", "LOWPASS", "KALPOS", "LEVANTLP"):
-        for fraction in (0.5, 1.5):
-            rec = simulate(fraction * levels[source], rate=RATE, duration=5.0, source=source, gesture="strokes")
-            audio = rec.columns["audio"][int(RATE):]
-            print(f"{source} strokes {fraction:g} x: band {level_db(audio):.1f} dB, total "
-                  f"{level_db(audio, 0.0, 2500.0):.1f} dB, audio peak {peak_hz(audio):.1f} Hz")
-        steps = []
-        for gesture in ("hold", "strokes"):
-            for fraction in (0.5, 0.7, 0.9, 1.1, 1.5):
-                rec = simulate(fraction * levels[source], rate=RATE, duration=5.0, source=source, gesture=gesture)
-                steps.append(f"{gesture} {fraction:g}: {level_db(rec.columns['audio'][int(RATE):]):.0f}")
-        print(f"{source} band level (dB): " + ", ".join(steps))
-    for source in ("TRUE", "LVT"):
-        for fmax in (1.0, 2.0, 4.0, 8.0, 12.0):
-            lp = loop(source, fmax, "strokes")
-            b = lp.run(int(4 * RATE))
-            target_v = lp._gesture.block(0, b["t"].size, RATE)[1]
-            times = bm.formation_times(b["stick"], target_v, RATE, lp.string.f0, lp.string.beta)[1:]
-            print(f"{source} {fmax:g} N strokes: ripple {1e6 * bm.ripple_rms(b['position_true'], target_v, RATE, 0.5):.3f}"
-                  f" um, stick {bm.stick_fraction(b['stick'], target_v, RATE, 0.5):.2f}, formation "
-                  + ", ".join(f"{t:.3f}" for t in times) + " s")
-    print("flagged on strokes at 20 N:", [s for s in sources() if is_broken(s, 20.0, gesture="strokes")])
+    for source in ("LVT", "LOWPASS", "KALPOS", "LEVANT", "FOAW", "TRUE"):
+        levels[source] = breakdown_fmax(source, tolerance=0.05, estimators=estimators(source))
+        b = loop(source, min(1.25 * levels[source], 200.0), "strokes").run(int(5 * RATE))
+        print(f"{source}: bowing breakdown {levels[source]:.3g} N (seed 0); handle's buzz at 1.25 x: "
+              f"{peak_hz(b['velocity_true'][int(RATE):], fmin=50.0):.0f} Hz")
+    for source, fmax in (("TRUE", 4.0), ("TRUE", 1.25 * levels["LVT"]), ("LVT", 1.25 * levels["LVT"]),
+                         ("LOWPASS", 1.25 * levels["LOWPASS"]), ("KALPOS", 1.25 * levels["KALPOS"])):
+        v = loop(source, fmax, "strokes").run(int(5 * RATE))["velocity_true"][int(0.25 * RATE):]
+        f, p = signal.welch(v, fs=RATE, nperseg=2048)
+        bands = ((0, 20), (20, 50), (50, 100), (100, 400), (400, 2500))
+        print(f"{source} at {fmax:.3g} N, handle's velocity per band (mm/s RMS): " + ", ".join(
+            f"{lo}-{hi} Hz {1e3 * np.sqrt(np.sum(p[(f >= lo) & (f < hi)]) * (f[1] - f[0])):.1f}" for lo, hi in bands))
+    for source in ("LVT", "LOWPASS", "KALPOS", "LEVANT", "FOAW", "LEVANTLP", "KALLEV", "KALFOAW", "LEASTSQ"):
+        rises = [hearing(source, seed)[1] for seed in range(args.seeds)]
+        lo = np.min(rises, axis=0)
+        hi = np.max(rises, axis=0)
+        names = ("100-400 Hz", "50-400 Hz", "inharmonic", "distance from TRUE")
+        print(f"{source} rise 0.8 -> 1.25 x, seeds 0-{args.seeds - 1} (dB): "
+              + ", ".join(f"{n} {a:.1f}..{b:.1f}" for n, a, b in zip(names, lo, hi)))
+    for fmax, index in ((12.1, 14), (7.7, 12)):
+        rec = simulate(fmax, rate=RATE, duration=7.0, source="LVT", seed=TRAINING["seed"] * 1000 + index)
+        v = rec.columns["velocity_lvt"]
+        hp = signal.sosfilt(signal.butter(2, 100.0, "high", fs=RATE, output="sos"), v)
+        window = window_sizes(rec.columns["position"], TABLE1["FOAW"]["window"], TABLE1["FOAW"]["margin"])
+        print(f"data set at {fmax:g} N: max |dv/dt| {np.max(np.abs(np.diff(v))) * RATE:.0f} m/s^2, above 100 Hz "
+              f"{1e3 * np.sqrt(np.mean(hp ** 2)):.2f} mm/s RMS, FOAW at its maximum window "
+              f"{100 * np.mean(window == TABLE1['FOAW']['window']):.1f} % of samples")
     for rate in (5000.0, 20000.0, 48000.0):
-        lp = loop("LVT", 2.0, "strokes", rate)
-        b = lp.run(int(3 * rate))
-        cruise = bm.cruise_mask(lp._gesture.block(0, b["t"].size, rate)[1], rate)
-        cruise[: int(0.5 * rate)] = False
-        edges = np.flatnonzero(np.diff(np.r_[0, cruise.astype(np.int8), 0]))
-        pitches = [peak_hz(b["string_velocity"][a:e], rate) for a, e in zip(edges[0::2], edges[1::2])]
-        print(f"pitch at {rate:g} Hz, 2 N, per cruise: " + ", ".join(f"{p:.1f}" for p in pitches))
+        b = loop("LVT", 2.0, "strokes", rate).run(int(5 * rate))
+        print(f"pitch at {rate:g} Hz, LVT at 2 N on strokes: {pitch(b['string_velocity'][int(0.25 * rate):], rate):.1f} Hz")
     if args.png:
-        level = levels.get(args.source) or breakdown_fmax(args.source, tolerance=0.05)
-        parts = stepping(args.source, level)
-        print(f"{args.source} stepping on strokes, band level per step: "
-              + ", ".join(f"{f:g} x {level_db(p):.1f} dB" for f, p in zip(STEPS, parts)))
-        spectrogram_figure(args.source, level, parts).savefig(args.png, dpi=100)
+        png(args.source, args.png, levels)
+
+
+def png(source, path, levels):
+    level = levels.get(source) or breakdown_fmax(source, tolerance=0.05, estimators=estimators(source))
+    parts = stepping(source, level)
+    print(f"{source} stepping on strokes, band level per step: "
+          + ", ".join(f"{f:g} x {level_db(p):.1f} dB" for f, p in zip(STEPS, parts)))
+    spectrogram_figure(source, level, parts).savefig(path, dpi=100)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,8 @@
 """Issue 11, items 1 and 4 on strokes: the levers tried, one trial each, as the table in docs/model.md.
 
+A record of issue 11's world (a rigid 1 kg handle, until 2026-11-25): since issue 20 the device is a
+light end-effector on a grip, which this script makes rigid (RIGID_GRIP) so its trials stay issue 11's.
+
     PYTHONPATH=. python scripts/recalibration_trials.py [-o table.md] [--workers 2] [--only NAME ...]
 
 Each trial changes a few of the model's constants in its own process (a fresh
@@ -40,6 +43,7 @@ from scipy import signal
 
 RATE = 5000.0
 SEED = 0
+RIGID_GRIP = (1e7, 1e4)  # N/m, N s/m: the grip of issue 20's device made rigid for issue 11's handle
 # the model before 2026-11-23: a 147 Hz string bowed at STK's beta, velocity scale 0.6, contact microphone 2e-3;
 # every trial is written as its changes to it
 BASE = dict(mass=1.0, s=0.6, f0=147.0, beta=0.127236, speed=0.04, accel=None, dwell=0.1, mic=2e-3)
@@ -110,8 +114,10 @@ def apply(cfg):
     calibration.F0 = cfg["f0"]
     breakdown_module.F0 = cfg["f0"]
     bowed_string.StringDesign = functools.partial(bowed_string.StringDesign, beta=cfg["beta"])
+    # issue 11's rigid handle: the hand lumped with the device through a grip too stiff and damped to move
     impedance = hand.HandImpedance(0.8 * cfg["mass"], calibration.HAND_STIFFNESS, calibration.HAND_DAMPING,
-                                   calibration.HAND_REACTION)
+                                   calibration.HAND_REACTION, grip_stiffness=RIGID_GRIP[0],
+                                   grip_damping=RIGID_GRIP[1])
     loop_module.SimulatedDevice = functools.partial(SimulatedDevice, mass=0.2 * cfg["mass"],
                                                     hand_impedance=impedance)
     mic_params = contact_mic.params

@@ -1,4 +1,4 @@
-"""``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--gesture hold|strokes] [--json] [-o FILE]``.
+"""``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--gesture strokes|hold] [--json] [-o FILE]``.
 
 Breakdown F_max (studyapp.model.breakdown) for one source or every source,
 over seeds 0..N-1. Prints a table (or with ``--json`` one JSON object for
@@ -26,10 +26,11 @@ def register(subparsers):
     which.add_argument("--all", action="store_true", help="every estimator, LVT and TRUE")
     p.add_argument("--rate", type=float, default=5000.0, metavar="HZ", help="sample rate in Hz, 1000..96000 (default 5000)")
     p.add_argument("--seeds", type=int, default=5, metavar="N", help="seeds 0..N-1, N at most 100 (default 5)")
-    p.add_argument("--gesture", default="hold", metavar="hold|strokes",
-                   help="hold (the hand at rest, with tremor) or strokes (default hold)")
-    p.add_argument("--duration", type=float, default=4.0, metavar="SECONDS",
-                   help="length of each trial, 0.5..60 s (default 4; shorter misses late onsets)")
+    p.add_argument("--gesture", default="strokes", metavar="strokes|hold",
+                   help="strokes (bowing, judged against TRUE's sound and feel) or hold (the hand at rest, with "
+                        "tremor) (default strokes)")
+    p.add_argument("--duration", type=float, default=5.0, metavar="SECONDS",
+                   help="length of each trial, 0.5..60 s (default 5; shorter misses late onsets)")
     p.add_argument("--json", action="store_true", help="print JSON instead of the table")
     p.add_argument("-o", "--output", metavar="FILE", help="also write the result: .csv, .md or .json")
     p.set_defaults(func=run)

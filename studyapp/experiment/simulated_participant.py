@@ -30,7 +30,7 @@ from studyapp.model.fmax_knob import KNOB_MAX
 
 class SimulatedParticipant:
     def __init__(self, seed, bow_time=0.25, probe_time=1.2, reaction_time=0.05, rest_time=1.0,
-                 retries=12, adjust_gesture="hold", rating_jitter=0.05,
+                 retries=12, adjust_gesture=None, rating_jitter=0.05,
                  hand_jitter=1.5, criterion_spread=2.0, level_check_time=1.0):
         self.seed = int(seed)
         self.bow_time = bow_time
@@ -38,7 +38,7 @@ class SimulatedParticipant:
         self.reaction_time = reaction_time
         self.rest_time = rest_time
         self.retries = retries
-        self.adjust_gesture = adjust_gesture
+        self.adjust_gesture = adjust_gesture  # None: bow with the protocol's gesture, as the participants did
         self.rating_jitter = rating_jitter
         self.hand_jitter = hand_jitter
         self.level_check_time = level_check_time  # s the experimenter listens to the level check's tone

@@ -2,13 +2,20 @@
 
 The paper's adjustment task (Sec. 8.2-8.3, Fig. 7) asks for "the maximum
 displayable friction gain F_max such that the display remains stable". This
-is the simulated world's answer, judged by the stability monitor
-(stability.py) instead of a participant.
+is the simulated world's answer, judged as the participants judged it: while
+bowing with the protocol's gesture (``strokes`` by default; ``hold`` kept).
 
 One trial, ``is_broken(source, f)``: the closed loop (loop.py) runs for
-``duration`` s at F_max = f with ``source`` as the velocity in the loop; it is
-broken if the loop faults, or if the monitor flags breakdown once its
-SETTLE = 0.25 s window has filled (checked every BLOCK = 0.05 s).
+``duration`` s at F_max = f with ``source`` as the velocity in the loop.
+- Bowing (``strokes``): broken if the loop faults, if the handle's velocity in
+  the band stability.BAND, RMS over [SETTLE, duration], is more than
+  stability.RISE (6 dB) above TRUE's on the same gesture at the same F_max and
+  seed (TRUE's runs are cached), or if the string's pitch (the largest spectral
+  peak of the string's velocity at the bow above 100 Hz, over the same span) is
+  more than stability.PITCH_TOLERANCE off f0. docs/model.md justifies it.
+- Holding (``hold``): broken if the loop faults or the stability monitor's hold
+  criterion flags breakdown once its SETTLE = 0.25 s window has filled
+  (checked every BLOCK = 0.05 s).
 
 The search, ``breakdown_fmax``, assumes broken(f) is monotonic in f and
 bisects log f. It starts from the bracket [LOW, HIGH] = [0.05, 200] N (200 N:
@@ -26,11 +33,13 @@ F_max and their median (for even N the mean of the middle two, numpy.median),
 minimum and maximum; inf (stable to 200 N) counts as the largest value.
 """
 
+import functools
 import math
 
 import numpy as np
 
 from studyapp.errors import ParameterError
+from studyapp.model import bowing_reference, stability
 from studyapp.model.calibration import F0
 from studyapp.model.sources import is_pseudo, with_pseudo_sources
 
@@ -41,6 +50,7 @@ HIGH = 200.0  # N, the search's highest F_max (loop.FMAX_LIMIT)
 GESTURES = ("hold", "strokes")
 MAX_SEEDS = 100  # a source's search takes about 0.3 s per seed at 5 kHz; --all with 100 seeds about 10 min
 DURATION_RANGE = (0.5, 60.0)  # s per trial; below about 2 s a late onset is missed (the verdict lags ~1 s)
+DURATION = 5.0  # s per trial by default: about ten strokes
 KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max")
 
 
@@ -81,15 +91,28 @@ def check_duration(seconds, label="duration"):
     return value
 
 
-def is_broken(source, fmax, rate=5000.0, gesture="hold", duration=4.0, seed=0, estimators=None, f0=None):
-    """Whether the stability monitor flags breakdown within ``duration`` s at ``fmax`` N."""
+def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, seed=0, estimators=None, f0=None):
+    """Whether ``source`` at ``fmax`` N breaks down within ``duration`` s of ``gesture`` (the module's criteria)."""
     from studyapp.model.loop import ClosedLoop, LoopConfig
 
     estimators = dict(estimators or {})
     if not is_pseudo(source) and source not in estimators:
         estimators[source] = {}
+    f0 = F0 if f0 is None else f0
     loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
-                                 f0=F0 if f0 is None else f0, seed=seed, audio=False))
+                                 f0=f0, seed=seed, audio=False), judge=False)
+    if gesture == "hold":
+        return _broken_holding(loop, duration)
+    total = int(round(duration * loop.rate))
+    block = loop.run(total)
+    if loop.fault is not None:
+        return True
+    level, pitch = _bowing_measures(block, loop.rate, loop.string.f0)
+    ref_level, _ = _true_bowing(float(loop.rate), float(f0), gesture, float(fmax), total, int(seed))
+    return level > stability.RISE * ref_level or not abs(pitch / loop.string.f0 - 1.0) <= stability.PITCH_TOLERANCE
+
+
+def _broken_holding(loop, duration):
     block = max(1, int(round(BLOCK * loop.rate)))
     settle = int(round(SETTLE * loop.rate))
     done = 0
@@ -102,13 +125,28 @@ def is_broken(source, fmax, rate=5000.0, gesture="hold", duration=4.0, seed=0, e
     return False
 
 
-def breakdown_fmax(source, rate=5000.0, gesture="hold", duration=4.0, low=LOW, high=HIGH, tolerance=0.02,
+def _bowing_measures(block, rate, f0):
+    """(band level m/s, pitch Hz) of a bowing trial over [SETTLE, end]."""
+    start = int(round(SETTLE * rate))
+    return (stability.band_level(block["velocity_true"], rate, start),
+            bowing_reference.pitch(block["string_velocity"][start:], rate))
+
+
+@functools.lru_cache(maxsize=4096)
+def _true_bowing(rate, f0, gesture, fmax, total, seed):
+    from studyapp.model.loop import ClosedLoop, LoopConfig
+
+    loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
+                                 seed=seed, audio=False), judge=False)
+    return _bowing_measures(loop.run(total), loop.rate, loop.string.f0)
+
+
+def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, low=LOW, high=HIGH, tolerance=0.02,
                    seed=0, estimators=None, f0=None, progress=None):
     """The largest F_max (N) at which ``source`` stays stable, by bisection on a log scale.
 
-    Stable means: the stability monitor does not flag breakdown within
-    ``duration`` s (``gesture="hold"``: the hand holding the handle, with
-    tremor). Returns ``low`` if even ``low`` breaks down and ``inf`` if
+    Stable means: ``is_broken`` is False (bowing ``strokes`` by default;
+    ``gesture="hold"``: the hand holding the handle, with tremor). Returns ``low`` if even ``low`` breaks down and ``inf`` if
     ``high`` does not; otherwise the geometric midpoint of the final bracket,
     whose width is at most ``tolerance`` (relative). ``progress(fmax, broken)``
     is called after each trial.
@@ -135,7 +173,7 @@ def breakdown_fmax(source, rate=5000.0, gesture="hold", duration=4.0, low=LOW, h
     return math.sqrt(lo * hi)
 
 
-def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="hold", duration=4.0, tolerance=0.02, progress=None):
+def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", duration=DURATION, tolerance=0.02, progress=None):
     """Breakdown F_max for seeds 0..``seeds``-1: a dict with exactly the keys ``KEYS``.
 
     ``fmax`` lists the seeds' values (N; inf when stable up to 200 N);

@@ -29,7 +29,9 @@ the source switches at a block boundary.
 The stability monitor (stability.py) is advanced per sample by the
 controller. Python runs only at block boundaries: it applies setting changes
 (source, F_max, force scale, bowing, gesture) and reads the monitor's
-verdict.
+verdict. While the gesture bows, the monitor judges against TRUE's band level
+on it at the loop's F_max (bowing_reference.py; ``judge=False`` leaves the
+monitor on its hold criterion, as the reference's own TRUE runs need).
 
 Built only as needed: the default device has no accelerometer (filter,
 noise) when no active estimator reads acceleration (unless
@@ -49,7 +51,7 @@ from studyapp.errors import ParameterError
 from studyapp.estimators import Bank
 from studyapp.estimators.registry import SPECS
 from studyapp.estimators.spec import validate_rate
-from studyapp.model import body, bow_table, bowed_string, calibration, contact_mic, control
+from studyapp.model import body, bow_table, bowed_string, bowing_reference, calibration, contact_mic, control
 from studyapp.model.control import (
     C_BOWING, C_BREAKAWAY, C_FORCE_SCALE, C_GAIN, C_PEAK, C_SCALE, C_SOURCE, C_USE_AUDIO, FAULT_DEVICE, FAULT_ESTIMATE,
     FAULT_FORCE, FAULT_SENSOR, FAULT_STRING, L_FAULT, L_FAULT_SAMPLE, N_CONTROL, N_LOOP_STATE, OUTPUTS,
@@ -128,8 +130,9 @@ class ClosedLoop:
     Settings (``set_*``) take effect at the next ``run``.
     """
 
-    def __init__(self, config=None, device=None):
+    def __init__(self, config=None, device=None, judge=True):
         config = config or LoopConfig()
+        self._judge_bowing = bool(judge)
         self.config = config
         self.rate = validate_rate(config.rate)
         f0 = check_f0(calibration.F0 if config.f0 is None else config.f0)
@@ -219,6 +222,14 @@ class ClosedLoop:
         self._gesture = make_gesture(name, self.rate, self._trajectory, position)
         self.device.follow(self._gesture)
         self.gesture_name = name
+        bowing = self._judge_bowing and bowing_reference.TABLE_GESTURE.get(name) is not None
+        self.monitor.reference = self.reference_level if bowing else None
+        if bowing:
+            self.reference_level()  # the table now (once per process), not in a live block
+
+    def reference_level(self):
+        """TRUE's band level (m/s) on this gesture at this F_max: what the monitor judges against while bowing."""
+        return bowing_reference.level(self.rate, self.string.f0, self.gesture_name, self.fmax)
 
     def set_hand_target(self, x_m):
         x_m = float(x_m)

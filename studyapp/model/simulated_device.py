@@ -5,17 +5,32 @@ it drives a real one. It holds what a real device has in the world: the
 moving mass, the sensors (sensors.py) with their seeded noise, and the hand
 that holds the handle and follows a gesture (hand.py, gestures.py).
 
-The mechanics: a moving mass m (device plus hand: the hand's mass moves with
-the handle) between end stops at +-11 mm (the LVDT's 2.2 cm range), pushed by
-the motor and by the hand. The force command F[k] computed from the sensors
-at sample k is held over [k, k+1] (zero-order hold), so the position sampled
-at k+1 is the first to feel it: the one-step delay of the paper's Fig. 1 and
-Sec. 2. Over one step the mass moves exactly under the constant total force f:
+The mechanics: two masses. The end-effector (mass m_e: the device's moving
+parts and sensors, calibration.DEVICE_MASS) between end stops at +-11 mm (the
+LVDT's 2.2 cm range), pushed by the motor; the hand (m_h), held to it by the
+grip (a spring K_g and damper B_g, hand.py) and driven by the arm along the
+gesture. With s = (x, v, x_h, v_h), end-effector then hand,
 
-    x[k+1] = x[k] + T v[k] + T^2 f / (2 m),   v[k+1] = v[k] + T f / m
+    ds/dt = A s + B (F, F_arm),   A = [[0, 1, 0, 0],
+                                       [-K_g/m_e, -B_g/m_e, K_g/m_e, B_g/m_e],
+                                       [0, 0, 0, 1],
+                                       [K_g/m_h, B_g/m_h, -K_g/m_h, -B_g/m_h]],
+                                  B = [[0, 0], [1/m_e, 0], [0, 0], [0, 1/m_h]].
 
-and an end stop is inelastic: the position is held at the stop and the
-velocity into it is set to zero (a rigid stop; stable at any rate).
+The force command F[k] computed from the sensors at sample k is held over
+[k, k+1] (zero-order hold), and so is the arm's force F_arm[k] from the state
+at k; so the position sampled at k+1 is the first to feel F[k]: the one-step
+delay of the paper's Fig. 1 and Sec. 2. Over one step the pair moves exactly
+(the zero-order-hold discretisation, Phi = exp(A T) and
+Gamma = int_0^T exp(A s) ds B, computed once with scipy.linalg.expm), so the
+stiff grip is stable at every rate:
+
+    s[k+1] = Phi s[k] + Gamma (F[k], F_arm[k]).
+
+The end-effector's acceleration is its mean over the step, (v[k+1] - v[k]) / T.
+An end stop is inelastic: the end-effector's position is held at the stop and
+its velocity into it is set to zero (a rigid stop; the hand is not stopped: the
+grip stretches).
 
 Two paths give the same samples. ``read_sensors`` / ``write_force`` step the
 world one sample (the hand's force and the sensors from the state at k, then
@@ -45,17 +60,42 @@ from studyapp.model.device import DeviceLimits, HapticDevice
 from studyapp.model.gestures import Hold
 from studyapp.model.sources import TRUE_INDEX
 
-DP_T, DP_MASS, DP_TRAVEL, DP_ACCELEROMETER = range(4)
-N_PARAMS = 4
-# state: true position, velocity, acceleration over the last step, the hand's push, fault
-DS_X, DS_V, DS_A, DS_PUSH, DS_FAULT = range(5)
-N_STATE = 5
+DP_T, DP_MASS, DP_TRAVEL, DP_ACCELEROMETER, DP_KG, DP_BG = range(6)
+DP_PHI = 6  # Phi, 4 x 4 row-major
+DP_GAMMA = DP_PHI + 16  # Gamma, 4 x 2 row-major
+N_PARAMS = DP_GAMMA + 8
+# state: the end-effector's true position, velocity, acceleration over the last step, the hand's push, fault,
+# the hand's position and velocity
+DS_X, DS_V, DS_A, DS_PUSH, DS_FAULT, DS_XH, DS_VH = range(7)
+N_STATE = 7
+
+
+def discretise(m_e, m_h, k_g, b_g, t):
+    """(Phi, Gamma) of the end-effector and hand on the grip over a step of ``t`` s (zero-order hold)."""
+    from scipy.linalg import expm
+
+    a = np.array([[0.0, 1.0, 0.0, 0.0],
+                  [-k_g / m_e, -b_g / m_e, k_g / m_e, b_g / m_e],
+                  [0.0, 0.0, 0.0, 1.0],
+                  [k_g / m_h, b_g / m_h, -k_g / m_h, -b_g / m_h]])
+    b = np.array([[0.0, 0.0], [1.0 / m_e, 0.0], [0.0, 0.0], [0.0, 1.0 / m_h]])
+    big = np.zeros((6, 6))
+    big[:4, :4] = a * t
+    big[:4, 4:] = b * t
+    e = expm(big)
+    return e[:4, :4], e[:4, 4:]
 
 
 @njit(cache=True, inline="always")
 def hand_force(hp, ds, x_target, v_target, a_target):
-    """The hand's force on the handle now (N), as given (non-finite included)."""
-    return hand.force(hp, x_target, v_target, a_target, ds[DS_X], ds[DS_V], ds[DS_PUSH])
+    """The arm's force on the hand now (N), as given (non-finite included)."""
+    return hand.force(hp, x_target, v_target, a_target, ds[DS_XH], ds[DS_VH], ds[DS_PUSH])
+
+
+@njit(cache=True, inline="always")
+def grip_force(dp, ds):
+    """The grip's force on the end-effector now (N): what the device feels of the hand."""
+    return dp[DP_KG] * (ds[DS_XH] - ds[DS_X]) + dp[DP_BG] * (ds[DS_VH] - ds[DS_V])
 
 
 @njit(cache=True, inline="always")
@@ -68,13 +108,21 @@ def sense(use_acc, ds, snp, sns, noise_x, noise_v, noise_a, noise_lf):
 
 
 @njit(cache=True, inline="always")
-def advance(dp, ds, f_total):
-    """Move the mass over one sample under the constant force ``f_total`` (N)."""
+def _row(dp, i, s0, s1, s2, s3, f, f_arm):
+    r = DP_PHI + 4 * i
+    g = DP_GAMMA + 2 * i
+    return dp[r] * s0 + dp[r + 1] * s1 + dp[r + 2] * s2 + dp[r + 3] * s3 + dp[g] * f + dp[g + 1] * f_arm
+
+
+@njit(cache=True, inline="always")
+def advance(dp, ds, f, f_arm):
+    """Move end-effector and hand over one sample under the constant motor force ``f`` and arm force ``f_arm`` (N)."""
     t = dp[DP_T]
-    a = f_total / dp[DP_MASS]
-    v0 = ds[DS_V]
-    x = ds[DS_X] + t * v0 + 0.5 * t * t * a
-    v = v0 + t * a
+    s0, s1, s2, s3 = ds[DS_X], ds[DS_V], ds[DS_XH], ds[DS_VH]
+    x = _row(dp, 0, s0, s1, s2, s3, f, f_arm)
+    v = _row(dp, 1, s0, s1, s2, s3, f, f_arm)
+    xh = _row(dp, 2, s0, s1, s2, s3, f, f_arm)
+    vh = _row(dp, 3, s0, s1, s2, s3, f, f_arm)
     stop = dp[DP_TRAVEL]
     if x > stop:
         x = stop
@@ -85,22 +133,26 @@ def advance(dp, ds, f_total):
         if v < 0.0:
             v = 0.0
     ds[DS_X] = x
-    ds[DS_A] = (v - v0) / t
+    ds[DS_A] = (v - s1) / t
     ds[DS_V] = v
+    ds[DS_XH] = xh
+    ds[DS_VH] = vh
 
 
 @njit(cache=True, inline="always")
-def actuate(dp, ds, hp, f, f_hand):
-    """The step [k, k+1] under the command ``f`` and the hand's force ``f_hand`` (from ``hand_force``)."""
-    if not np.isfinite(f_hand):
-        f_hand = 0.0
+def actuate(dp, ds, hp, f, f_arm):
+    """The step [k, k+1] under the command ``f`` and the arm's force ``f_arm`` (from ``hand_force``)."""
+    if not np.isfinite(f_arm):
+        f_arm = 0.0
         ds[DS_PUSH] = 0.0
         ds[DS_X] = 0.0
         ds[DS_V] = 0.0
         ds[DS_A] = 0.0
+        ds[DS_XH] = 0.0
+        ds[DS_VH] = 0.0
         ds[DS_FAULT] = 1.0
     ds[DS_PUSH] = hand.learn_push(hp, ds[DS_PUSH], f)
-    advance(dp, ds, f + f_hand)
+    advance(dp, ds, f, f_arm)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -114,7 +166,8 @@ def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, nois
         x = ds[DS_X]
         v = ds[DS_V]
         a = ds[DS_A]
-        f_hand = hand_force(hp, ds, target[k], target_v[k], target_a[k])
+        f_arm = hand_force(hp, ds, target[k], target_v[k], target_a[k])
+        f_hand = grip_force(dp, ds)
         x_m, a_m, v_m = sense(use_acc, ds, snp, sns, noise_x[k], noise_v[k], noise_a[k], noise_lf[k])
         control.check_sensors(state, k, x_m, a_m, v_m)
         # control.source_velocity and control.observe, written out: as inline calls they cost 15-20 ns
@@ -132,7 +185,7 @@ def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, nois
             out[control.O_AUDIO, k] += contact_mic.step(mic_p, mic_s, a)
         f = control.command(state, lp, ls, k, f)
         control.record(out, k, x_m, a_m, v_m, x, v, a, f, f_hand if np.isfinite(f_hand) else 0.0)
-        actuate(dp, ds, hp, f, f_hand)
+        actuate(dp, ds, hp, f, f_arm)
 
 
 @njit(cache=True, error_model="numpy")
@@ -146,8 +199,13 @@ def hand_once(hp, ds, x_target, v_target, a_target):
 
 
 @njit(cache=True, error_model="numpy")
-def write_once(dp, ds, hp, f, f_hand):
-    actuate(dp, ds, hp, f, f_hand)
+def grip_once(dp, ds):
+    return grip_force(dp, ds)
+
+
+@njit(cache=True, error_model="numpy")
+def write_once(dp, ds, hp, f, f_arm):
+    actuate(dp, ds, hp, f, f_arm)
 
 
 class SimulatedDevice(HapticDevice):
@@ -161,17 +219,24 @@ class SimulatedDevice(HapticDevice):
         self.rate = float(rate)
         self.mass = float(mass)
         self.limits = limits
-        self.hand = hand_impedance or hand.HandImpedance(calibration.HAND_MASS, calibration.HAND_STIFFNESS,
-                                                         calibration.HAND_DAMPING, calibration.HAND_REACTION)
+        self.hand = hand_impedance or hand.HandImpedance(
+            calibration.HAND_MASS, calibration.HAND_STIFFNESS, calibration.HAND_DAMPING, calibration.HAND_REACTION,
+            calibration.GRIP_STIFFNESS, calibration.GRIP_DAMPING)
         self.sensor_spec = sensor_spec or sensors.SensorSpec()
         self.accelerometer = bool(accelerometer)
         self._dp = np.zeros(N_PARAMS)
         self._dp[DP_T] = 1.0 / self.rate
-        self._dp[DP_MASS] = self.mass + self.hand.mass
+        self._dp[DP_MASS] = self.mass
         self._dp[DP_TRAVEL] = limits.travel
         self._dp[DP_ACCELEROMETER] = 1.0 if self.accelerometer else 0.0
+        self._dp[DP_KG] = self.hand.grip_stiffness
+        self._dp[DP_BG] = self.hand.grip_damping
+        phi, gamma = discretise(self.mass, self.hand.mass, self.hand.grip_stiffness, self.hand.grip_damping,
+                                self._dp[DP_T])
+        self._dp[DP_PHI:DP_GAMMA] = phi.ravel()
+        self._dp[DP_GAMMA:] = gamma.ravel()
         self._ds = np.zeros(N_STATE)
-        self._hp = self.hand.params(self._dp[DP_MASS], self.rate)
+        self._hp = self.hand.params(self.mass + self.hand.mass, self.rate)
         self._snp = self.sensor_spec.params(self.rate)
         self._sns = np.zeros(sensors.N_STATE)
         # the accelerometer's low-frequency noise is the 4th child, so the first three streams stay as they were
@@ -194,9 +259,7 @@ class SimulatedDevice(HapticDevice):
         self._gesture_start = self._sample
 
     def truth(self):
-        f_hand = 0.0
-        if self._target is not None:
-            f_hand = hand_once(self._hp, self._ds, *self._target)
+        f_hand = grip_once(self._dp, self._ds)
         return (float(self._ds[DS_X]), float(self._ds[DS_V]), float(self._ds[DS_A]),
                 f_hand if np.isfinite(f_hand) else 0.0)
 
@@ -218,8 +281,8 @@ class SimulatedDevice(HapticDevice):
 
     def write_force(self, force):
         target = self._target if self._target is not None else tuple(float(t[0]) for t in self._targets(1))
-        f_hand = hand_once(self._hp, self._ds, *target)
-        write_once(self._dp, self._ds, self._hp, float(force), f_hand)
+        f_arm = hand_once(self._hp, self._ds, *target)
+        write_once(self._dp, self._ds, self._hp, float(force), f_arm)
         self._target = None
         self._sample += 1
 

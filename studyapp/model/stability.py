@@ -1,56 +1,48 @@
 """Stability monitor: does the loop still feel and sound like a bowed string?
 
-The paper's participants found the margin of stability by "device oscillation
-and clear distortion in the sound" (Sec. 8.3): "the point immediately before
-the model no longer feels or sounds like a bowed string".
+The paper's participants found the margin of stability while bowing, by "device
+oscillation and clear distortion in the sound" (Sec. 8.3): "the point
+immediately before the model no longer feels or sounds like a bowed string".
+So breakdown is judged while the hand bows with the protocol's gesture, by
+comparison with what the ideal sensor (TRUE, the true velocity) gives at the
+same F_max: the participant's reference is a string that behaves like a string.
 
-What breakdown is in this model. While the bow sticks, the string pushes on
-the handle through the junction (F = -G rho(v_delta) v_delta, with rho at its
-0.98 clip), and the string beyond the bow is a resonator: with the sticking
-bow as its fixed end, the nut-side segment rings at about f0 / (1 - beta)
-(587 Hz for the default 440 Hz string bowed at beta = 0.25), and below that
-the stuck string is stiff. A velocity source that lags the handle's true
-velocity turns this coupling from a brake into a drive, and past a gain the
-loop oscillates by itself: the force swings between +F_max and -F_max, the
-handle buzzes (mm/s) and the string near the bow rings with it (the sound
-distorts; the handle's buzz is heard too, contact_mic.py). With TRUE it is
-the loop mode; with the tachometer and the estimators the handle bouncing on
-the stuck string comes first, at 30-130 Hz (docs/model.md).
+While bowing (``strokes``, ``strokes-validation``; ``live`` and ``playback``
+judged against the strokes): the handle's velocity v (m/s: the simulation's
+true velocity, or a real device's tachometer) band-passed over BAND = 50-400 Hz
+(2nd-order Butterworth high-pass then low-pass), its mean square averaged over
+BOW_WINDOW = 1 s (about two stroke cycles; exponential), and
 
-Criterion, on absolute quantities (pinned by tests/model/test_model_stability.py).
-The monitor watches the handle's velocity v (m/s: the simulation's true
-velocity, or a real device's tachometer), high-passed at f0 / 2 (220 Hz for the
-default string) so that strokes, their reversals and tremor do not count,
-while the loop mode, above f0, does, and so do the harmonics of the lower
-bounce (saturated at +-F_max, it is nearly a square wave):
+    broken  =  band level > RISE * reference(F_max),   RISE = 2 (6 dB)
+
+with reference(F_max) TRUE's band level on the same gesture at the same F_max
+(bowing_reference.py: a table computed once per rate, pitch and gesture). Why
+this band: below 50 Hz the strokes' own reversals fill the band (TRUE's handle
+has 10-12 mm/s at 20-50 Hz, the gesture itself); above 400 Hz lie the string's
+pitch and the stick-slip; between them TRUE's handle moves 3-6 mm/s while a
+breaking loop buzzes at 100-300 Hz (LVT, LOWPASS, LEVANT: 20-35 mm/s at
+1.25 x its breakdown) or shakes the grip at 30-100 Hz (the Kalman filters):
+docs/model.md, "Breakdown while bowing". ``studyapp breakdown`` judges a whole
+trial the same way (breakdown.py), with TRUE run at the same seed and F_max,
+and adds the string's pitch: more than PITCH_TOLERANCE = 2 % off f0 is broken
+(it catches TRUE's own breakdown, where the string leaves f0 for a higher mode).
+
+With the hand holding (``hold``): the oscillation of a stuck string. The
+handle's velocity high-passed at f0 / 2, so tremor does not count:
 
     level = RMS of v over the last WINDOW = 0.25 s                 (``score``, m/s)
     e(t)  = RMS of v over the last ENVELOPE = 12 ms (about one oscillation period)
     cv    = standard deviation / mean of e over the last 0.25 s
-    broken  = level > VIBRATION_MIN = 1 mm/s  and  cv < CV_MAX = 0.15
+    broken  = level > VIBRATION_MIN  and  cv < CV_MAX = 0.15
 
 A self-sustained oscillation is large and steady: the force saturates at
-+-F_max, so the handle's buzz is of order F_max / (m w) (mm/s at a few newtons
-on the 1 kg of handle and hand) with an envelope that hardly moves (cv 0.01-0.1).
-What it must not be confused with: estimator noise, whose force is random and
-whose envelope fluctuates like a Rayleigh variable (cv 0.2-0.35) even when
-large; bowing, whose stick-slip ripple changes with every stroke; and, above
-all, anything at a low gain. An earlier criterion on F / F_max read estimator
-noise the same at every gain and flagged LEVANT and KALMAN "broken" at
-0.001 N on some seeds; in metres per second, a handle pushed by millinewtons
-cannot reach VIBRATION_MIN. VIBRATION_MIN sits far above the held handle's
-band-passed velocity at low gain (0.001 mm/s with the 440 Hz string, 0.04 mm/s
-with the former 147 Hz one: the tremor's leak through the high-pass) and below
-the buzz of the breakdowns (LOWPASS 1.9 mm/s at 9.8 N, LVT 3.2 mm/s at 13.3 N;
-scripts/model_figures.py prints them). An oscillation that starts is itself
-an envelope change: cv falls below CV_MAX some tenths of a second after the
-onset, so the verdict lags the onset by about that long (a participant also
-needs a moment).
-
-Caveat (what the model shows): regular bowing masks the oscillation, because
-every slip restarts the sticking phase in which it grows; it appears when the
-bow rests or moves slowly. Breakdown searches (``studyapp.model.breakdown``)
-therefore hold the handle, with tremor.
++-F_max, so the buzz is of order F_max / (m w), m the mass that moves at
+audio rates (the end-effector: above the grip's corner the hand stays put),
+with an envelope that hardly moves (cv 0.01-0.1). Estimator noise has a
+random envelope (cv 0.2-0.35, Rayleigh-like). VIBRATION_MIN therefore scales
+with the moving mass: IMPULSE / m, 1 mm/s for 1 kg (the rigid handle it was set
+for), 10 mm/s for the 0.1 kg end-effector. The verdict lags an onset by a few
+tenths of a second (cv must fall).
 """
 
 import math
@@ -62,18 +54,37 @@ from scipy import signal
 from studyapp.model import calibration
 from studyapp.model.sensors import section_at
 
+BAND = (50.0, 400.0)  # Hz, the bowing verdict's band
+RISE = 2.0  # over TRUE's band level: 6 dB
+PITCH_TOLERANCE = 0.02  # of f0
+BOW_WINDOW = 1.0  # s
 WINDOW = 0.25  # s
 ENVELOPE = 0.012  # s
 HIGHPASS_FRACTION = 0.5  # of f0
-VIBRATION_MIN = 1e-3  # m/s
+IMPULSE = 1e-3  # kg m/s: VIBRATION_MIN times the mass that moves at audio rates
+VIBRATION_MIN = IMPULSE / calibration.DEVICE_MASS  # m/s
 CV_MAX = 0.15
 
-# parameter vector: high-pass section (5), long and short smoothing factors
-MP_HP, MP_LONG, MP_SHORT = 0, 5, 6
-N_PARAMS = 7
-# state: high-pass (2), long mean of r^2, short mean of r^2, long mean of e, long mean of e^2
-MS_HP, MS_MS, MS_ENV_MS, MS_ENV_MEAN, MS_ENV_SQ = 0, 2, 3, 4, 5
-N_STATE = 6
+# parameter vector: high-pass section (5), long and short smoothing factors, band sections (2 x 5), band smoothing
+MP_HP, MP_LONG, MP_SHORT, MP_BAND, MP_BAND_LONG = 0, 5, 6, 7, 17
+N_PARAMS = 18
+# state: high-pass (2), long mean of r^2, short mean of r^2, long mean of e, long mean of e^2, band sections (4),
+# band mean square
+MS_HP, MS_MS, MS_ENV_MS, MS_ENV_MEAN, MS_ENV_SQ, MS_BAND, MS_BAND_MS = 0, 2, 3, 4, 5, 6, 10
+N_STATE = 11
+
+
+def band_sos(rate):
+    """The bowing band's filter at ``rate`` (scipy sos, two sections: high-pass, low-pass)."""
+    hi = min(BAND[1], 0.45 * rate)
+    return np.vstack([signal.butter(2, BAND[0], "high", fs=rate, output="sos"),
+                      signal.butter(2, hi, "low", fs=rate, output="sos")])
+
+
+def band_level(velocity, rate, start=0):
+    """RMS (m/s) of ``velocity`` through the bowing band (causal, from rest), over its samples from ``start`` on."""
+    y = signal.sosfilt(band_sos(rate), np.asarray(velocity, dtype=np.float64))[int(start):]
+    return float(np.sqrt(np.mean(y * y))) if y.size else 0.0
 
 
 @njit(cache=True, inline="always")
@@ -89,6 +100,9 @@ def observe(mp, ms, v):
     e = math.sqrt(ms[MS_ENV_MS])
     ms[MS_ENV_MEAN] += a * (e - ms[MS_ENV_MEAN])
     ms[MS_ENV_SQ] += a * (e * e - ms[MS_ENV_SQ])
+    b = section_at(mp, MP_BAND, ms, MS_BAND, v)
+    b = section_at(mp, MP_BAND + 5, ms, MS_BAND + 2, b)
+    ms[MS_BAND_MS] += mp[MP_BAND_LONG] * (b * b - ms[MS_BAND_MS])
 
 
 @njit(cache=True)
@@ -110,32 +124,46 @@ def verdict(ms):
 
 
 class StabilityMonitor:
-    """``.broken``, ``.score`` (= ``.level``, m/s), ``.cv``; the loop advances ``.state`` sample by sample."""
+    """``.broken``, ``.score`` (= ``.level``, m/s), ``.cv``, ``.band``; the loop advances ``.state`` per sample.
 
-    def __init__(self, rate, f0=calibration.F0):
+    ``reference``: None judges as with the hand holding; a callable giving
+    TRUE's band level (m/s) now (bowing_reference.py) judges while bowing.
+    """
+
+    def __init__(self, rate, f0=calibration.F0, reference=None):
         self.rate = float(rate)
         hp = signal.butter(2, min(HIGHPASS_FRACTION * f0, 0.45 * rate), "high", fs=rate, output="sos")[0]
         self.params = np.zeros(N_PARAMS)
         self.params[MP_HP:MP_HP + 5] = np.array([hp[0], hp[1], hp[2], hp[4], hp[5]]) / hp[3]
         self.params[MP_LONG] = 1.0 - np.exp(-1.0 / (WINDOW * rate))
         self.params[MP_SHORT] = 1.0 - np.exp(-1.0 / (ENVELOPE * rate))
+        for j, sec in enumerate(band_sos(rate)):
+            self.params[MP_BAND + 5 * j:MP_BAND + 5 * j + 5] = np.array([sec[0], sec[1], sec[2], sec[4], sec[5]]) / sec[3]
+        self.params[MP_BAND_LONG] = 1.0 - np.exp(-1.0 / (BOW_WINDOW * rate))
         self.state = np.zeros(N_STATE)
+        self.reference = reference
         self.reset()
 
     def reset(self):
         self.state[:] = 0.0
         self.level = 0.0
         self.cv = 1.0
+        self.band = 0.0
         self.broken = False
 
     @property
     def score(self):
-        return self.level
+        """What the verdict reads (m/s): the band level while bowing, the high-passed level while holding."""
+        return self.level if self.reference is None else self.band
 
     def judge(self):
-        """Update ``level``, ``cv`` and ``broken`` from the state (the loop calls this after each block)."""
+        """Update ``level``, ``cv``, ``band`` and ``broken`` from the state (the loop calls this after each block)."""
         self.level, self.cv = verdict(self.state)
-        self.broken = bool(self.level > VIBRATION_MIN and self.cv < CV_MAX)
+        self.band = math.sqrt(max(self.state[MS_BAND_MS], 0.0))
+        if self.reference is None:
+            self.broken = bool(self.level > VIBRATION_MIN and self.cv < CV_MAX)
+        else:
+            self.broken = bool(self.band > RISE * self.reference())
         return self.broken
 
     def measure(self, velocity):

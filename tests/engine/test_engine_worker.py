@@ -14,6 +14,7 @@ from studyapp.engine.config import EngineConfig
 from studyapp.engine.commands import ResetString, SetFmax, SetSource, Stall
 from studyapp.engine.engine import Engine, EngineError
 from studyapp.errors import ParameterError
+from studyapp.model import bowing_reference, calibration
 from studyapp.model.stability import StabilityMonitor
 from tests.engine.waiting import wait_for
 
@@ -93,8 +94,10 @@ def test_worker_runs_switches_source_and_fmax_and_stops_cleanly():
         reset = np.flatnonzero(np.diff(tel["trial_clock"]) < 0)[0] + 1
         assert (tel["start"] + reset) % block == 0 and tel["trial_clock"][reset] == 0.0
         np.testing.assert_allclose(np.diff(tel["trial_clock"][reset:]), 1 / RATE, rtol=1e-6)
-        monitor = StabilityMonitor(RATE)
         last = reset + (len(tel["t"]) - reset) // block * block - 1  # the last sample of a whole block
+        # bowing strokes, the monitor judges against TRUE's band level at this F_max (issue 20)
+        reference = bowing_reference.level(RATE, calibration.F0, "strokes", float(tel["fmax"][last]))
+        monitor = StabilityMonitor(RATE, reference=lambda: reference)
         monitor.measure(tel["velocity_true"][reset:last + 1])
         assert tel["stability_score"][last] == pytest.approx(monitor.score, rel=1e-9) and monitor.score > 0
         assert tel["broken"][last] == float(monitor.broken)

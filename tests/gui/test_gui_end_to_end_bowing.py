@@ -4,7 +4,9 @@ turn and pad press a JACK MIDI message from another process (the LPD8 of test_gu
 every stroke synthesised Qt mouse events on the participant's bowing surface: press, drag left and right,
 release. Then the session's log holds each trial's gesture as performed (``hand_trace``) and every change
 of the hand's gesture both ways, export has every response, and a simulated participant replays the logged
-gesture headless. (The recorded audio's checks, issue 22 items 1-5, are added by the audio work.)
+gesture headless. The recorded audio passes the hearing-safety checks of tests/audio_checks.py (issue 22
+items 1-5): no sample above the documented peak, no step starting louder than what follows, silence with the
+bow lifted and on pages without the tone.
 """
 
 import csv
@@ -20,6 +22,7 @@ from PySide6.QtCore import QPoint, Qt
 from studyapp.experiment.export import export_responses
 from studyapp.experiment.protocol import load_protocol
 from studyapp.session.controller import PAGE_SETTLE_S
+from tests import audio_checks
 from tests.gui.conftest import ENGINE_START, ROOT, wait_until
 from tests.gui.test_gui_end_to_end import Lpd8, session_console, step_of  # noqa: F401 (a fixture)
 
@@ -140,6 +143,10 @@ def test_a_whole_sinclair2014_session_bowed_with_the_pointer(session_console, qa
     with open(folder / "audio_cues.csv", newline="") as f:
         starts = {int(row["step"]) for row in csv.DictReader(f) if row["event"] == "start"}
     assert set(bowed) <= starts
+    archive = audio_checks.read_archive(folder)
+    audio_checks.check_peak(archive)  # at most the ceiling, one 16-bit step of rounding allowed
+    audio_checks.check_start_transients(archive)
+    audio_checks.check_silences(archive)
 
     # a simulated participant replays the logged gesture (headless, the same protocol)
     done = subprocess.run([sys.executable, "-m", "studyapp", "run", "--protocol", str(SINCLAIR), "--participant",

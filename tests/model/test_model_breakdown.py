@@ -68,7 +68,7 @@ def test_over_seeds_on_the_loop_gives_each_seeds_own_search():
     assert tuple(result) == breakdown.KEYS
     assert (result["source"], result["rate"], result["gesture"], result["seeds"]) == ("LOWPASS", 5000.0, "hold", 2)
     assert all(isinstance(v, float) for v in result["fmax"])
-    assert result["fmax"] == [breakdown.breakdown_fmax("LOWPASS", duration=1.5, seed=s) for s in (0, 1)]
+    assert result["fmax"] == [breakdown.breakdown_fmax("LOWPASS", gesture="hold", duration=1.5, seed=s) for s in (0, 1)]
     assert result["fmax_median"] == pytest.approx(statistics.median(result["fmax"]))
     assert (result["fmax_min"], result["fmax_max"]) == (min(result["fmax"]), max(result["fmax"]))
 

@@ -26,7 +26,8 @@ def test_json_for_one_source_with_progress(capsys):
     out, err = capsys.readouterr()
     doc = json.loads(out)
     assert list(doc) == KEYS
-    assert (doc["source"], doc["rate"], doc["gesture"], doc["seeds"]) == ("LOWPASS", 5000.0, "hold", 2)
+    # issue 20: breakdown is judged while bowing by default
+    assert (doc["source"], doc["rate"], doc["gesture"], doc["seeds"]) == ("LOWPASS", 5000.0, "strokes", 2)
     assert len(doc["fmax"]) == 2 and all(isinstance(v, float) and v > 0 for v in doc["fmax"])
     assert doc["fmax_median"] == pytest.approx(statistics.median(doc["fmax"]))
     assert (doc["fmax_min"], doc["fmax_max"]) == (min(doc["fmax"]), max(doc["fmax"]))
@@ -49,7 +50,7 @@ def test_inf_is_null_in_json_inf_in_csv(never_broken, tmp_path, capsys):
 
 def test_all_writes_one_csv_row_per_source(tmp_path, capsys):
     out = tmp_path / "sub" / "breakdown.csv"
-    assert main(["breakdown", "--all", "--seeds", "2", "--duration", "0.5", "-o", str(out)]) == 0
+    assert main(["breakdown", "--all", "--seeds", "2", "--gesture", "hold", "--duration", "0.5", "-o", str(out)]) == 0
     with out.open() as f:
         reader = csv.DictReader(f)
         rows = list(reader)
@@ -68,11 +69,11 @@ def test_all_writes_one_csv_row_per_source(tmp_path, capsys):
 
 def test_markdown_is_headed_by_date_and_command(never_broken, tmp_path, capsys):
     out = tmp_path / "breakdown.md"
-    assert main(["breakdown", "--all", "--seeds", "2", "--gesture", "strokes", "-o", str(out)]) == 0
+    assert main(["breakdown", "--all", "--seeds", "2", "-o", str(out)]) == 0
     lines = out.read_text().splitlines()
     header = next(line for line in lines if line.startswith("Generated on"))
     assert datetime.date.today().isoformat() in header
-    assert (f"`studyapp breakdown --all --rate 5000 --seeds 2 --gesture strokes --duration 4 -o {out}`"
+    assert (f"`studyapp breakdown --all --rate 5000 --seeds 2 --gesture strokes --duration 5 -o {out}`"
             in header)
     table = [line for line in lines if line.startswith("|")]
     assert table[0] == "| " + " | ".join(COLUMNS) + " |"

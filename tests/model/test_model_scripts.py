@@ -19,15 +19,13 @@ def load(name):
     return module
 
 
-def test_the_shipped_trial_is_the_calibration():
+def test_the_shipped_trial_is_issue_11s_calibration():
+    """The script records issue 11's levers on the rigid 1 kg handle (shipped 2026-11-23 to 2026-11-25)."""
     trials = load("recalibration_trials")
     shipped = dict(trials.BASE, **trials.SHIPPED)
-    assert shipped["f0"] == calibration.F0
-    assert shipped["beta"] == calibration.BOW_POSITION
-    assert shipped["s"] == calibration.VELOCITY_SCALE
-    assert shipped["mic"] == calibration.CONTACT_MIC_GAIN
-    assert shipped["mass"] == pytest.approx(calibration.DEVICE_MASS + calibration.HAND_MASS)
-    assert shipped["speed"] == calibration.STROKE_SPEED and shipped["dwell"] == calibration.STROKE_DWELL
+    assert (shipped["f0"], shipped["beta"], shipped["s"], shipped["mic"]) == (440.0, 0.25, 1.2, 0.02)
+    assert shipped["mass"] == 1.0 and (shipped["speed"], shipped["dwell"]) == (0.04, 0.1)
+    assert shipped["f0"] == calibration.F0 and shipped["mic"] == calibration.CONTACT_MIC_GAIN
     assert [t for t in trials.TRIALS if t[2] is trials.SHIPPED]
 
 

@@ -15,10 +15,11 @@ still sounds when bowed, F_max scaling only the force fed back). Other knobs are
 An interrupted trial starts again from F_max = 0 (a sudden return to a high
 F_max could be unsafe on a real device): nothing is restored.
 
-The simulated participant (Sec. 8.2): it rests the bow on the string and holds
-the handle (gesture ``adjust_gesture``, ``hold``: the model's oscillation
-shows when the bow rests or moves slowly, while regular strokes mask it; see
-studyapp.model.stability), then from F_max = 0 raises the knob in steps of 3
+The simulated participant (Sec. 8.2): it bows with the protocol's gesture (as
+the participants bowed; ``adjust_gesture`` names another, e.g. ``hold``), and
+the loop's stability monitor judges breakdown while bowing, against the ideal
+sensor's sound and feel at the same F_max (studyapp.model.stability). From
+F_max = 0 it raises the knob in steps of 3
 to 5 positions (drawn per trial), listening ``probe_time`` seconds after each,
 until the loop's stability monitor flags breakdown (it reacts within
 ``reaction_time``) or the loop faults. The oscillation, once started,
@@ -32,8 +33,7 @@ of ``hand_jitter`` positions. If the string never breaks down it confirms at
 the top of the knob.
 
 Each F_max step is probed for ``probe_time`` = 1.2 s, longer than the
-stability monitor needs to call a breakdown (about 1 s after the oscillation
-starts, studyapp.model.stability): with shorter probes the participant kept
+stability monitor's window (1 s while bowing, studyapp.model.stability): with shorter probes the participant kept
 raising F_max past breakdown before hearing it, and confirmed two to three
 times above the F_max that model.breakdown.breakdown_fmax finds.
 """
@@ -182,7 +182,8 @@ class Adjustment:
         knob = runner.task.knob_index
         step = int(rng.integers(3, 6))
         participant.knob_values[knob] = 0
-        runner.set_gesture(participant.adjust_gesture)
+        if participant.adjust_gesture is not None:
+            runner.set_gesture(participant.adjust_gesture)
         runner.set_bowing(True)
         runner.advance(participant.reaction_time)
         value, broken = 0, False

@@ -1,0 +1,83 @@
+"""TRUE's band level while bowing: the reference the stability monitor judges a live loop against.
+
+The bowing verdict (stability.py) compares the handle's velocity in the band
+stability.BAND with what the ideal sensor gives on the same gesture at the same
+F_max. A breakdown search (breakdown.py) runs TRUE beside each trial; a live
+loop cannot, so it reads this table instead: TRUE's band level
+(stability.band_level over [SETTLE, DURATION] s of the gesture from rest) at
+F_max on a log grid GRID (0.05-200 N, 25 points, a factor 1.41 apart),
+interpolated linearly in log F_max and log level, and held constant outside the
+grid. TRUE's string stays at its pitch up to about 22 N (5 kHz); above the
+first grid point where it leaves f0 by more than stability.PITCH_TOLERANCE,
+the table holds the last healthy level (a broken TRUE is no reference).
+
+TRUE's run does not depend on the seed (it reads no sensor) and the strokes
+are deterministic, so one table per (rate, f0, gesture) serves every seed. It
+is computed on first use (about 0.3 s at 5 kHz, 3-5 s at 48 kHz) and kept for
+the process. ``live`` and ``playback`` read the strokes' table: the
+protocol's strokes stand for a person's bowing.
+"""
+
+import functools
+import math
+
+import numpy as np
+
+GRID = tuple(float(f) for f in np.geomspace(0.05, 200.0, 25))
+DURATION = 2.5  # s
+SETTLE = 0.25  # s
+TABLE_GESTURE = {"strokes": "strokes", "strokes-validation": "strokes-validation", "live": "strokes",
+                 "playback": "strokes"}
+
+
+def pitch(x, rate, fmin=100.0):
+    """Frequency (Hz) of the largest spectral peak of ``x`` above ``fmin`` (Hann window, 4x zero padding, parabolic)."""
+    x = np.asarray(x, dtype=np.float64) - np.mean(x)
+    if x.size < 8 or not np.any(x):
+        return math.nan
+    n = 1 << int(np.ceil(np.log2(x.size * 4)))
+    spec = np.abs(np.fft.rfft(x * np.hanning(x.size), n))
+    f = np.fft.rfftfreq(n, 1.0 / rate)
+    spec[f < fmin] = 0.0
+    i = int(np.argmax(spec))
+    if i == 0 or i + 1 >= spec.size or min(spec[i - 1:i + 2]) <= 0.0:
+        return float(f[i])
+    a, b, c = np.log(spec[i - 1:i + 2])
+    den = a - 2.0 * b + c
+    return float(f[i] + (0.5 * (a - c) / den if den != 0.0 else 0.0) * (f[1] - f[0]))
+
+
+def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
+    """(band level, pitch) of TRUE bowing ``gesture`` at ``fmax`` for ``duration`` s, measured after SETTLE."""
+    from studyapp.model import stability
+    from studyapp.model.loop import ClosedLoop, LoopConfig
+
+    loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
+                                 seed=seed, audio=False), judge=False)
+    block = loop.run(int(round(duration * loop.rate)))
+    start = int(round(SETTLE * loop.rate))
+    return (stability.band_level(block["velocity_true"], loop.rate, start),
+            pitch(block["string_velocity"][start:], loop.rate))
+
+
+@functools.lru_cache(maxsize=16)
+def table(rate, f0, gesture):
+    """(log F_max, log level) arrays of TRUE's band level over GRID, held after TRUE leaves its pitch."""
+    from studyapp.model import stability
+
+    levels = []
+    for fmax in GRID:
+        level, p = true_run(rate, f0, gesture, fmax)
+        if levels and not abs(p / f0 - 1.0) <= stability.PITCH_TOLERANCE:
+            level = levels[-1]
+        levels.append(max(level, 1e-12))
+    return np.log(np.array(GRID)), np.log(np.array(levels))
+
+
+def level(rate, f0, gesture, fmax):
+    """TRUE's band level (m/s) at ``fmax`` on ``gesture`` (``hold`` has none: None)."""
+    name = TABLE_GESTURE.get(gesture)
+    if name is None:
+        return None
+    log_f, log_level = table(float(rate), float(f0), name)
+    return float(np.exp(np.interp(math.log(max(fmax, GRID[0])), log_f, log_level)))
