@@ -38,7 +38,10 @@ class EngineConfig:
     telemetry_seconds: float = 4.0  # history kept in the rings
     realtime: bool = True  # ask for SCHED_FIFO for the worker's loop thread (falls back silently)
     device: str | None = None  # "module:factory" of a real device driver; None: the simulated device
-    hang_timeout: float = 0.08  # s without a heartbeat before the watchdog calls the worker hung
+    hang_timeout: float = 0.08  # s without a heartbeat before the force guard calls the worker hung
+    # s without the force guard's heartbeat before the worker switches its own force off: the guard's
+    # failure is the rarer one, so the deadline is looser than hang_timeout, sparing a loaded machine false trips
+    guard_timeout: float = 0.2
 
     def block_size(self):
         if self.block is not None:

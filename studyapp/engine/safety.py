@@ -8,9 +8,10 @@ Three layers keep a fault from leaving the device pushing:
    sample exceeded either bound.
 2. Latched faults. A non-finite value anywhere in a block (the loop latches
    its own fault the moment one appears and zeroes the force from that sample
-   on), a clamp found violated, or the parent's watchdog clearing the
-   ``force_enable`` word (the experimenter's emergency stop or the watchdog:
-   the fault says which, ``force_off_text``): the force scale goes to 0 and stays there until
+   on), a clamp found violated, or the ``force_enable`` word cleared (the
+   experimenter's emergency stop, the force guard finding the worker silent, or
+   the worker finding the guard silent, engine/guard.py: the fault says which,
+   ``force_off_text``): the force scale goes to 0 and stays there until
    ``clear()`` (an experimenter's decision, never automatic). The word is read
    twice per block: before the block runs (``before_block``), so a worker
    that was stopped or starved while the watchdog tripped computes its next
@@ -58,6 +59,9 @@ def force_off_text(reason, silence=0.0):
     if reason == "watchdog":
         return (f"watchdog: the engine stopped answering for {1e3 * silence:.0f} ms; force switched off for "
                 f"safety — {CLEAR_HINT}")
+    if reason == "guard":
+        return (f"watchdog: the force guard stopped answering for {1e3 * silence:.0f} ms; force switched off for "
+                "safety — restart the engine")
     return WATCHDOG
 
 
