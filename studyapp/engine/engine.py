@@ -65,6 +65,7 @@ from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
 from studyapp.errors import EngineError, ParameterError
+from studyapp.model.loop import GESTURES
 from studyapp.model.sources import with_pseudo_sources
 
 __all__ = ["Engine", "EngineError"]
@@ -116,8 +117,11 @@ class Engine:
         fmax = float(c.fmax)
         if not 0.0 <= fmax <= c.safety.fmax_ceiling:
             raise ParameterError(f"fmax = {c.fmax}: allowed is 0 to {c.safety.fmax_ceiling:g} N (the safety ceiling)")
+        if c.gesture not in GESTURES or c.gesture == "playback":
+            live = [g for g in GESTURES if g != "playback"]  # playback needs a recorded trajectory
+            raise ParameterError(f"gesture {c.gesture!r}: allowed are {', '.join(live)}")
         parse_audio(c.audio)
-        c.block_size()
+        c.check_sizes()
         return names
 
     def start(self, timeout=START_TIMEOUT):

@@ -6,8 +6,8 @@ stop its worker with SIGSTOP, and keep the parent busy for ``--busy`` seconds
 
 - ``python``: a pure-Python loop (bytecode: the interpreter hands its lock to
   other threads every switch interval);
-- ``gil``: one long call into C that never lets go of the interpreter's lock
-  (``sum`` over a ``range``, sized beforehand), a parent that has stopped
+- ``gil``: one call into C that never lets go of the interpreter's lock
+  (libc's ``usleep`` through ``ctypes.PyDLL``), a parent that has stopped
   answering altogether: none of its threads runs until the call returns.
 
 The force-cut time is from the SIGSTOP to the moment the ``force_enable`` word in
@@ -55,26 +55,16 @@ def _busy_python(seconds):
     return total
 
 
-def _gil_items(seconds):
-    """How many items ``sum`` over a ``range`` takes for ``seconds``: measured before any stop, since
-    the interpreter's lock is free between two calls, and the stopped worker's watchdog could run there."""
-    n = 2_000_000
-    times = []
-    for _ in range(3):
-        started = time.perf_counter()
-        sum(range(n))
-        times.append(time.perf_counter() - started)
-    return int(seconds * n / max(min(times), 1e-9))
+def _busy_gil(seconds):
+    """Sleep in C with the interpreter's lock held: ``PyDLL`` calls keep the GIL, unlike ``CDLL``'s."""
+    import ctypes
 
-
-def _busy_gil(items):
-    return sum(range(items))  # in C throughout: the interpreter's lock is never let go
-
-
+    ctypes.PyDLL(None).usleep(int(seconds * 1e6))
 
 
 def one_try(mode, busy=2.0):
-    """One SIGSTOP while the parent is busy; returns the force-cut time in s (None if the force stayed on)."""
+    """One SIGSTOP while the parent is busy; returns the force-cut time in s (None if the force stayed on,
+    "void" if it was cut before the stop: the worker starved by a loaded machine, retried by ``measure``)."""
     from studyapp.engine.config import EngineConfig
     from studyapp.engine.engine import Engine
 
@@ -90,13 +80,12 @@ def one_try(mode, busy=2.0):
                                daemon=True)
         observer.start()
         ready_in.recv()
-        items = _gil_items(busy) if mode == "gil" else 0
+        if not engine.status_block.force_enable:  # cut already (the machine starved the worker): no try
+            observer.kill()
+            return "void"
         stopped = time.monotonic()
         os.kill(engine.process.pid, signal.SIGSTOP)
-        if mode == "gil":
-            _busy_gil(items)
-        else:
-            _busy_python(busy)
+        (_busy_gil if mode == "gil" else _busy_python)(busy)
         cut = result_in.recv()
         observer.join(5.0)
         return None if cut is None else cut - stopped
@@ -108,16 +97,21 @@ def one_try(mode, busy=2.0):
 
 def measure(tries=20, busy=2.0, modes=MODES, progress=print):
     runs = {mode: [] for mode in modes}
+    void = {mode: 0 for mode in modes}
     for i in range(tries):
         for mode in modes:
             cut = one_try(mode, busy)
-            runs[mode].append(cut)
+            while cut == "void" and void[mode] < 5 * tries:
+                void[mode] += 1
+                progress(f"try {i + 1}/{tries} {mode}: the force was cut before the stop (a loaded machine); again")
+                cut = one_try(mode, busy)
+            runs[mode].append(None if cut == "void" else cut)
             progress(f"try {i + 1}/{tries} {mode}: " + ("force never cut" if cut is None else f"{1e3 * cut:.1f} ms"))
     summary = {}
     for mode, cuts in runs.items():
         seen = [c for c in cuts if c is not None]
         summary[mode] = {
-            "tries": len(cuts), "never_cut": len(cuts) - len(seen),
+            "tries": len(cuts), "never_cut": len(cuts) - len(seen), "void_tries": void[mode],
             "median_ms": 1e3 * statistics.median(seen) if seen else None,
             "max_ms": 1e3 * max(seen) if seen else None,
             "cuts_ms": [None if c is None else round(1e3 * c, 2) for c in cuts],

@@ -2,8 +2,9 @@
 
 Three layers keep a fault from leaving the device pushing:
 
-1. Clamps. F_max is clamped to the protocol's ceiling (``SafetyLimits.fmax_ceiling``)
-   before the loop sees it; inside the loop the force is clamped to the motor
+1. Clamps. F_max is clamped to the protocol's ceiling (``SafetyLimits.fmax_ceiling``,
+   from ``Protocol.fmax_ceiling`` for a session, the console's preview and
+   ``live --protocol``; the motors' sustained limit otherwise) before the loop sees it; inside the loop the force is clamped to the motor
    limits (model/device.py). After each block ``check`` verifies that no
    sample exceeded either bound.
 2. Latched faults. A non-finite value anywhere in a block (the loop latches
@@ -46,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from studyapp.errors import ParameterError
+from studyapp.model.device import DeviceLimits
 
 
 WATCHDOG = "watchdog: the parent switched the force off"
@@ -67,7 +69,7 @@ def force_off_text(reason, silence=0.0):
 
 @dataclass(frozen=True)
 class SafetyLimits:
-    fmax_ceiling: float = 60.0  # N; the motors' sustained limit unless the protocol sets a lower one
+    fmax_ceiling: float = DeviceLimits().sustained  # N: the motors' 60 N unless the protocol sets a lower one
     velocity_bound: float = 0.3  # m/s; bowing strokes move at a few cm/s
     saturation: float = 0.95  # fraction of the motor's sustained limit that counts as saturated
     window: float = 0.25  # s

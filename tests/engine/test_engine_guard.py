@@ -6,6 +6,7 @@ interpreter's lock), and the worker switches its own force off when the guard
 goes silent. The times are measured by ``studyapp bench force-cut``.
 """
 
+import ctypes
 import os
 import signal
 import time
@@ -22,12 +23,8 @@ RATE = 5000.0
 
 
 def _hold_the_interpreter(seconds):
-    """Return after about ``seconds`` spent in one C call that never releases the GIL."""
-    n = 1_000_000
-    started = time.perf_counter()
-    sum(range(n))
-    items = int(seconds * n / max(time.perf_counter() - started, 1e-9))
-    sum(range(items))
+    """Sleep ``seconds`` in C with the GIL held (``PyDLL`` keeps it): no thread of this process runs."""
+    ctypes.PyDLL(None).usleep(int(seconds * 1e6))
 
 
 def test_the_guard_clears_the_word_for_a_silent_running_worker_only():
