@@ -51,8 +51,10 @@ def _recording_rate(path, recorded, given):
 
     if given is None:
         return recorded
+    from studyapp.number_text import to_float
+
     try:
-        value = float(given)
+        value = to_float(given)
     except ValueError:
         value = math.nan
     if not math.isclose(value, recorded, rel_tol=1e-6):

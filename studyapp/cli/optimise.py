@@ -79,8 +79,7 @@ def run(args):
     if output.suffix.lower() != ".toml":
         raise UserError(f"-o {output}: expected a .toml file")
     output_paths.check_file(output)
-    if args.max_lag <= 0:
-        raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
+    delay_option.check_max_lag(args.max_lag)
     if args.patience < 1:
         raise UserError(f"--patience {args.patience}: allowed is an integer of at least 1")
     if args.max_sets is not None and args.max_sets < 1:
@@ -168,6 +167,7 @@ def parse_ranges(items):
     """``NAME.PARAM=LOW:HIGH`` items as {NAME: {PARAM: (low, high)}}."""
     from studyapp.errors import UserError
     from studyapp.estimators.registry import spec
+    from studyapp.number_text import to_float
 
     ranges = {}
     for item in items:
@@ -175,7 +175,7 @@ def parse_ranges(items):
         name, _, param = key.partition(".")
         low, _, high = bounds.partition(":")
         try:
-            pair = (float(low), float(high))
+            pair = (to_float(low), to_float(high))
         except ValueError:
             raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=1:128") from None
         if not name or not param:

@@ -42,8 +42,10 @@ from pathlib import Path
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, open_file
+from studyapp.small_files import read_regular
 
 DAMAGED_SUFFIX = ".damaged"
+LOG_LIMIT = 1 << 30  # bytes: a long study's log is a few MB; above this it is not a session log
 TORN_SUFFIX = ".torn-"
 _CRC_TAIL = re.compile(rb',"crc":"([0-9a-f]{8})"\}$')
 
@@ -119,9 +121,10 @@ def scan(data):
 
 
 def read_log(path):
-    """``scan`` of the log at ``path`` (empty when there is none)."""
+    """``scan`` of the log at ``path`` (empty when there is none); ``UserError`` for a FIFO or device
+    (never read: it would block or never end) or a log above ``LOG_LIMIT``."""
     try:
-        return scan(Path(path).read_bytes())
+        return scan(read_regular(path, "session log (events.jsonl)", LOG_LIMIT))
     except FileNotFoundError:
         return LogScan()
 
@@ -164,7 +167,7 @@ class SessionLog:
     def _open(self, existed):
         if not existed:
             fsync_directory(self.path.parent)
-        data = self.path.read_bytes()
+        data = read_regular(self.path, "session log (events.jsonl)", LOG_LIMIT)
         log = scan(data)
         self._size = len(data) - len(log.torn)
         self.seq = max((e["seq"] for e in log.events if isinstance(e.get("seq"), int)), default=-1) + 1
