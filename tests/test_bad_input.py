@@ -392,6 +392,11 @@ CASES_21 = {
     # item 11: sizes bounded before any allocation
     "live-block-1e9": [*LIVE, "--block", "1000000000"],
     "live-block-above-half-the-watchdog": [*LIVE, "--block", "201"],
+    "estimate-block-1e12": ["estimate", "{in}/good.csv", *ESTIMATE, "--block", "1000000000000"],
+    "bench-estimators-samples-1e12": ["bench", "estimators", "--samples", "1000000000000"],
+    "bench-memory-rows-1e12": ["bench", "memory", "--rows", "1000000000000"],
+    "bench-memory-block-1e12": ["bench", "memory", "--rows", "1000", "--block", "1000000000000"],
+    "tradeoff-cost-samples-1e12": [*TRADEOFF, "-o", "{out}/t", "--cost-samples", "1000000000000"],
     # item 12: live refuses before the worker starts
     "live-gesture-nope": [*LIVE, "--gesture", "NOPE"],
     "live-gesture-playback": [*LIVE, "--gesture", "playback"],
