@@ -37,11 +37,12 @@ WATCHED = "running"  # the worker's state in which its heartbeat must keep comin
 DONE = ("stopped", "failed")
 
 
-def main(status_name, hang_timeout, priority):
-    """Entry point of the guard process (spawned by ``Engine.start``)."""
+def main(status_name, hang_timeout, priority=None):
+    """Entry point of the guard process (spawned by ``Engine.start``); ``priority``: SCHED_FIFO's, or None."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     parent = os.getppid()
-    _try_realtime(priority)
+    if priority is not None:  # None: the engine runs without real-time priority, and so does its guard
+        _try_realtime(priority)
     status = StatusBlock.attach(status_name)
     try:
         watch(status, hang_timeout, lambda: os.getppid() == parent)
