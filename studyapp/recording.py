@@ -127,7 +127,15 @@ def load(path):
         raise
     except Exception as exc:  # any parser failure is a bad input file, reported in one line
         raise InputDataError(f"{path}: not a readable {suffix} recording ({type(exc).__name__}: {exc})") from None
+    if not columns or not any(len(values) for values in columns.values()):
+        raise InputDataError(f"{path}: no samples: allowed is a recording of at least one sample")
     rate = meta.get("rate")
+    if rate is not None:
+        try:  # metadata is any JSON: "abc" or a list is no rate
+            rate = float(rate)
+        except (TypeError, ValueError):
+            raise InputDataError(f"{path}: metadata 'rate' = {rate!r}: allowed is a sample rate in Hz "
+                                 "(a positive number)") from None
     if rate is None and "t" in columns and len(columns["t"]) > 1:
         # t is k / rate printed to 17 digits: the rate comes back to within rounding
         span = float(columns["t"][-1] - columns["t"][0])
@@ -164,7 +172,12 @@ def _load_h5(path):
     with h5py.File(path, "r") as f:
         raw = f.attrs.get("meta", "{}")
         meta = parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), path)
-        columns = {k: np.asarray(f[k][()], dtype=np.float64) for k in f.keys()}
+        columns = {}
+        for k in f.keys():
+            dtype = getattr(f[k], "dtype", None)  # a group has none
+            if dtype is None or dtype.kind not in "biuf":
+                raise InputDataError(f"{path}: column {k!r} holds {dtype or 'a group'}, not numbers")
+            columns[k] = np.asarray(f[k][()], dtype=np.float64)
     return columns, meta
 
 

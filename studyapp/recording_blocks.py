@@ -73,6 +73,9 @@ class RecordingBlocks:
                                  f"got shapes {sorted(set(shapes.values()))}")
         self.names = list(shapes)
         self.length = next(iter(shapes.values()))[0]
+        if self.length == 0:
+            self.close()
+            raise InputDataError(f"{path}: no samples: allowed is a recording of at least one sample")
         self.rate = self._rate()
 
     def _open_npz(self):
@@ -100,7 +103,13 @@ class RecordingBlocks:
         self._h5 = h5py.File(self.path, "r")
         raw = self._h5.attrs.get("meta", "{}")
         self.meta = parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), self.path)
-        return {name: self._h5[name].shape for name in self._h5.keys()}
+        shapes = {}
+        for name in self._h5.keys():
+            dtype = getattr(self._h5[name], "dtype", None)  # a group has none
+            if dtype is None or dtype.kind not in "biuf":
+                raise InputDataError(f"{self.path}: column {name!r} holds {dtype or 'a group'}, not numbers")
+            shapes[name] = self._h5[name].shape
+        return shapes
 
     def _rate(self):
         rate = self.meta.get("rate")

@@ -21,6 +21,8 @@ import stat
 import numpy as np
 
 from studyapp.errors import InputDataError
+from studyapp.number_text import to_float
+from studyapp.small_files import NotARegularFile, open_regular
 
 
 class SampleTable:
@@ -28,8 +30,10 @@ class SampleTable:
 
     def __init__(self, path, required=("position",)):
         self.path = str(path)
-        try:
-            self._file = open(path, newline="", encoding="utf-8-sig")
+        try:  # opened without blocking: a FIFO is refused at once, not waited on
+            self._file = open_regular(path, "CSV", "r", newline="", encoding="utf-8-sig")
+        except NotARegularFile as exc:
+            raise InputDataError(str(exc)) from None
         except FileNotFoundError:
             raise InputDataError(f"{path}: no such file") from None
         except IsADirectoryError:
@@ -81,14 +85,16 @@ class SampleTable:
             yield rows, {name: self._floats(rows, lines, j, name) for name, j in indices.items()}
 
     def _floats(self, rows, lines, j, name):
-        try:
-            return np.array([row[j] for row in rows], dtype=np.float64)  # float() per cell, in C
-        except ValueError:
-            pass
+        cells = [row[j] for row in rows]
+        if "_" not in "".join(cells):  # numpy, like float(), reads "1_0" as 10 (studyapp.number_text)
+            try:
+                return np.array(cells, dtype=np.float64)  # float() per cell, in C
+            except ValueError:
+                pass
         out = np.empty(len(rows))
         for i, row in enumerate(rows):  # find the cell to name
             try:
-                out[i] = float(row[j])
+                out[i] = to_float(row[j])
             except ValueError:
                 raise InputDataError(
                     f"{self.path}: line {lines[i]}, column {name!r}: {row[j].strip()!r} is not a number"

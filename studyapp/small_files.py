@@ -1,7 +1,11 @@
 """Read a small text file a person gave us (a protocol, a parameter file) without trusting it.
 
-Only a regular file is read (``/dev/zero`` or a FIFO would never end), and at
-most ``LIMIT_BYTES`` of it: such files are a few kilobytes, so a larger one is
+Only a regular file is read (``/dev/zero`` or ``/dev/urandom`` would never
+end), and it is opened without blocking, so a FIFO is refused at once instead
+of waiting forever for a writer (``open_regular``, for every reader of a file
+a person or a crash could have replaced: protocols, parameter files, CSV
+inputs, a session's session.json and events.jsonl). At most ``LIMIT_BYTES`` of
+a small file is read: such files are a few kilobytes, so a larger one is
 refused before it costs memory or parse time. TOML nested deeper than Python's
 recursion limit is refused too (``tomllib`` would raise ``RecursionError``).
 Every problem is one ``UserError`` naming the file.
@@ -17,22 +21,50 @@ from studyapp.errors import UserError
 LIMIT_BYTES = 1 << 20
 
 
+class NotARegularFile(UserError, OSError):
+    """The path names a FIFO, a device, a socket: never read (an ``OSError`` too, for callers that skip those)."""
+
+
+def open_regular(path, what, mode="rb", **kwargs):
+    """``open(path, mode)`` for reading, for a regular file only (``NotARegularFile`` otherwise).
+
+    The file is opened with ``O_NONBLOCK`` (a FIFO opens at once instead of waiting for a
+    writer), its type checked on the open descriptor, then blocking restored. Other failures
+    are the usual ``OSError`` (``FileNotFoundError``, ``IsADirectoryError``, ...).
+    """
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise NotARegularFile(f"{path}: not a regular file (a FIFO, device or socket): allowed is a {what} file")
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, mode, **kwargs)
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_regular(path, what, limit):
+    """The bytes of the regular file ``path``, at most ``limit`` of them (``UserError`` if larger)."""
+    with open_regular(path, what) as f:
+        data = f.read(limit + 1)
+    if len(data) > limit:
+        raise UserError(f"{path}: larger than {limit >> 20} MB: allowed is a {what} file up to that size")
+    return data
+
+
 def read_bytes(path, what):
     """The bytes of the regular file ``path`` (``what`` names it in messages, e.g. "protocol")."""
     path = Path(path)
     try:
-        with open(path, "rb") as f:
-            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
-                raise UserError(f"{path}: not a regular file: allowed is a {what} file")
-            data = f.read(LIMIT_BYTES + 1)
+        data = read_regular(path, what, LIMIT_BYTES)
     except FileNotFoundError:
         raise UserError(f"{path}: cannot read the {what}: no such file") from None
     except IsADirectoryError:
         raise UserError(f"{path}: is a folder: allowed is a {what} file") from None
+    except UserError:
+        raise
     except OSError as exc:
         raise UserError(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
-    if len(data) > LIMIT_BYTES:
-        raise UserError(f"{path}: larger than {LIMIT_BYTES >> 20} MB: allowed is a {what} file up to that size")
     return data
 
 

@@ -364,3 +364,192 @@ def test_plan_and_notes_bad_input_is_refused_in_one_line(case, inputs, tmp_path,
     err = capsys.readouterr().err
     assert_refused(code, err, before[:2], (_tree(inputs), _tree(out)))
     assert (out / "p.toml").read_bytes() == before[2]
+
+
+# ---------------------------------------------------------------------------------------------------
+# Issue 21, items 11-15 (force safety and bad input; wt-forcesafe). Items 9-10 are in
+# tests/engine/test_engine_ceiling.py, tests/engine/test_engine_guard.py and
+# tests/experiment/test_experiment_validation.py. Inputs of their own, so this block stands alone.
+# ---------------------------------------------------------------------------------------------------
+
+RESPONSE_HEADER = "participant,session,task,condition,trial,fmax,rating,time,protocol_hash\n"
+
+
+def _npz(path, columns, meta):
+    import json
+
+    np.savez(path, __meta__=np.array(json.dumps(meta)), **columns)
+
+
+def _signal():
+    from studyapp.synthetic import stick_slip
+
+    return stick_slip(RATE, 0.1, seed=1)
+
+
+@pytest.fixture(scope="module")
+def inputs21(tmp_path_factory):
+    import h5py
+
+    d = tmp_path_factory.mktemp("inputs21")
+    sig = _signal()
+    _npz(d / "rate_abc.npz", sig, {"rate": "abc"})
+    _npz(d / "rate_list.npz", sig, {"rate": [1, 2]})
+    _npz(d / "fmax_abc.npz", sig, {"rate": RATE, "fmax": "abc"})
+    _npz(d / "zero.npz", {k: np.zeros(0) for k in sig}, {"rate": RATE})
+    _npz(d / "nan.npz", {k: np.full_like(v, np.nan) for k, v in sig.items()}, {"rate": RATE})
+    _npz(d / "nan_position.npz", {k: (np.full_like(v, np.nan) if k == "position" else v) for k, v in sig.items()},
+         {"rate": RATE})
+    with h5py.File(d / "zero.h5", "w") as f:
+        f.attrs["meta"] = '{"rate": 5000.0}'
+        for k in sig:
+            f.create_dataset(k, data=np.zeros(0))
+    with h5py.File(d / "compound.h5", "w") as f:
+        f.attrs["meta"] = '{"rate": 5000.0}'
+        f.create_dataset("position", data=np.zeros(10, dtype=[("a", "f8"), ("b", "i4")]))
+    (d / "cell_1_0.csv").write_text("position\n" + "".join(f"{0.001 * i!r}\n" for i in range(20)) + "1_0\n")
+    (d / "trial_1e12.csv").write_text(RESPONSE_HEADER + "p1,1,adjustment,LVT,1000000000000,2.5,,1.0,abc\n"
+                                      "p1,1,adjustment,LOWPASS,1,2.0,,1.0,abc\n")
+    (d / "fmax_1e308.csv").write_text(RESPONSE_HEADER + "p1,1,adjustment,LVT,1,1e308,,1.0,abc\n"
+                                      "p1,1,adjustment,LOWPASS,1,2.0,,1.0,abc\n")
+    (d / "cell_1_0_responses.csv").write_text(RESPONSE_HEADER + "p1,1,adjustment,LVT,1,1_0,,1.0,abc\n")
+    _results(d / "results_step_1e30", event={"step": 10**30})
+    _results(d / "results_step_1e30_float", event={"step": 1e30})
+    _results(d / "results_fmax_1e308", event={"fmax": 1e308})
+    _results(d / "results_trial_1e12", event={"trial": 10**12})
+    os.mkfifo(d / "fifo.toml")
+    os.mkfifo(d / "fifo.csv")
+    for name, file in (("session_fifo", "session.json"), ("events_fifo", "events.jsonl"),
+                       ("events_urandom", "events.jsonl")):
+        folder = next(p.parent for p in _results(d / f"results_{name}").rglob("events.jsonl"))
+        (folder / file).unlink()
+        if name == "events_urandom":
+            (folder / file).symlink_to("/dev/urandom")
+        else:
+            os.mkfifo(folder / file)
+    yield d
+
+
+SIMULATE21 = ["simulate", "--duration", "0.05", "-o", "{out}/s.npz"]
+ANALYSE21 = ["-o", "{out}/rep"]
+
+CASES_21 = {
+    # item 11: sizes bounded before any allocation
+    "live-block-1e9": [*LIVE, "--block", "1000000000"],
+    "live-block-above-half-the-watchdog": [*LIVE, "--block", "201"],
+    "estimate-block-1e12": ["estimate", "{in}/good.csv", *ESTIMATE, "--block", "1000000000000"],
+    "bench-estimators-samples-1e12": ["bench", "estimators", "--samples", "1000000000000"],
+    "bench-memory-rows-1e12": ["bench", "memory", "--rows", "1000000000000"],
+    "bench-memory-block-1e12": ["bench", "memory", "--rows", "1000", "--block", "1000000000000"],
+    "tradeoff-cost-samples-1e12": [*TRADEOFF, "-o", "{out}/t", "--cost-samples", "1000000000000"],
+    # item 12: live refuses before the worker starts
+    "live-gesture-nope": [*LIVE, "--gesture", "NOPE"],
+    "live-gesture-playback": [*LIVE, "--gesture", "playback"],
+    "live-audio-wav-unwritable-folder": [*LIVE, "--audio", "wav:/sys/a.wav"],
+    "live-audio-wav-proc": [*LIVE, "--audio", "wav:/proc/a.wav"],
+    # item 14: tracebacks
+    "evaluate-meta-rate-abc": ["evaluate", "{in21}/rate_abc.npz"],
+    "evaluate-meta-rate-list": ["evaluate", "{in21}/rate_list.npz"],
+    "evaluate-meta-fmax-abc": ["evaluate", "{in21}/fmax_abc.npz"],
+    "optimise-meta-rate-abc": [*OPTIMISE, "{in21}/rate_abc.npz", "-o", "{out}/p.toml"],
+    "optimise-meta-rate-list": [*OPTIMISE, "{in21}/rate_list.npz", "-o", "{out}/p.toml"],
+    "estimate-h5-compound": ["estimate", "{in21}/compound.h5", "--estimator", "LOWPASS", "-o", "{out}/e.csv"],
+    "evaluate-h5-compound": ["evaluate", "{in21}/compound.h5"],
+    "optimise-max-lag-1e308": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--max-lag", "1e308"],
+    "evaluate-max-lag-1e308": ["evaluate", "{in}/rec.npz", "--max-lag", "1e308"],
+    "export-step-1e30": ["export", "{in21}/results_step_1e30", "-o", "{out}/x.csv"],
+    "export-step-1e30-float": ["export", "{in21}/results_step_1e30_float", "-o", "{out}/x.csv"],
+    "analyse-step-1e30": ["analyse", "{in21}/results_step_1e30", *ANALYSE21],
+    "analyse-trial-1e12-event": ["analyse", "{in21}/results_trial_1e12", *ANALYSE21],
+    "analyse-csv-trial-1e12": ["analyse", "{in21}/trial_1e12.csv", *ANALYSE21],
+    "analyse-trials-1e20": ["analyse", "{in}/results_good", *ANALYSE21, "--trials", "99999999999999999999"],
+    "analyse-csv-fmax-1e308": ["analyse", "{in21}/fmax_1e308.csv", *ANALYSE21],
+    "analyse-fmax-1e308": ["analyse", "{in21}/results_fmax_1e308", *ANALYSE21],
+    # item 15: too lenient
+    "simulate-rate-5_000": [*SIMULATE21, "--rate", "5_000"],
+    "simulate-seed-1_0": [*SIMULATE21, "--seed", "1_0"],
+    "estimate-rate-5_000": ["estimate", "{in}/good.csv", "--estimator", "LOWPASS", "--rate", "5_000",
+                            "-o", "{out}/e.csv"],
+    "estimate-set-1_0": ["estimate", "{in}/good.csv", *ESTIMATE, "--set", "cutoff_hz=25_0"],
+    "estimate-csv-cell-1_0": ["estimate", "{in21}/cell_1_0.csv", *ESTIMATE],
+    "analyse-csv-cell-1_0": ["analyse", "{in21}/cell_1_0_responses.csv", *ANALYSE21],
+    "estimate-zero-row-npz": ["estimate", "{in21}/zero.npz", "--estimator", "LOWPASS", "-o", "{out}/e.csv"],
+    "estimate-zero-row-h5": ["estimate", "{in21}/zero.h5", "--estimator", "LOWPASS", "-o", "{out}/e.csv"],
+    "evaluate-zero-row-npz": ["evaluate", "{in21}/zero.npz"],
+    "simulate-duration-1e-300": ["simulate", "--duration", "1e-300", "-o", "{out}/s.npz"],
+    "evaluate-all-nan": ["evaluate", "{in21}/nan.npz"],
+    "optimise-all-nan": [*OPTIMISE, "{in21}/nan.npz", "-o", "{out}/p.toml"],
+    "evaluate-position-nan-reference-true": ["evaluate", "{in21}/nan_position.npz", "--reference", "true"],
+    "optimise-position-nan-reference-true": [*OPTIMISE, "{in21}/nan_position.npz", "--reference", "true",
+                                             "-o", "{out}/p.toml"],
+    "export-strict-fmax-1e308": ["export", "{in21}/results_fmax_1e308", "-o", "{out}/x.csv", "--strict"],
+    "estimate-path-with-newline": ["estimate", "{in21}/no\nsuch.csv", *ESTIMATE],
+    "estimate-value-with-newline": ["estimate", "{in}/good.csv", "--estimator", "LOW\nPASS", "--rate", "5000",
+                                    "-o", "{out}/e.csv"],
+    "run-participant-with-newline": ["run", "--participant", "p\n1", "--simulated-participant", "--headless",
+                                     "--results", "{out}/r", "--protocol", PROTOCOL],
+}
+
+
+def _argv21(template, inputs, inputs21, out):
+    return [a.replace("{in21}", str(inputs21)) for a in _argv(template, inputs, out)]
+
+
+@pytest.mark.parametrize("case", list(CASES_21))
+def test_issue21_bad_input_is_refused_in_one_line(case, inputs, inputs21, tmp_path, capsys, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    monkeypatch.chdir(out)
+    before = ((_tree(inputs), _tree(inputs21)), _tree(out))
+    code = main(_argv21(CASES_21[case], inputs, inputs21, out))
+    err = capsys.readouterr().err
+    assert_refused(code, err, before, ((_tree(inputs), _tree(inputs21)), _tree(out)))
+
+
+# item 13: each in a child process, so that a FIFO that blocks fails the test (timeout) instead of hanging it
+FIFO_CASES = {
+    "run-protocol-fifo": [*RUN, "--results", "{out}/r", "--protocol", "{in21}/fifo.toml"],
+    "gui-protocol-fifo": ["gui", "--protocol", "{in21}/fifo.toml"],
+    "estimate-csv-fifo": ["estimate", "{in21}/fifo.csv", *ESTIMATE],
+    "evaluate-params-fifo": ["evaluate", "{in}/rec.npz", "--params", "{in21}/fifo.toml"],
+    "tradeoff-params-fifo": [*TRADEOFF, "-o", "{out}/t", "--params", "{in21}/fifo.toml"],
+    "export-events-fifo": ["export", "{in21}/results_events_fifo", "-o", "{out}/x.csv"],
+    "analyse-events-fifo": ["analyse", "{in21}/results_events_fifo", *ANALYSE21],
+    "export-events-urandom": ["export", "{in21}/results_events_urandom", "-o", "{out}/x.csv"],
+    "analyse-events-urandom": ["analyse", "{in21}/results_events_urandom", *ANALYSE21],
+}
+
+
+def _child(argv, out):
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    env.pop("DISPLAY", None)
+    env.pop("WAYLAND_DISPLAY", None)
+    return subprocess.run([sys.executable, "-m", "studyapp", *argv], capture_output=True, text=True, timeout=120,
+                          env=env, cwd=out, preexec_fn=_limit_memory)
+
+
+@pytest.mark.parametrize("case", list(FIFO_CASES))
+def test_issue21_a_fifo_or_device_is_refused_without_blocking(case, inputs, inputs21, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    before = ((_tree(inputs), _tree(inputs21)), _tree(out))
+    proc = _child(_argv21(FIFO_CASES[case], inputs, inputs21, out), out)
+    assert_refused(proc.returncode, proc.stderr, before, ((_tree(inputs), _tree(inputs21)), _tree(out)))
+
+
+def test_issue21_a_session_json_fifo_is_read_as_damaged_with_a_warning(inputs, inputs21, tmp_path):
+    # Without --strict a damaged session.json is a warning and its content comes from events.jsonl: a FIFO is
+    # such damage, reported at once (never waited on).
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = _child(["export", str(inputs21 / "results_session_fifo"), "-o", str(out / "x.csv")], out)
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr
+    assert "session.json" in proc.stderr and "not a regular file" in proc.stderr
+    assert (out / "x.csv").read_text().count("\n") == 2  # the header and the one response
+    for argv in (["export", str(inputs21 / "results_session_fifo"), "-o", str(out / "y.csv"), "--strict"],
+                 ["analyse", str(inputs21 / "results_session_fifo"), "-o", str(out / "rep"), "--strict"]):
+        proc = _child(argv, out)  # --strict: the warning, then the refusal; nothing written
+        lines = proc.stderr.strip().splitlines()
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr and "not a regular file" in lines[0]
+        assert lines[-1].startswith("studyapp: error: ") and "--strict" in lines[-1]
+        assert not (out / "y.csv").exists() and not (out / "rep").exists()

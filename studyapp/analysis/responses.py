@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.experiment.event_fields import TRIAL_MAX
 from studyapp.experiment.tasks import task_names, task_type
 
 REQUIRED_COLUMNS = ["participant", "task", "condition", "trial", "fmax", "rating"]
@@ -135,10 +136,11 @@ def check_responses(frame, label, csv_rows=False, include_practice=False, includ
     for column in ["trial", "fmax", "rating"]:
         frame[column] = _numbers(frame[column], column, label, where)
     trials = frame["trial"].dropna()
-    bad_trial = (trials < 1) | (trials != np.round(trials))
+    bad_trial = (trials < 1) | (trials > TRIAL_MAX) | (trials != np.round(trials))  # 1e12 would be a MemoryError
     if bad_trial.any():
         i = int(bad_trial.index[np.flatnonzero(bad_trial)[0]])
-        raise InputDataError(f"{label}: column 'trial' at {where(i)} is {frame['trial'][i]:g}; allowed: 1, 2, 3, ...")
+        raise InputDataError(f"{label}: column 'trial' at {where(i)} is {frame['trial'][i]:g}; "
+                             f"allowed: 1, 2, 3, ... {TRIAL_MAX}")
     for task in MEASURED_TASKS:
         measure = task_type(task).measure
         values = frame[measure.column].where(frame["task"] == task)

@@ -8,7 +8,8 @@ malformed command line (argparse's own usage dump is several lines), a
 number option that is not finite, a negative ``--seed`` (``number_options``),
 and a file that cannot be written (an ``OSError``: a full disk, a read-only
 folder), which names the file. An ``EngineError`` (the real-time engine
-failed, not the user) is one line and exit code 1.
+failed, not the user) is one line and exit code 1. One line even when the
+path or value named holds a newline: it is shown escaped (``one_line``).
 """
 
 import argparse
@@ -84,10 +85,10 @@ def main(argv=None):
                 return 0
         return args.func(args) or 0
     except UserError as exc:
-        print(f"studyapp: error: {exc}", file=sys.stderr)
+        print(f"studyapp: error: {one_line(exc)}", file=sys.stderr)
         return 2
     except EngineError as exc:
-        print(f"studyapp: error: {exc}", file=sys.stderr)
+        print(f"studyapp: error: {one_line(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("studyapp: interrupted", file=sys.stderr)
@@ -101,5 +102,10 @@ def main(argv=None):
     except OSError as exc:
         # the outputs are atomic (studyapp.atomic): a failed write leaves no partial file to mention
         where = f"{exc.filename}: " if exc.filename else ""
-        print(f"studyapp: error: {where}{exc.strerror or exc}: nothing written", file=sys.stderr)
+        print(f"studyapp: error: {one_line(f'{where}{exc.strerror or exc}')}: nothing written", file=sys.stderr)
         return 2
+
+
+def one_line(message):
+    """``message`` on one line: a path or value holding a newline is shown with it escaped, as repr() does."""
+    return str(message).replace("\r", "\\r").replace("\n", "\\n")

@@ -56,11 +56,12 @@ def run(args):
     from studyapp.analysis.study import analyse
     from studyapp.cli import output_paths
     from studyapp.errors import ParameterError, UserError
+    from studyapp.experiment.event_fields import TRIAL_MAX
 
     if not 0.0 < args.alpha < 1.0:
         raise ParameterError(f"--alpha {args.alpha:g}: allowed 0 < alpha < 1")
-    if args.trials is not None and args.trials < 1:
-        raise ParameterError(f"--trials {args.trials}: allowed an integer >= 1")
+    if args.trials is not None and not 1 <= args.trials <= TRIAL_MAX:
+        raise ParameterError(f"--trials {args.trials}: allowed an integer from 1 to {TRIAL_MAX}")
 
     def say(message):
         print(f"studyapp analyse: {message}", file=sys.stderr, flush=True)

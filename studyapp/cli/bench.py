@@ -1,4 +1,4 @@
-"""``studyapp bench estimators|loop|live|midi|memory``: speed and memory, measured, never asserted in tests."""
+"""``studyapp bench estimators|loop|live|midi|memory|force-cut``: speed and memory, measured, never asserted in tests."""
 
 
 def register(sub):
@@ -38,6 +38,14 @@ def register(sub):
     p.add_argument("--dir", metavar="DIR", help="where the temporary inputs go (default: the system's temp folder)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.cli.memory_benchmark"))
+
+    p = kinds.add_parser("force-cut", help="time from a stopped worker to its force cut, with the parent busy")
+    p.add_argument("--tries", type=int, default=20, metavar="N", help="tries per mode (default 20)")
+    p.add_argument("--busy", type=float, default=2.0, help="seconds the parent stays busy (default 2)")
+    p.add_argument("--mode", choices=("python", "gil", "both"), default="both",
+                   help="python: a pure-Python loop; gil: one C call holding the interpreter's lock (default both)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.engine.force_cut_benchmark"))
 
 
 def _run(module):

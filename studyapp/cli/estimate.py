@@ -16,6 +16,7 @@ further down stay written.
 """
 
 DEFAULT_BLOCK = 1 << 16  # samples: about 5 MB of a 9-column recording as text
+BLOCK_MAX = 1 << 24  # samples: ~1.3 GB of such text; a larger --block is a typo, not a wish
 
 
 def register(sub):
@@ -51,8 +52,10 @@ def _recording_rate(path, recorded, given):
 
     if given is None:
         return recorded
+    from studyapp.number_text import to_float
+
     try:
-        value = float(given)
+        value = to_float(given)
     except ValueError:
         value = math.nan
     if not math.isclose(value, recorded, rel_tol=1e-6):
@@ -120,8 +123,8 @@ def run(args):
     from studyapp.errors import ParameterError
     from studyapp.sample_table import write_header, write_rows
 
-    if args.block < 1:
-        raise ParameterError(f"--block {args.block}: allowed is an integer of at least 1")
+    if not 1 <= args.block <= BLOCK_MAX:  # a block's rows are held in memory at once
+        raise ParameterError(f"--block {args.block}: allowed is an integer from 1 to {BLOCK_MAX}")
     settings = parse_settings(args.set)
     if args.output:
         output_paths.check_file(args.output, inputs=[args.input])

@@ -50,8 +50,7 @@ def run(args):
     from studyapp.evaluation.provenance import provenance
     from studyapp.evaluation.report import evaluate
 
-    if args.max_lag <= 0:
-        raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
+    delay_option.check_max_lag(args.max_lag)
     output = Path(args.output) if args.output else None
     if output is not None:
         output_paths.check_folder(output, inputs=[*args.recordings, *filter(None, [args.params, args.validation])])

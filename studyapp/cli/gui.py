@@ -74,6 +74,10 @@ def run(args):
     check_experimenter(args.experimenter)
     check_session_number(args.session_number)
     check_notes(args.notes)
+    if args.protocol:  # a bad protocol (a FIFO, a device, a bad field) is one line before any window opens
+        from studyapp.experiment.protocol import load_protocol
+
+        load_protocol(args.protocol)
     require_display()
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")

@@ -6,7 +6,10 @@ JSON object on stdout at exit:
 "events_dropped", ...}``; ``events_dropped`` counts the worker's events (MIDI control events, notices)
 that its event ring overwrote before this process read them.
 Stops after ``--seconds`` or on Ctrl-C / SIGTERM, always cleanly (no orphan
-process, no shared memory left behind).
+process, no shared memory left behind). With ``--protocol`` the protocol's
+F_max ceiling is the worker's hard clamp (experiment/protocol.py); without it,
+the motors' sustained limit. Every setting is checked before the worker starts:
+a bad one is one line, exit 2.
 """
 
 
@@ -14,7 +17,9 @@ def register(sub):
     p = sub.add_parser("live", help="run the haptic loop in real time (audio out, MIDI knobs in)")
     p.add_argument("--rate", type=float, default=5000.0, help="haptic rate in Hz (default 5000)")
     p.add_argument("--source", default=None, help="velocity source: an estimator, LVT or TRUE (default LVT)")
-    p.add_argument("--fmax", type=float, default=1.0, help="F_max in N (default 1)")
+    p.add_argument("--fmax", type=float, default=1.0, help="F_max in N (default 1), at most the ceiling")
+    p.add_argument("--protocol", metavar="FILE",
+                   help="a study protocol whose F_max ceiling clamps the force (default: the motors' 60 N)")
     p.add_argument("--estimators", default=None,
                    help="active estimators: comma-separated names or 'all' (default: just the source)")
     p.add_argument("--audio", default="device",
@@ -81,6 +86,11 @@ def run(args):
         fmax=args.fmax, gesture=args.gesture, seed=args.seed, block=args.block, audio=args.audio,
         midi=args.midi,
     )
+    if args.protocol is not None:
+        from studyapp.engine.safety import SafetyLimits
+        from studyapp.experiment.protocol import load_protocol
+
+        config.safety = SafetyLimits(fmax_ceiling=load_protocol(args.protocol).fmax_ceiling)
     engine = Engine(config, on_notice=lambda notice: say(notice.text),
                     on_fault=lambda text: say(f"live: fault: {text}"))
 

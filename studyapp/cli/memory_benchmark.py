@@ -19,7 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
+from studyapp.cli.estimate import BLOCK_MAX
 from studyapp.errors import ParameterError
+
+ROWS_MAX = 10**9  # samples per input: ~70 GB of CSV, the most a disk here is asked to hold
 
 COLUMNS = ("t", "position", "velocity_lvt", "acceleration", "velocity_true", "acceleration_true", "force",
            "string_velocity", "audio")
@@ -82,10 +85,10 @@ def measure(input_path, output_path, block, rate):
 
 
 def run_cli(args):
-    if args.rows < 1:
-        raise ParameterError(f"--rows {args.rows}: allowed is an integer of at least 1")
-    if args.block < 1:
-        raise ParameterError(f"--block {args.block}: allowed is an integer of at least 1")
+    if not 1 <= args.rows <= ROWS_MAX:  # the inputs are written to disk first
+        raise ParameterError(f"--rows {args.rows}: allowed is an integer from 1 to {ROWS_MAX}")
+    if not 1 <= args.block <= BLOCK_MAX:
+        raise ParameterError(f"--block {args.block}: allowed is an integer from 1 to {BLOCK_MAX}")
     rate = 5000.0
     results = []
     with tempfile.TemporaryDirectory(prefix="studyapp-bench-memory-", dir=args.dir) as folder:

@@ -3,6 +3,8 @@
 argparse's ``float`` takes ``nan`` and ``inf``, and ``int`` takes ``-1``; no
 option of ours means anything by them (an open-ended option is left out
 instead), so ``checked`` replaces those types on every sub-command's options.
+Both also take ``5_000`` (Python's digit grouping), which is refused too
+(``studyapp.number_text``).
 The error then goes through argparse, naming the option:
 ``argument --max-lag: 'nan' is not a finite number``.
 """
@@ -10,12 +12,14 @@ The error then goes through argparse, naming the option:
 import argparse
 import math
 
+from studyapp.number_text import to_float, to_int
+
 SEED_MAX = 2**63 - 1  # numpy's generators take any non-negative integer; run stores seeds as int64
 
 
 def finite_float(text):
     try:
-        value = float(text)
+        value = to_float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"invalid float value: {text!r}") from None
     if not math.isfinite(value):
@@ -23,9 +27,16 @@ def finite_float(text):
     return value
 
 
+def integer(text):
+    try:
+        return to_int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+
+
 def seed(text):
     try:
-        value = int(text)
+        value = to_int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
     if not 0 <= value <= SEED_MAX:
@@ -43,3 +54,5 @@ def checked(parser):
             action.type = finite_float
         elif action.type is int and action.dest == "seed":
             action.type = seed
+        elif action.type is int:
+            action.type = integer

@@ -81,8 +81,7 @@ def run(args):
     checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
     output_paths.check_file(output, inputs=args.recordings)
     output_paths.check_file(checkpoint, "--checkpoint", inputs=[*args.recordings, output])
-    if args.max_lag <= 0:
-        raise UserError(f"--max-lag {args.max_lag:g}: allowed is a positive number of seconds")
+    delay_option.check_max_lag(args.max_lag)
     if args.patience < 1:
         raise UserError(f"--patience {args.patience}: allowed is an integer of at least 1")
     if args.max_sets is not None and args.max_sets < 1:
@@ -169,6 +168,7 @@ def parse_ranges(items):
     """``NAME.PARAM=LOW:HIGH`` items as {NAME: {PARAM: (low, high)}}."""
     from studyapp.errors import UserError
     from studyapp.estimators.registry import spec
+    from studyapp.number_text import to_float
 
     ranges = {}
     for item in items:
@@ -176,7 +176,7 @@ def parse_ranges(items):
         name, _, param = key.partition(".")
         low, _, high = bounds.partition(":")
         try:
-            pair = (float(low), float(high))
+            pair = (to_float(low), to_float(high))
         except ValueError:
             raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=2:128") from None
         if not name or not param:

@@ -53,7 +53,12 @@ def run(args):
         args.source = LVT_SENSOR
     recording.check_path(args.output)
     output_paths.check_file(args.output)
-    validate_rate(args.rate)
+    rate = validate_rate(args.rate)
+    if 0 < args.duration and round(args.duration * rate) < 1:  # would write a recording with no samples
+        from studyapp.errors import ParameterError
+
+        raise ParameterError(f"--duration {args.duration:g}: allowed is at least one sample, {1 / rate:g} s at "
+                             f"{rate:g} Hz")
     check_fmax(args.fmax)
     check_source(args.source)
     check_gesture(args.gesture)

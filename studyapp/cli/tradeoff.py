@@ -75,8 +75,8 @@ def run(args):
     for f in fmax:
         if not 0 <= f <= 1000:
             raise UserError(f"--fmax {f:g}: allowed is a number of newtons from 0 to 1000")
-    if args.cost_samples < 1000:
-        raise UserError(f"--cost-samples {args.cost_samples}: allowed is an integer of at least 1000")
+    if not 1000 <= args.cost_samples <= 10**8:  # allocated at once for the timing
+        raise UserError(f"--cost-samples {args.cost_samples}: allowed is an integer from 1000 to 100000000")
     if args.tune and args.params:
         raise UserError("--params with --tune: allowed is one of them (--tune starts from Table 1 at each rate)")
     for option, value in (("--patience", args.patience), ("--workers", args.workers)):

@@ -63,6 +63,11 @@ def parse(spec):
         folder = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(folder):
             raise ParameterError(f"--audio {spec}: folder {folder} does not exist")
+        try:  # a real write, removed at once: os.access says yes to root on /sys and /proc
+            tempfile.TemporaryFile(dir=folder).close()
+        except OSError as exc:
+            raise ParameterError(f"--audio {spec}: folder {folder} is not writable ({exc.strerror or exc}): "
+                                 "allowed is a WAV file in a writable folder") from None
         return "wav", path
     raise ParameterError(f"--audio {spec!r}: use device, device:NAME, wav:FILE, null or discard")
 

@@ -12,6 +12,8 @@ from studyapp.errors import ParameterError
 from studyapp.model.sources import LVT_SENSOR, with_pseudo_sources
 
 BLOCK_PERIOD = 0.002  # s: default block length; commands and MIDI act at block boundaries
+TELEMETRY_MAX = 60.0  # s of telemetry the rings may keep (a minute at 96 kHz: ~1 GB with all estimators)
+HANG_TIMEOUT_MAX = 5.0  # s: a watchdog slower than that watches nothing
 
 
 def block_samples(rate, period=BLOCK_PERIOD):
@@ -38,14 +40,31 @@ class EngineConfig:
     telemetry_seconds: float = 4.0  # history kept in the rings
     realtime: bool = True  # ask for SCHED_FIFO for the worker's loop thread (falls back silently)
     device: str | None = None  # "module:factory" of a real device driver; None: the simulated device
-    hang_timeout: float = 0.08  # s without a heartbeat before the watchdog calls the worker hung
+    hang_timeout: float = 0.08  # s without a heartbeat before the force guard calls the worker hung
+    # s without the force guard's heartbeat before the worker switches its own force off: the guard's
+    # failure is the rarer one, so the deadline is looser than hang_timeout, sparing a loaded machine false trips
+    guard_timeout: float = 0.2
 
     def block_size(self):
+        """Samples per block. At most half ``hang_timeout`` worth: the heartbeat comes once a block, and the
+        bound comes before any allocation (the ring holds at least four blocks)."""
         if self.block is not None:
-            if int(self.block) < 1:
-                raise ParameterError(f"block = {self.block}: allowed is a number of samples >= 1")
+            top = max(1, int(self.rate * self.hang_timeout / 2))
+            if not 1 <= int(self.block) <= top:
+                raise ParameterError(f"block = {self.block}: allowed is 1 to {top} samples "
+                                     f"(half the watchdog's {1e3 * self.hang_timeout:g} ms at {self.rate:g} Hz)")
             return int(self.block)
         return block_samples(self.rate)
+
+    def check_sizes(self):
+        """Every size that becomes an allocation, bounded before any is made (``ParameterError``)."""
+        if not 0.0 < float(self.hang_timeout) <= HANG_TIMEOUT_MAX:
+            raise ParameterError(f"hang_timeout = {self.hang_timeout}: allowed is above 0 and up to "
+                                 f"{HANG_TIMEOUT_MAX:g} s")
+        if not 0.0 < float(self.telemetry_seconds) <= TELEMETRY_MAX:
+            raise ParameterError(f"telemetry_seconds = {self.telemetry_seconds}: allowed is above 0 and up to "
+                                 f"{TELEMETRY_MAX:g} s")
+        return self.block_size()
 
     def sources(self):
         """The velocity sources a pad can select, in the scene's order."""

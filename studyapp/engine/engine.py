@@ -7,21 +7,31 @@
         engine.controls()          # controls the worker applied since the last call (events.Applied)
 
 The parent creates the shared memory (a ring for the telemetry, the status
-block, a ring of events from the worker), spawns the worker (``worker.main``) and, once it reports ready, runs a
-watchdog thread that also drains the worker's events. The watchdog wakes every
-``POLL`` seconds, or at once when the process ends (it waits on the process
-sentinel), so:
+block, a ring of events from the worker), spawns the force guard
+(``guard.main``, a process of its own: nothing the parent does can delay it)
+and the worker (``worker.main``), and, once the worker reports ready, runs a
+watchdog thread that drains the worker's events and reports faults. The
+guard, not this thread, cuts the force of a worker whose heartbeat is older
+than ``hang_timeout`` (default 80 ms): it clears the ``force_enable`` word
+within ``hang_timeout + guard.POLL``, whatever the parent is doing (busy in
+Python, collecting garbage, stopped). The worker in turn switches its own force
+off when the guard's heartbeat is older than ``guard_timeout``. The watchdog
+thread wakes every ``POLL`` seconds, or at once when the worker or the guard
+ends (it waits on their sentinels), so:
 
 - a worker that dies (crash, SIGKILL) is noticed within a few milliseconds;
-- a worker whose heartbeat is older than ``hang_timeout`` (default 80 ms) is
-  called hung, so detection takes at most ``hang_timeout + POLL`` (< 100 ms).
+- a worker whose heartbeat is older than ``hang_timeout`` is called hung: the
+  guard's cut (``force_off_time``) is reported, or the thread's own finding
+  if it comes first (both clear the same word);
+- a guard that dies is a fault too: only a restart brings supervision back.
 
 Either way the fault is reported (``faults``, ``on_fault``), the
 ``force_enable`` word is cleared, with the reason "watchdog" and how long the
 worker was silent beside it (``StatusBlock.disable_force``; a worker that was only slow zeroes its force
 at its next block and latches a fault) and ``force_output`` reads 0: the
 simulated device, which lives in the worker, stops with it. ``stop()`` asks
-the worker to finish, waits for it, kills it if it will not go, and unlinks
+the worker to finish, waits for it, kills it if it will not go, ends the
+guard and unlinks
 the shared memory: no orphan process, no leaked segment. It waits only while
 the worker shows signs of life: a running worker whose heartbeat is older than
 ``STALL_GRACE`` (or its ``hang_timeout``, the longer), or a worker closing its
@@ -48,13 +58,14 @@ from multiprocessing.connection import wait as wait_for
 
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
-from studyapp.engine import midi_hotplug
+from studyapp.engine import guard, midi_hotplug
 from studyapp.engine.audio import parse as parse_audio
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
 from studyapp.errors import EngineError, ParameterError
+from studyapp.model.loop import GESTURES
 from studyapp.model.sources import with_pseudo_sources
 
 __all__ = ["Engine", "EngineError"]
@@ -77,6 +88,7 @@ class Engine:
         self.info = {}
         self.summary = None
         self.process = None
+        self.guard = None  # the force guard's process (guard.py)
         self.ring = None
         self.status_block = None
         self._controls = []
@@ -105,12 +117,15 @@ class Engine:
         fmax = float(c.fmax)
         if not 0.0 <= fmax <= c.safety.fmax_ceiling:
             raise ParameterError(f"fmax = {c.fmax}: allowed is 0 to {c.safety.fmax_ceiling:g} N (the safety ceiling)")
+        if c.gesture not in GESTURES or c.gesture == "playback":
+            live = [g for g in GESTURES if g != "playback"]  # playback needs a recorded trajectory
+            raise ParameterError(f"gesture {c.gesture!r}: allowed are {', '.join(live)}")
         parse_audio(c.audio)
-        c.block_size()
+        c.check_sizes()
         return names
 
     def start(self, timeout=START_TIMEOUT):
-        from studyapp.engine.worker import channels_for, main
+        from studyapp.engine.worker import REALTIME_PRIORITY, channels_for, main
 
         c = self.config
         capacity = max(int(c.telemetry_seconds * c.rate), 4 * c.block_size())
@@ -119,6 +134,11 @@ class Engine:
         ctx = multiprocessing.get_context("spawn")
         self._commands = ctx.Queue()
         self._events = EventRing.create()
+        self.guard = ctx.Process(
+            target=guard.main, name="studyapp-guard", daemon=True,
+            args=(self.status_block.name, c.hang_timeout, REALTIME_PRIORITY + 1 if c.realtime else None),
+        )
+        self.guard.start()
         self.process = ctx.Process(
             target=main, name="studyapp-engine", daemon=True,
             args=(c, self.ring.spec, self.status_block.name, self._commands, self._events.name),
@@ -272,31 +292,56 @@ class Engine:
             self.on_fault(text)
 
     def _trip(self, text, when, silence=0.0):
-        self.status_block.disable_force("watchdog", silence)
+        block = self.status_block
+        if block.force_enable:
+            block.disable_force("watchdog", silence)
+        elif block.force_off_reason == "watchdog":  # the guard was first: its moment is the cut's
+            when = block.force_off_time
         self.tripped = True
         self._fault(text, when)
 
+    def _hung(self, silence):
+        return (f"watchdog: the engine stopped answering (no heartbeat for {1e3 * silence:.0f} ms, "
+                f"{1e3 * self.config.hang_timeout:.0f} ms allowed); force switched off for safety")
+
     def _watch(self):
-        sentinel = self.process.sentinel
+        sentinels = [self.process.sentinel, self.guard.sentinel]
         timeout = self.config.hang_timeout
         while not self._stop_watch.is_set():
-            ended = wait_for([sentinel], POLL)
+            ended = wait_for(sentinels, POLL)
             now = time.monotonic()
             while (event := self._next_event(0)) is not None:
                 self._handle(event)
+            worker_ended = self.process.sentinel in ended
+            guard_ended = self.guard.sentinel in ended
+            if guard_ended:
+                sentinels.remove(self.guard.sentinel)  # a process ends once: wait on it no more
             if self._stopping or self.tripped:
-                if ended:
+                if worker_ended:
                     return
                 continue  # keep passing on the worker's events until stop()
-            if ended:
+            if worker_ended:
                 self.process.join(0.1)
                 self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero", now)
                 return
-            snap = self.status_block.read()
+            if guard_ended:
+                self.guard.join(0.1)
+                self._trip(f"watchdog: the force guard died (exit code {self.guard.exitcode}); force switched off "
+                           "for safety: restart the engine", now)
+                continue
+            block = self.status_block
+            if not block.force_enable and block.force_off_reason == "watchdog":
+                self.process.join(0.05)  # a killed worker's exit can lag its silence: say it died if it did
+                if self.process.exitcode is not None:
+                    self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero",
+                               block.force_off_time)
+                    return
+                self._trip(self._hung(block.force_off_silence), block.force_off_time)
+                continue
+            snap = block.read()
             silence = now - snap["heartbeat"]
             if snap["state"] == "running" and silence > timeout:
-                self._trip(f"watchdog: the engine stopped answering (no heartbeat for {1e3 * silence:.0f} ms, "
-                           f"{1e3 * timeout:.0f} ms allowed); force switched off for safety", now, silence)
+                self._trip(self._hung(silence), now, silence)
 
     # shutting down ---------------------------------------------------------
     def stop(self, timeout=10.0):
@@ -320,6 +365,7 @@ class Engine:
             if self.process.is_alive():
                 self.process.kill()  # SIGKILL: a stopped worker would never handle SIGTERM
         self.process.join(5.0)
+        self._end_guard()
         self._stop_watch.set()
         if self._watchdog is not None and self._watchdog is not threading.current_thread():
             self._watchdog.join(2.0)
@@ -336,10 +382,18 @@ class Engine:
             return now - max(snap["heartbeat"], heard) > max(STALL_GRACE, self.config.hang_timeout)
         return now - max(snap["heartbeat"], heard) > CLOSE_GRACE
 
+    def _end_guard(self):
+        if self.guard is not None:
+            if self.guard.is_alive():
+                self.guard.kill()
+            self.guard.join(5.0)
+
     def _cleanup(self):
         if self.process is not None and self.process.is_alive():
             self.process.kill()
             self.process.join(5.0)
+        self._end_guard()
+        self.guard = None
         commands = getattr(self, "_commands", None)
         if commands is not None:
             commands.close()

@@ -2,15 +2,17 @@
 
 Three layers keep a fault from leaving the device pushing:
 
-1. Clamps. F_max is clamped to the protocol's ceiling (``SafetyLimits.fmax_ceiling``)
-   before the loop sees it; inside the loop the force is clamped to the motor
+1. Clamps. F_max is clamped to the protocol's ceiling (``SafetyLimits.fmax_ceiling``,
+   from ``Protocol.fmax_ceiling`` for a session, the console's preview and
+   ``live --protocol``; the motors' sustained limit otherwise) before the loop sees it; inside the loop the force is clamped to the motor
    limits (model/device.py). After each block ``check`` verifies that no
    sample exceeded either bound.
 2. Latched faults. A non-finite value anywhere in a block (the loop latches
    its own fault the moment one appears and zeroes the force from that sample
-   on), a clamp found violated, or the parent's watchdog clearing the
-   ``force_enable`` word (the experimenter's emergency stop or the watchdog:
-   the fault says which, ``force_off_text``): the force scale goes to 0 and stays there until
+   on), a clamp found violated, or the ``force_enable`` word cleared (the
+   experimenter's emergency stop, the force guard finding the worker silent, or
+   the worker finding the guard silent, engine/guard.py: the fault says which,
+   ``force_off_text``): the force scale goes to 0 and stays there until
    ``clear()`` (an experimenter's decision, never automatic). The word is read
    twice per block: before the block runs (``before_block``), so a worker
    that was stopped or starved while the watchdog tripped computes its next
@@ -49,6 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from studyapp.errors import ParameterError
+from studyapp.model.device import DeviceLimits
 
 
 WATCHDOG = "watchdog: the parent switched the force off"
@@ -62,12 +65,15 @@ def force_off_text(reason, silence=0.0):
     if reason == "watchdog":
         return (f"watchdog: the engine stopped answering for {1e3 * silence:.0f} ms; force switched off for "
                 f"safety — {CLEAR_HINT}")
+    if reason == "guard":
+        return (f"watchdog: the force guard stopped answering for {1e3 * silence:.0f} ms; force switched off for "
+                "safety — restart the engine")
     return WATCHDOG
 
 
 @dataclass(frozen=True)
 class SafetyLimits:
-    fmax_ceiling: float = 60.0  # N; the motors' sustained limit unless the protocol sets a lower one
+    fmax_ceiling: float = DeviceLimits().sustained  # N: the motors' 60 N unless the protocol sets a lower one
     velocity_bound: float = 0.3  # m/s; bowing strokes move at a few cm/s
     saturation: float = 0.95  # fraction of the motor's sustained limit that counts as saturated
     window: float = 0.25  # s

@@ -8,11 +8,14 @@ sequence number and keeps the copy only when both reads are equal and even.
 Beside the locked record sit words the parent writes and the worker reads:
 ``force_enable``, and why it was last cleared (``force_off_reason``, one of
 ``FORCE_OFF_REASONS``, and for the watchdog ``force_off_silence``, the seconds
-the worker had not answered). The watchdog clears it when the worker stops
-answering, so a worker that is merely slow, not dead, zeroes its force at its
-next block; the experimenter's emergency stop clears it too. The reason is
-written before the word is cleared, so the worker's fault text says which
-(``safety.force_off_text``) instead of blaming the watchdog for an operator's stop.
+the worker had not answered, and ``force_off_time``, when). The force guard
+(engine/guard.py) clears it when the worker stops answering, so a worker that
+is merely slow, not dead, zeroes its force at its next block; the
+experimenter's emergency stop clears it too, and so does the worker itself when
+the guard's own heartbeat (``guard_heartbeat``) grows older than its deadline.
+The reason is written before the word is cleared, so the worker's fault text
+says which (``safety.force_off_text``) instead of blaming the watchdog for an
+operator's stop. Each word is one aligned float64: read and written whole.
 """
 
 import time
@@ -46,11 +49,14 @@ NUMBERS = (
 
 TEXTS = {"source": 32, "fault": 200, "audio": 120, "midi": 120}
 
+_HEARTBEAT, _STATE = NUMBERS.index("heartbeat"), NUMBERS.index("state")
+
 STATES = ("starting", "running", "stopping", "stopped", "failed")
-FORCE_OFF_REASONS = ("parent", "operator", "watchdog")  # "parent": cleared without a reason given
+# "parent": cleared without a reason given; "guard": the worker found the force guard silent
+FORCE_OFF_REASONS = ("parent", "operator", "watchdog", "guard")
 
 _SEQ = 8
-_ENABLE = 3 * 8  # force_enable, force_off_reason, force_off_silence
+_ENABLE = 5 * 8  # force_enable, force_off_reason, force_off_silence, force_off_time, guard_heartbeat
 
 
 class StatusBlock:
@@ -61,7 +67,7 @@ class StatusBlock:
         self._owner = owner
         buf = shm.buf
         self._seq = np.ndarray((1,), dtype=np.int64, buffer=buf)
-        self._enable = np.ndarray((3,), dtype=np.float64, buffer=buf, offset=_SEQ)
+        self._enable = np.ndarray((5,), dtype=np.float64, buffer=buf, offset=_SEQ)
         offset = _SEQ + _ENABLE
         self._numbers = np.ndarray((len(NUMBERS),), dtype=np.float64, buffer=buf, offset=offset)
         offset += 8 * len(NUMBERS)
@@ -84,7 +90,7 @@ class StatusBlock:
         shm = shared_memory.SharedMemory(create=True, size=cls.size())
         block = cls(shm, owner=True)
         block._seq[0] = 0
-        block._enable[:] = (1.0, 0.0, 0.0)
+        block._enable[:] = (1.0, 0.0, 0.0, 0.0, 0.0)
         block._numbers[:] = 0.0
         block._texts[:] = 0
         return block
@@ -157,13 +163,14 @@ class StatusBlock:
     @force_enable.setter
     def force_enable(self, on):
         if on:
-            self._enable[1:] = 0.0
+            self._enable[1:4] = 0.0
         self._enable[0] = 1.0 if on else 0.0
 
     def disable_force(self, reason, silence=0.0):
         """Clear ``force_enable``, saying why (``FORCE_OFF_REASONS``; the watchdog gives the silence in s)."""
         self._enable[1] = FORCE_OFF_REASONS.index(reason)
         self._enable[2] = float(silence)
+        self._enable[3] = time.monotonic()
         self._enable[0] = 0.0
 
     @property
@@ -173,6 +180,30 @@ class StatusBlock:
     @property
     def force_off_silence(self):
         return float(self._enable[2])
+
+    @property
+    def force_off_time(self):
+        """``time.monotonic()`` when ``force_enable`` was last cleared (0 while it is set)."""
+        return float(self._enable[3])
+
+    @property
+    def guard_heartbeat(self):
+        """``time.monotonic()`` of the force guard's last round (0 before it started)."""
+        return float(self._enable[4])
+
+    def guard_beat(self):
+        self._enable[4] = time.monotonic()
+
+    def worker_beat(self):
+        """(state, heartbeat) of the worker, from one consistent record (the guard's cheap read)."""
+        for _ in range(1000):
+            before = int(self._seq[0])
+            if before % 2 == 0:
+                state, beat = self._numbers[_STATE], self._numbers[_HEARTBEAT]
+                if int(self._seq[0]) == before:
+                    return STATES[int(state)], float(beat)
+            time.sleep(0)
+        raise RuntimeError("status block: writer never finished a record")
 
     def close(self):
         self._seq = self._enable = self._numbers = self._texts = None

@@ -51,6 +51,11 @@ went away), and the status block's ``midi`` text and a notice follow.
 
 The worker stops on a ``Stop`` command, or when its parent dies (it checks the
 parent's sentinel every 50 ms, so no orphan keeps running).
+
+It runs its loop only under the force guard's watch (engine/guard.py): it
+waits for the guard's first heartbeat before it reports ready, and from then
+on switches its force off itself (reason "guard") when that heartbeat is older
+than ``guard_timeout``: a guard that died or was stopped leaves no force unwatched.
 """
 
 import gc
@@ -183,6 +188,7 @@ class Worker:
         self.stalls = 0  # misses whose block took longer than its period by the wall clock only
         self._rows = np.empty((len(self.channels), self.block))
         self._faults_seen = 0
+        self.supervised = False  # the guard's heartbeat is checked from the first timed block on (run)
         status.set(
             block=self.block, fmax=self.loop.fmax, force_scale=1.0, source=self.loop.source,
             audio=self.sink.description, midi=self.midi.description if self.midi else "none",
@@ -358,11 +364,11 @@ class Worker:
     def step(self, started):
         """One block; returns (finished, wall-clock compute, CPU time of this thread)."""
         cpu_started = time.thread_time()
-        enabled = self.status.force_enable
+        enabled = self._force_enabled()
         self.safety.before_block(enabled, why=None if enabled else self._force_off_text())
         bowing = self.loop.bowing
         out = self.loop.run(self.block)
-        enabled = self.status.force_enable
+        enabled = self._force_enabled()
         self.safety.check(out, force_enable=enabled, why=None if enabled else self._force_off_text())
         if self.sink.render:
             # the bow as it was for this block (a fault lifts it): silence while it is off the string
@@ -387,6 +393,24 @@ class Worker:
             self.midi.new_block(self.k, finished)
         return finished, finished - started, cpu
 
+    def _force_enabled(self):
+        """The parent's ``force_enable`` word, cleared here first if the force guard has gone silent."""
+        status = self.status
+        if self.supervised and status.force_enable:
+            silence = time.monotonic() - status.guard_heartbeat
+            if silence > self.config.guard_timeout:
+                status.disable_force("guard", silence)
+        return status.force_enable
+
+    def wait_for_guard(self, timeout=60.0):
+        """Block until the force guard has started watching (``RuntimeError`` after ``timeout`` s)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() - self.status.guard_heartbeat > self.config.guard_timeout:
+            if time.monotonic() > end:
+                raise RuntimeError(f"the force guard did not start within {timeout:g} s")
+            time.sleep(0.005)
+        self.supervised = True
+
     def _force_off_text(self):
         """Why the parent cleared ``force_enable``, in words (read only while it is cleared)."""
         return force_off_text(self.status.force_off_reason, self.status.force_off_silence)
@@ -394,6 +418,7 @@ class Worker:
     def run(self):
         status = self.status
         self.prime()
+        self.wait_for_guard()
         status.set(state="running", heartbeat=time.monotonic())
         status.publish(texts=True)
         self.events.put(ev.Ready({

@@ -32,6 +32,7 @@ from studyapp.estimators.spec import validate_rate
 from studyapp.synthetic import stick_slip
 
 BLOCK = 256
+SAMPLES_MAX = 10**8  # per timed run: 0.8 GB an array
 
 
 @njit(cache=True)
@@ -100,8 +101,8 @@ def run(rate, progress=True, n=100_000):
 
 def run_cli(args):
     rate = validate_rate(args.rate)
-    if args.samples < BLOCK:
-        raise ParameterError(f"--samples {args.samples}: allowed is an integer of at least {BLOCK}")
+    if not BLOCK <= args.samples <= SAMPLES_MAX:  # every estimator's input and output are allocated at once
+        raise ParameterError(f"--samples {args.samples}: allowed is an integer from {BLOCK} to {SAMPLES_MAX}")
     result = run(rate, n=args.samples)
     if args.json:
         print(json.dumps(result, indent=2))

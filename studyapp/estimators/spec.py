@@ -15,6 +15,7 @@ from typing import Callable
 import numpy as np
 
 from studyapp.errors import ParameterError
+from studyapp.number_text import to_float
 
 RATE_MIN = 1_000.0
 RATE_MAX = 96_000.0
@@ -67,7 +68,7 @@ class Param:
             return value
         if isinstance(value, str):
             try:
-                value = float(value)
+                value = to_float(value)
             except ValueError:
                 raise ParameterError(f"{where} = {value!r}: allowed is {self.allowed(rate)}") from None
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
@@ -164,7 +165,7 @@ class EstimatorSpec:
 
 def validate_rate(rate):
     try:
-        rate = float(rate)
+        rate = to_float(rate)
     except (TypeError, ValueError):
         raise ParameterError(f"rate = {rate!r}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz") from None
     if not (RATE_MIN <= rate <= RATE_MAX):

@@ -64,7 +64,13 @@ def take_from_recording(recording, name, reference="lvt", sha256=None):
         if column not in columns:
             raise InputDataError(f"{name}: no {column!r} column (it has {', '.join(columns)})")
     arrays = {c: np.ascontiguousarray(columns[c], dtype=np.float64) for c in wanted}
+    for column, values in arrays.items():  # all NaN: nothing to tune or score, whatever the estimators make of it
+        if not np.isfinite(values).any():
+            raise InputDataError(f"{name}: column {column!r} has no finite sample: allowed is a recording with "
+                                 "measured values")
     fmax = recording.meta.get("fmax") if recording.meta else None
+    if fmax is not None and (isinstance(fmax, bool) or not isinstance(fmax, (int, float))):
+        raise InputDataError(f"{name}: metadata 'fmax' = {fmax!r}: allowed is a number of newtons")
     return Take(
         name=name, rate=float(recording.rate), position=arrays["position"],
         acceleration=arrays["acceleration"], velocity=arrays["velocity_lvt"],

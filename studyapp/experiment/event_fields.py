@@ -1,16 +1,28 @@
-"""Checks of single fields of a logged event, shared by the response check and the task types."""
+"""Checks of single fields of a logged event, shared by the response check and the task types.
+
+Every number has an upper bound as well: a value such as step 10^30 or F_max
+10^308 is valid JSON but no session writes it, and letting it through gave an
+overflow or a memory error further on (issue 21, item 14).
+"""
 
 import math
 
+from studyapp.model.loop import FMAX_LIMIT
 
-def integer(value, low):
-    """An int (not a bool) >= ``low``."""
-    return isinstance(value, int) and not isinstance(value, bool) and value >= low
+STEP_MAX = 10**6  # a session's steps: a few hundred
+TRIAL_MAX = 10_000  # trials of one task per condition (the protocol allows 100 plus practice)
+FMAX_MAX = FMAX_LIMIT  # N: no loop ran above it
 
 
-def number(value):
-    """A finite int or float (not a bool) >= 0."""
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
+def integer(value, low, high=math.inf):
+    """An int (not a bool) from ``low`` to ``high``."""
+    return isinstance(value, int) and not isinstance(value, bool) and low <= value <= high
+
+
+def number(value, high=math.inf):
+    """A finite int or float (not a bool) from 0 to ``high``."""
+    return (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            and 0 <= value <= high)
 
 
 def text(value):

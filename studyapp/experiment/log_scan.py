@@ -27,10 +27,12 @@ import json
 import re
 import zlib
 from dataclasses import dataclass, field
-from pathlib import Path
+
+from studyapp.small_files import read_regular
 
 _CRC = re.compile(rb',"crc":"([0-9a-f]{8})"\}')
 _CRC_END = re.compile(rb',"crc":"([0-9a-f]{8})"\}$')
+LOG_LIMIT = 1 << 30  # bytes: a long study's log is a few MB; above this it is not a session log
 NOT_AN_EVENT = "not an event"
 NO_CHECKSUM = "no checksum"
 
@@ -143,9 +145,10 @@ def scan(data):
 
 
 def read_log(path):
-    """``scan`` of the log at ``path`` (empty when there is none)."""
+    """``scan`` of the log at ``path`` (empty when there is none); ``UserError`` for a FIFO or device
+    (never read: it would block or never end) or a log above ``LOG_LIMIT``."""
     try:
-        return scan(Path(path).read_bytes())
+        return scan(read_regular(path, "session log (events.jsonl)", LOG_LIMIT))
     except FileNotFoundError:
         return LogScan()
 

@@ -15,8 +15,16 @@ every field.
 Nothing starts on an invalid protocol, and nothing is enrolled:
 ``load_protocol`` raises one ``UserError`` whose single line names the file,
 the field and what is allowed. Every number has a finite range that the model
-accepts (F_max and the knob's ceiling at most the loop's ``FMAX_LIMIT`` of
-200 N); NaN and infinities are refused.
+accepts; NaN and infinities are refused.
+
+The protocol's F_max ceiling (``fmax_ceiling``) is the engine's hard clamp
+for the whole study: every task, the console's preview and the live knob
+(engine/safety.py ``SafetyLimits.fmax_ceiling``). It is ``[apparatus]
+fmax_ceiling`` when given, else the largest F_max the tasks use (the rating's
+and listen task's ``fmax``, the adjustment knob's ``ceiling``); at most the
+motors' sustained limit, ``SAFE_CEILING`` (60 N for the TGR). A task's F_max
+above it is refused here, so no value is logged at one level and applied at
+another.
 The protocol's hash is the SHA-256 of the file's bytes, so two sessions ran the
 same study exactly when their hashes agree.
 """
@@ -27,7 +35,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from studyapp.errors import UserError
+from studyapp.model.device import DeviceLimits
 from studyapp.small_files import parse_toml, read_bytes
+
+SAFE_CEILING = DeviceLimits().sustained  # N: the motors' sustained limit, the engine's default ceiling
+FMAX_FIELDS = ("fmax", "ceiling")  # the task fields that set an F_max level
 
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
 NAME_ALLOWED = "1 to 32 letters, digits, '_' or '-'"
@@ -53,6 +65,7 @@ class Protocol:
     specs: dict = field(default_factory=dict)  # task name -> its validated spec (the task type's parse)
     pages: tuple = ()  # the [[pages]] (studyapp.experiment.pages.Page), in file order
     participant_title: str = PARTICIPANT_TITLE  # the title the participant sees (never ``title``)
+    fmax_ceiling: float = SAFE_CEILING  # N: the engine's hard clamp for this study (module docstring)
 
     def task(self, name):
         return self.specs[name]
@@ -81,6 +94,7 @@ class Protocol:
             "knobs": self.knobs,
             "pads": self.pads,
             "gesture": self.gesture,
+            "fmax_ceiling": self.fmax_ceiling,
             "estimators": {k: dict(v) for k, v in self.estimators.items()},
             "conventions": conventions.record({n: self.estimator_params(n) for n in estimators.names()}),
             "pages": [page.to_dict() for page in self.pages],
@@ -206,6 +220,11 @@ def parse_protocol(text, source="<protocol>"):
     gesture = apparatus.string("gesture", "one of " + ", ".join(gestures), default="strokes")
     if gesture not in gestures:
         apparatus.fail("gesture", f"= {gesture!r}", "one of " + ", ".join(gestures))
+    ceiling = None
+    if "fmax_ceiling" in apparatus.values:
+        ceiling = apparatus.number("fmax_ceiling", 0.0, SAFE_CEILING, "N (the motors' sustained limit)",
+                                   low_open=True)
+    apparatus.used.add("fmax_ceiling")
     apparatus.finish()
 
     known = estimators.names()
@@ -234,6 +253,7 @@ def parse_protocol(text, source="<protocol>"):
                             f"allowed is to list it in tasks or remove the table")
 
     pages = parse_pages(source, document, tasks)
+    ceiling = _fmax_ceiling(source, specs, ceiling)
 
     return Protocol(
         path=source,
@@ -251,7 +271,24 @@ def parse_protocol(text, source="<protocol>"):
         specs=specs,
         pages=pages,
         participant_title=participant_title.strip(),
+        fmax_ceiling=ceiling,
     )
+
+
+def _fmax_ceiling(source, specs, given):
+    """The protocol's F_max ceiling (module docstring); ``UserError`` for a task's F_max above it."""
+    levels = [(task, key, float(getattr(spec, key))) for task, spec in specs.items() for key in FMAX_FIELDS
+              if isinstance(getattr(spec, key, None), (int, float))]
+    ceiling = given if given is not None else SAFE_CEILING
+    where = ("[apparatus] fmax_ceiling" if given is not None
+             else f"the motors' sustained limit; a lower one may be set as [apparatus] fmax_ceiling")
+    for task, key, value in levels:
+        if value > ceiling:
+            raise UserError(f"{source}: [{task}] {key} = {value!r}: allowed is a number above 0 and up to "
+                            f"{ceiling:g} N (the protocol's F_max ceiling: {where})")
+    if given is not None:
+        return given
+    return max((value for _, _, value in levels), default=SAFE_CEILING)
 
 
 def load_protocol(path):

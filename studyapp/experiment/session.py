@@ -68,6 +68,7 @@ from studyapp.experiment.session_info import (
 )
 from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
 from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
+from studyapp.small_files import LIMIT_BYTES, open_regular
 
 CREATED = "session_created"
 SESSION_END = "session_end"
@@ -106,8 +107,8 @@ def read_description(folder):
     folder = Path(folder)
     path = folder / SESSION_FILE
     try:
-        with open(path, encoding="utf-8") as f:
-            return _check_description(json.load(f), path), []
+        with open_regular(path, "session description", "r", encoding="utf-8") as f:  # a FIFO is damaged, not waited on
+            return _check_description(json.loads(f.read(LIMIT_BYTES)), path), []
     except (OSError, ValueError, UnicodeDecodeError) as exc:
         problem = "missing" if isinstance(exc, FileNotFoundError) else f"damaged ({exc})"
     created = next((e for e in read_log(folder / EVENTS_FILE).events if e.get("type") == CREATED), None)

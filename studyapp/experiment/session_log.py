@@ -37,7 +37,8 @@ from pathlib import Path
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, open_file
-from studyapp.experiment.log_scan import read_events, read_log, scan  # noqa: F401 - the log's readers, here too
+from studyapp.experiment.log_scan import LOG_LIMIT, read_events, read_log, scan  # noqa: F401 - the log's readers, here too
+from studyapp.small_files import read_regular
 
 DAMAGED_SUFFIX = ".damaged"
 TORN_SUFFIX = ".torn-"
@@ -97,7 +98,7 @@ class SessionLog:
     def _open(self, existed):
         if not existed:
             fsync_directory(self.path.parent)
-        data = self.path.read_bytes()
+        data = read_regular(self.path, "session log (events.jsonl)", LOG_LIMIT)
         log = scan(data)
         self._size = len(data) - len(log.cut)
         self.seq = max((e["seq"] for e in log.events if isinstance(e.get("seq"), int)), default=-1) + 1

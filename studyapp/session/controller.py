@@ -112,7 +112,7 @@ from enum import StrEnum
 from studyapp.engine import commands as cmd
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.events import Learned
-from studyapp.engine.safety import force_off_text
+from studyapp.engine.safety import SafetyLimits, force_off_text
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode
 from studyapp.experiment.protocol import load_protocol
@@ -286,7 +286,8 @@ class SessionController:
         names = scene_conditions(p)
         config = EngineConfig(rate=p.rate, estimators={n: p.estimator_params(n) for n in names}, source=names[0],
                               fmax=0.0, gesture=p.gesture, seed=int(seed) % 2**32, audio=self.audio, midi=self.midi,
-                              actions=actions, realtime=self.realtime, device=self.device)
+                              actions=actions, realtime=self.realtime, device=self.device,
+                              safety=SafetyLimits(fmax_ceiling=p.fmax_ceiling))  # the hard clamp, preview too
         if self.hang_timeout is not None:
             config.hang_timeout = float(self.hang_timeout)
         return config

@@ -38,7 +38,6 @@ raising F_max past breakdown before hearing it, and confirmed two to three
 times above the F_max that model.breakdown.breakdown_fmax finds.
 """
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,7 +112,7 @@ class AdjustmentTrial(ConfirmPadTrial):
 
 class Adjustment:
     name = "adjustment"
-    measure = Measure(column="fmax", low=0.0, high=math.inf, allowed="a finite F_max >= 0 N",
+    measure = Measure(column="fmax", low=0.0, high=FMAX_LIMIT, allowed=f"an F_max from 0 to {FMAX_LIMIT:g} N",
                       higher_is_better=True, label="max F_max")
 
     def parse(self, table, bounds):

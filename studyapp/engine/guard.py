@@ -1,0 +1,73 @@
+"""The force guard: a small process that switches the force off when the worker stops answering.
+
+Why a process of its own: a watchdog thread in the parent shares the parent's
+interpreter lock, so a parent busy in Python (a long computation, a garbage
+collection, one C call that never lets go of the lock) delayed the force cut
+to 350-760 ms (issue 21, item 10), and a parent stopped altogether never cut
+it. The guard does nothing else, so nothing in the app can keep it busy.
+
+Every ``POLL`` seconds it
+
+1. writes its own heartbeat (``StatusBlock.guard_beat``). The worker reads it
+   before every block and switches its force off itself (reason "guard") when
+   it is older than ``EngineConfig.guard_timeout``: a guard that died or was
+   stopped leaves no force unwatched;
+2. reads the worker's heartbeat; while the worker is running and its
+   heartbeat is older than ``hang_timeout``, it clears ``force_enable``
+   (reason "watchdog", the silence, and the moment, ``force_off_time``).
+
+A worker stopped (SIGSTOP), hung or killed therefore loses its force within
+``hang_timeout + POLL`` (80 + 2 ms by default) plus the OS's wake-up delay of
+this process, whatever the parent does; the worker, reading the word before
+and after each block, computes and writes no force from then on
+(engine/safety.py). The guard asks for real-time priority one step above the
+worker's loop (and runs without it where the OS refuses). It leaves when the
+worker has stopped or failed, when its parent is gone, or on SIGTERM (the
+parent's ``Engine.stop``).
+"""
+
+import os
+import signal
+import time
+
+from studyapp.engine.status import StatusBlock
+
+POLL = 0.002  # s between rounds
+WATCHED = "running"  # the worker's state in which its heartbeat must keep coming
+DONE = ("stopped", "failed")
+
+
+def main(status_name, hang_timeout, priority=None):
+    """Entry point of the guard process (spawned by ``Engine.start``); ``priority``: SCHED_FIFO's, or None."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    parent = os.getppid()
+    if priority is not None:  # None: the engine runs without real-time priority, and so does its guard
+        _try_realtime(priority)
+    status = StatusBlock.attach(status_name)
+    try:
+        watch(status, hang_timeout, lambda: os.getppid() == parent)
+    finally:
+        status.close()
+
+
+def watch(status, hang_timeout, parent_alive=lambda: True, rounds=None):
+    """The guard's loop (``rounds``: stop after that many, for tests)."""
+    while rounds is None or rounds > 0:
+        if rounds is not None:
+            rounds -= 1
+        status.guard_beat()
+        state, heartbeat = status.worker_beat()
+        if state in DONE or not parent_alive():
+            return
+        now = time.monotonic()
+        silence = now - heartbeat
+        if state == WATCHED and silence > hang_timeout and status.force_enable:
+            status.disable_force("watchdog", silence)
+        time.sleep(POLL)
+
+
+def _try_realtime(priority):
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except (OSError, AttributeError):
+        pass

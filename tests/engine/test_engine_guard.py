@@ -1,0 +1,101 @@
+"""The force guard cuts a stalled worker's force whatever the parent does (issue 21, item 10).
+
+These tests check the mechanism, not a time: the cut is made by the guard
+process while the parent cannot run a line of Python (one C call holding the
+interpreter's lock), and the worker switches its own force off when the guard
+goes silent. The times are measured by ``studyapp bench force-cut``.
+"""
+
+import ctypes
+import os
+import signal
+import time
+
+import numpy as np
+
+from studyapp.engine import guard
+from studyapp.engine.config import EngineConfig
+from studyapp.engine.engine import Engine
+from studyapp.engine.status import StatusBlock
+from tests.engine.waiting import wait_for
+
+RATE = 5000.0
+
+
+def _hold_the_interpreter(seconds):
+    """Sleep ``seconds`` in C with the GIL held (``PyDLL`` keeps it): no thread of this process runs."""
+    ctypes.PyDLL(None).usleep(int(seconds * 1e6))
+
+
+def test_the_guard_clears_the_word_for_a_silent_running_worker_only():
+    status = StatusBlock.create()
+    try:
+        status.set(state="running", heartbeat=time.monotonic())
+        status.publish()
+        guard.watch(status, hang_timeout=10.0, rounds=3)
+        assert status.force_enable and status.guard_heartbeat > 0
+        status.set(state="starting", heartbeat=time.monotonic() - 5.0)  # compiling: not yet watched
+        status.publish()
+        guard.watch(status, hang_timeout=0.08, rounds=3)
+        assert status.force_enable
+        status.set(state="running")
+        status.publish()
+        guard.watch(status, hang_timeout=0.08, rounds=1)
+        assert not status.force_enable and status.force_off_reason == "watchdog"
+        assert status.force_off_silence > 4.0 and status.force_off_time > 0
+    finally:
+        status.close()
+
+
+def test_a_stopped_worker_loses_its_force_while_the_parent_holds_the_interpreter():
+    engine = Engine(EngineConfig(rate=RATE, source="TRUE", fmax=2.0, hang_timeout=0.08)).start()
+    try:
+        wait_for(lambda: engine.status()["samples"] > 0.2 * RATE)
+        stopped = time.monotonic()
+        os.kill(engine.process.pid, signal.SIGSTOP)
+        _hold_the_interpreter(1.5)  # no thread of this process runs meanwhile
+        returned = time.monotonic()
+        block = engine.status_block
+        assert not block.force_enable and block.force_off_reason == "watchdog"
+        assert stopped < block.force_off_time < returned  # cut by the guard while this process was held
+        os.kill(engine.process.pid, signal.SIGCONT)
+        wait_for(lambda: engine.tripped, timeout=5.0)
+        assert "heartbeat" in engine.faults[0] and engine.fault_time == block.force_off_time
+        # the worker wakes, finds the word cleared and computes no force from its first block on
+        wait_for(lambda: engine.status()["fault_latched"], timeout=5.0)
+        end = engine.status()["samples"]
+        wait_for(lambda: engine.status()["samples"] > end + 0.05 * RATE)
+        assert np.all(engine.telemetry(int(0.05 * RATE))["force"] == 0.0)
+    finally:
+        engine.stop()
+
+
+def test_the_worker_switches_its_force_off_when_the_guard_goes_silent():
+    engine = Engine(EngineConfig(rate=RATE, source="TRUE", fmax=2.0)).start()
+    try:
+        wait_for(lambda: engine.status()["samples"] > 0.2 * RATE)
+        os.kill(engine.guard.pid, signal.SIGSTOP)
+        wait_for(lambda: engine.status()["fault_latched"], timeout=5.0)
+        assert engine.status_block.force_off_reason == "guard"
+        assert "force guard stopped answering" in engine.status()["fault"]
+        end = engine.status()["samples"]
+        wait_for(lambda: engine.status()["samples"] > end + 0.05 * RATE)
+        assert np.all(engine.telemetry(int(0.05 * RATE))["force"] == 0.0)
+        os.kill(engine.guard.pid, signal.SIGCONT)
+    finally:
+        engine.stop()
+
+
+def test_a_dead_guard_is_a_fault_and_the_force_goes_off():
+    engine = Engine(EngineConfig(rate=RATE, source="TRUE", fmax=2.0, realtime=False)).start()  # guard without it too
+    guard_pid = engine.guard.pid
+    try:
+        wait_for(lambda: engine.status()["samples"] > 0.2 * RATE)
+        os.kill(guard_pid, signal.SIGKILL)
+        wait_for(lambda: engine.tripped, timeout=5.0)
+        assert "force guard died" in engine.faults[0]
+        assert engine.force_output == 0.0
+        wait_for(lambda: engine.status()["fault_latched"], timeout=5.0)
+    finally:
+        engine.stop()
+    assert engine.guard is None and engine.process is None
