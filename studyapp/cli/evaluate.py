@@ -17,7 +17,10 @@ def register(sub):
     p = sub.add_parser("evaluate", help="error, delay, objective and ranking of estimators on recordings (Fig. 5)")
     p.add_argument("recordings", nargs="+", metavar="RECORDING",
                    help="recording files (.npz/.h5/.csv) or directories of them")
-    p.add_argument("--params", metavar="PARAMS.toml", help="tuned parameters (from studyapp optimise)")
+    p.add_argument("--params", nargs="+", metavar="PARAMS.toml",
+                   help="tuned parameters (from studyapp optimise); with several files (e.g. optimise --seed 0, "
+                        "1, 2) the first is evaluated and every file's F_g is compared under one common scale "
+                        "(seed_spread.csv)")
     p.add_argument("--estimators", nargs="+", metavar="NAMES",
                    help="estimators to evaluate (default: those in --params, else the paper's thirteen)")
     p.add_argument("--reference", choices=("lvt", "true"), default="lvt",
@@ -56,9 +59,12 @@ def run(args):
         output_paths.check_folder(output, inputs=[*args.recordings, *filter(None, [args.params, args.validation])])
     if args.compare_paper and output is None:
         raise UserError("--compare-paper: needs -o DIR, the folder its two tables are written to")
+    params_files = args.params or [None]
+    args.params = params_files[0]
     takes = load_takes(expand_paths(args.recordings), args.reference)
     unavailable = {}
     params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes), unavailable)
+    others = [parameter_sets(path, args.estimators, min(t.rate for t in takes)) for path in params_files[1:]]
     for name, reason in unavailable.items():
         print(f"studyapp evaluate: {name} skipped, {reason}", file=sys.stderr)
     cases = perceptual_options.cases(args, min(t.rate for t in takes), args.perceptual, "--perceptual")
@@ -69,6 +75,15 @@ def run(args):
         params=args.params, recordings=[t.name for t in takes], recording_sha256=[t.sha256 for t in takes])
     if unavailable:
         document["unavailable"] = unavailable
+    spread = None
+    if others:
+        from studyapp.evaluation.params_file import read
+        from studyapp.evaluation.seed_spread import labels, seed_spread
+
+        names = labels(params_files, [read(path)[1] for path in params_files])
+        spread = seed_spread(Dataset(takes, args.max_lag, delay_method=args.delay),
+                             dict(zip(names, [params] + [o[0] for o in others])))
+        document["seed_spread"] = spread
     validation = None
     if args.validation:
         from studyapp.evaluation.validation import compare
@@ -82,6 +97,10 @@ def run(args):
     perceptual = None if cases is None else perceptual_options.add_to_evaluation(cases, result, document)
     if output is not None:
         _write_outputs(output, result, document, validation)
+        if spread is not None:
+            from studyapp.evaluation.tables import write_csv
+
+            write_csv(output / "seed_spread.csv", spread)
         if perceptual is not None:
             perceptual_options.write_outputs(output, perceptual, result.names)
     if args.compare_paper:
@@ -95,6 +114,13 @@ def run(args):
         _print_table(result, validation)
         if perceptual is not None:
             perceptual_options.print_table(perceptual, result.names)
+        if spread is not None:
+            print("F_g of each parameter file under one common scale:")
+            for row in spread:
+                cells = "  ".join(f"{k[4:]} {v:.4g}" if v is not None else f"{k[4:]} inf"
+                                  for k, v in row.items() if k.startswith("F_g "))
+                pct = "-" if row["spread_pct"] is None else f"{row['spread_pct']:.2f} %"
+                print(f"  {row['estimator']:<11} {cells}  spread {pct}")
     return 0
 
 

@@ -64,7 +64,7 @@ def run(args):
     from studyapp.errors import UserError
     from studyapp.evaluation import params_file
     from studyapp.evaluation.dataset import (
-        RecordingFiles, estimator_names, expand_paths, load_takes, raw_objectives_task, warm_up,
+        RawObjectives, RecordingFiles, estimator_names, expand_paths, load_takes, warm_up,
     )
     from studyapp.evaluation.executors import make_executor
     from studyapp.evaluation.optimiser import Optimiser
@@ -116,8 +116,8 @@ def run(args):
         fingerprint = {"objective": "perceptual", "perceptual": cases.describe(), "tune": args.tune}
         initializer, initargs = perceptual_scores.warm_up, (cases, tuple(names))
     else:
-        objective = partial(raw_objectives_task, RecordingFiles(tuple(paths), args.reference, args.max_lag,
-                                                                tuple(names), delay_method=args.delay))
+        objective = RawObjectives(RecordingFiles(tuple(paths), args.reference, args.max_lag, tuple(names),
+                                                 delay_method=args.delay))
         fingerprint = {
             "recordings": [t.sha256 for t in takes], "reference": args.reference,
             "max_lag_s": args.max_lag, "delay": args.delay, "tune": args.tune,

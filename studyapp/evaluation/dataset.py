@@ -13,6 +13,9 @@ runs the estimator on every take, from rest, and returns eq. 28's vector
 ``RecordingFiles`` is a small picklable pointer to recording files: a worker
 process (or a dask worker on a shared file system) loads the files once,
 warms up the compiled estimators once, and keeps both for every later task.
+``RawObjectives`` is the optimiser's objective over such a source; its
+``shares(k)`` split the takes into k contiguous parts whose raw vectors,
+joined in order, are the whole vector, so k workers can share every set.
 """
 
 import hashlib
@@ -24,6 +27,7 @@ import numpy as np
 from studyapp.errors import InputDataError, UserError
 from studyapp.estimators.bounds import all_good
 from studyapp.evaluation import kernels
+from studyapp.evaluation.batch import batches
 from studyapp.evaluation.metric import DEFAULT_METHOD, Reference, check_method
 from studyapp.evaluation.normalisation import raw_objectives
 
@@ -105,8 +109,10 @@ def load_takes(paths, reference="lvt"):
 class Dataset:
     """Takes plus the delay bound and method; measures raw objectives (eq. 28) of a parameter set.
 
-    ``fast=True`` runs the estimators through ``kernels.run`` (same output,
-    compiled once per process: for long runs such as the optimiser's).
+    ``fast=True`` runs the estimators side by side on the takes of each
+    ``batch.Batch`` (same output, compiled once per process: for long runs
+    such as the optimiser's). ``share=(j, k)`` measures only the j-th of k
+    contiguous parts of the takes (the whole list by default).
     """
 
     def __init__(self, takes, max_lag_s=DEFAULT_MAX_LAG_S, fast=False, delay_method=DEFAULT_METHOD):
@@ -124,6 +130,13 @@ class Dataset:
                     f"{take.name}: {take.reference.shape[0]} samples is too short for a delay bound of "
                     f"{self.max_lag_s:g} s ({max_lag} samples)")
             self.references.append(Reference(take.reference, max_lag, self.delay_method))
+        self._batches = {}
+
+    def share(self, share=None):
+        """The indices of the takes in ``share`` = (j, k): the j-th of k contiguous parts."""
+        n = len(self.takes)
+        j, k = (0, 1) if share is None else (int(share[0]), int(share[1]))
+        return range(j * n // k, (j + 1) * n // k)
 
     def load(self):
         return self
@@ -141,17 +154,30 @@ class Dataset:
             return kernels.run(estimator, take.position, take.acceleration, take.velocity, take.finite)
         return estimator.process(take.position, take.acceleration, take.velocity)
 
-    def delays_and_errors(self, name, params):
-        """(E, D) arrays over the takes."""
-        errors = np.empty(len(self.takes))
-        delays = np.empty(len(self.takes))
-        for r, (take, ref) in enumerate(zip(self.takes, self.references)):
-            delays[r], errors[r] = ref.measure(self.estimate(take, name, params))
+    def delays_and_errors(self, name, params, share=None):
+        """(E, D) arrays over the takes (of ``share``)."""
+        indices = self.share(share)
+        errors = np.empty(len(indices))
+        delays = np.empty(len(indices))
+        if self.fast:
+            for batch in self._batches_of(share):
+                for r, (delay, error) in zip(batch.positions, batch.measure(name, params)):
+                    delays[r], errors[r] = delay, error
+            return errors, delays
+        for r, i in enumerate(indices):
+            delays[r], errors[r] = self.references[i].measure(self.estimate(self.takes[i], name, params))
         return errors, delays
 
-    def raw_objectives(self, name, params):
-        """Eq. 28: [E_0, |D_0|, E_1, |D_1|, ...]."""
-        return raw_objectives(*self.delays_and_errors(name, params))
+    def _batches_of(self, share):
+        key = tuple(share or (0, 1))
+        if key not in self._batches:
+            indices = self.share(share)
+            self._batches[key] = batches([self.takes[i] for i in indices], [self.references[i] for i in indices])
+        return self._batches[key]
+
+    def raw_objectives(self, name, params, share=None):
+        """Eq. 28: [E_0, |D_0|, E_1, |D_1|, ...] (over the takes of ``share``)."""
+        return raw_objectives(*self.delays_and_errors(name, params, share))
 
 
 def warm_up(names, rate=5000.0, fast=False):
@@ -166,6 +192,7 @@ def warm_up(names, rate=5000.0, fast=False):
     from studyapp.estimators.spec import RATE_MAX
 
     x = np.zeros(16)
+    side = np.zeros((16, 2))
     for name in names:
         try:
             estimator = create(name, rate)
@@ -173,6 +200,7 @@ def warm_up(names, rate=5000.0, fast=False):
             estimator = create(name, RATE_MAX)
         if fast:
             kernels.run(estimator, x, x, x, True)
+            kernels.run_many(estimator, side, side, side)
         else:
             estimator.process(x, x, x)
 
@@ -201,9 +229,23 @@ class RecordingFiles:
         return dataset
 
 
-def raw_objectives_task(source, name, params):
-    """The executor's unit of work: raw objectives of one parameter set (``source.load()`` gives the data)."""
-    return source.load().raw_objectives(name, params)
+@dataclass(frozen=True)
+class RawObjectives:
+    """The optimiser's objective: ``(name, params) -> eq. 28's vector`` over ``source.load()``'s takes.
+
+    ``source`` is a picklable recipe (``RecordingFiles``, ``simulated.SimulatedSet``); ``share``
+    (j, k) limits the vector to the j-th of k contiguous parts of the takes.
+    """
+
+    source: object
+    share: tuple = (0, 1)
+
+    def __call__(self, name, params):
+        return self.source.load().raw_objectives(name, params, self.share)
+
+    def shares(self, k):
+        """k objectives whose vectors, joined in order, are this one's (on the whole takes)."""
+        return [RawObjectives(self.source, (j, int(k))) for j in range(int(k))]
 
 
 RECORDING_SUFFIXES = (".npz", ".h5", ".csv")

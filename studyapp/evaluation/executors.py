@@ -8,7 +8,8 @@
   a large study past one machine; the workers must see the recording files at
   the same paths (a shared file system) and have studyapp installed.
 
-Any other ``Executor`` works too: the optimiser only calls ``submit``.
+Any other ``Executor`` works too: the optimiser only calls ``submit``, and asks
+``parallelism`` how many tasks to split an iteration into.
 """
 
 import os
@@ -35,6 +36,7 @@ class ClusterExecutor(Executor):
     def __init__(self, client):
         self.client = client
         self.executor = client.get_executor()
+        self.workers = max(1, sum(client.nthreads().values()))  # the cluster's threads when it connected
 
     def submit(self, fn, /, *args, **kwargs):
         return self.executor.submit(fn, *args, **kwargs)
@@ -44,6 +46,11 @@ class ClusterExecutor(Executor):
             self.executor.shutdown(wait=wait)
         finally:
             self.client.close()
+
+
+def parallelism(executor):
+    """How many tasks ``executor`` runs at once (1 for ``InlineExecutor`` and unknown executors)."""
+    return int(getattr(executor, "workers", None) or getattr(executor, "_max_workers", None) or 1)
 
 
 def cpu_count():

@@ -12,6 +12,14 @@ One iteration:
 4. an estimator stops searching once ``patience`` new sets in a row brought no
    improvement; the run ends when none is left (the paper's rule, 1000).
 
+Work is sent to the executor in few, large tasks: an iteration's sets go out
+together, one task per worker (``executors.parallelism``). An objective that
+can be split by recordings (``shares(k)``, ``dataset.RawObjectives``) gives
+every worker an equal part of the recordings of every set, so all workers stay
+busy even when a single estimator is still searching; any other objective
+(``objective(name, params)`` alone) has its sets dealt to the workers,
+slowest first.
+
 Iterations are synchronous and each estimator draws from its own generator
 (seeded from the run's seed and its name), so a run is reproducible whatever
 the number of workers and whether it was resumed from a checkpoint. An
@@ -28,6 +36,7 @@ import numpy as np
 
 from studyapp.errors import UserError
 from studyapp.evaluation import checkpoint as checkpoints
+from studyapp.evaluation.executors import parallelism
 from studyapp.evaluation.normalisation import ObjectiveSum
 from studyapp.evaluation.search import AdaptiveSearch
 
@@ -40,11 +49,25 @@ def estimator_seed(seed, name):
     return [int(seed), zlib.crc32(name.encode("utf-8"))]
 
 
-def timed(objective, name, params):
-    """Run ``objective(name, params)`` and also return how long it took (s), in the worker."""
-    started = time.perf_counter()
-    raw = objective(name, params)
-    return raw, time.perf_counter() - started
+def evaluate_sets(objective, sets):
+    """The executor's unit of work: ``[(objective(name, params), seconds it took)]`` for each (name, params)."""
+    results = []
+    for name, params in sets:
+        started = time.perf_counter()
+        raw = np.asarray(objective(name, params), dtype=np.float64)
+        results.append((raw, time.perf_counter() - started))
+    return results
+
+
+def _deal(names, durations, bins):
+    """Names dealt to ``bins`` lists, slowest first each to the least loaded (longest processing time first)."""
+    loads = [0.0] * bins
+    dealt = [[] for _ in range(bins)]
+    for name in sorted(names, key=lambda n: -durations.get(n, 0.0)):
+        least = loads.index(min(loads))
+        dealt[least].append(name)
+        loads[least] += durations.get(name, 0.0)
+    return [d for d in dealt if d]
 
 
 def _key(params):
@@ -71,7 +94,8 @@ class Optimiser:
 
     ``spaces``: name -> ``Space``; ``objective(name, params) -> raw vector`` is a
     picklable callable run by ``executor`` (an object with ``submit``; it may
-    be set later, before ``run``).
+    be set later, before ``run``); it may offer ``shares(k)`` (see the module
+    docstring).
     ``tolerance`` is the least fall of F_g that counts as an improvement (the
     default, ``TOLERANCE`` per objective, is far below any difference that
     matters; without it, ever smaller gains from zooming in on a continuous
@@ -122,13 +146,7 @@ class Optimiser:
 
     # -- evaluation ----------------------------------------------------------------
     def _evaluate(self, proposals):
-        """Raw objectives of name -> params, from the cache or the executor.
-
-        The slowest estimators are submitted first (longest processing time
-        first), so an iteration's sets finish together; the order of
-        submission never changes a result.
-        """
-        futures = {}
+        """Raw objectives of name -> params, from the cache or the executor (one task per worker)."""
         raws = {}
         missing = []
         for name, params in proposals.items():
@@ -137,11 +155,22 @@ class Optimiser:
                 raws[name] = hit
             else:
                 missing.append(name)
-        for name in sorted(missing, key=lambda n: -self.durations.get(n, 0.0)):
-            futures[name] = self.executor.submit(timed, self.objective, name, proposals[name])
-        for name, future in futures.items():
-            raw, seconds = future.result()
-            raw = np.asarray(raw, dtype=np.float64)
+        workers = parallelism(self.executor)
+        if missing and workers > 1 and hasattr(self.objective, "shares"):
+            sets = [(name, proposals[name]) for name in missing]
+            futures = [self.executor.submit(evaluate_sets, part, sets) for part in self.objective.shares(workers)]
+            parts = [future.result() for future in futures]
+            results = {name: (np.concatenate([part[i][0] for part in parts]), sum(part[i][1] for part in parts))
+                       for i, name in enumerate(missing)}
+        elif missing:
+            dealt = _deal(missing, self.durations, workers)
+            futures = [self.executor.submit(evaluate_sets, self.objective, [(n, proposals[n]) for n in names])
+                       for names in dealt]
+            results = {}
+            for names, future in zip(dealt, futures):
+                results.update(zip(names, future.result()))
+        for name in missing:
+            raw, seconds = results[name]
             self.durations[name] = seconds
             self.cache[name][_key(proposals[name])] = raw
             raws[name] = raw

@@ -22,9 +22,7 @@ rate, with the estimators evaluated there, and returns its ``Result``.
   the rate's optimum in a few minutes.
 """
 
-from functools import partial
-
-from studyapp.evaluation.dataset import raw_objectives_task
+from studyapp.evaluation.dataset import RawObjectives
 from studyapp.evaluation.optimiser import Optimiser
 from studyapp.evaluation.space import SEARCH_RANGES, Space
 
@@ -52,7 +50,7 @@ def search_spaces(names, rate, windows="seconds"):
 def retune(source, starts, rate, executor, patience, seed=0, windows="seconds", progress=None):
     """Tune the estimators of ``starts`` (name -> first parameter set) on ``source.load()`` at ``rate``."""
     optimiser = Optimiser(
-        search_spaces(list(starts), rate, windows), partial(raw_objectives_task, source), executor,
+        search_spaces(list(starts), rate, windows), RawObjectives(source), executor,
         patience=patience, seed=seed, progress=progress, starts=starts,
     )
     return optimiser.run()

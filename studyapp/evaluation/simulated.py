@@ -7,7 +7,7 @@ so a worker process that receives the recipe rebuilds the very same samples in
 a fraction of a second (about 0.05 s per 2 s recording at 96 kHz) instead of
 being sent megabytes of arrays; ``load()`` does it once per process and keeps
 the result, as ``dataset.RecordingFiles`` does for files. The optimiser's
-tasks (``dataset.raw_objectives_task``) take either.
+objective (``dataset.RawObjectives``) takes either.
 
 The delay of every estimate is measured with ``delay_method`` (see
 ``metric.py``).

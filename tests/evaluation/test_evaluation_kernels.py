@@ -39,3 +39,25 @@ def test_absurd_finite_input_takes_the_guarded_path(signals, name, column, value
     held = [s.copy() for s in cols]
     held[column][10] = held[column][9]
     assert np.array_equal(out, create(name, 5000.0).process(*held))
+
+
+@pytest.mark.parametrize("name", names())
+def test_side_by_side_runs_equal_separate_runs(name):
+    """Interleaved runs on several recordings give each recording's own run, bit for bit."""
+    sigs = [stick_slip(5000.0, 0.1, seed=s) for s in (5, 6, 7)]
+    cols = [np.ascontiguousarray(np.stack([s[c] for s in sigs], axis=1))
+            for c in ("position", "acceleration", "velocity_lvt")]
+    out = kernels.run_many(create(name, 5000.0), *cols)
+    for r, s in enumerate(sigs):
+        assert np.array_equal(out[r], create(name, 5000.0).process(s["position"], s["acceleration"], s["velocity_lvt"]))
+
+
+@pytest.mark.parametrize("order, window", [(1, 2), (2, 33), (6, 300)])
+def test_leastsq_block_form_equals_its_step(order, window, signals):
+    x, a, v = signals
+    cols = [np.ascontiguousarray(np.stack([c, c[::-1]], axis=1)) for c in (x, a, v)]
+    out = kernels.run_many(create("LEASTSQ", 5000.0, order=order, window=window), *cols)
+    for r in range(2):
+        expected = create("LEASTSQ", 5000.0, order=order, window=window).process(cols[0][:, r], cols[1][:, r],
+                                                                                 cols[2][:, r])
+        assert np.array_equal(out[r], expected)
