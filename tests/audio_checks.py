@@ -13,6 +13,7 @@ with the figures when a check fails.
 """
 
 import csv
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +35,7 @@ class Archive:
     x: np.ndarray  # the file's samples, full scale 1.0
     cues: list  # the rows of audio_cues.csv for this file: dicts with int "sample"
     pcm_peak: int  # the largest |sample| in the file, in 16-bit units
+    tone_steps: frozenset = frozenset()  # the steps of the level check's pages (they play the reference tone)
 
 
 def read_archive(folder, name="audio.wav"):
@@ -41,7 +43,11 @@ def read_archive(folder, name="audio.wav"):
     rate, pcm = wavfile.read(folder / name)
     with open(folder / "audio_cues.csv", newline="", encoding="utf-8") as f:
         cues = [{**row, "sample": int(row["sample"])} for row in csv.DictReader(f) if row["file"] == name]
-    return Archive(float(rate), pcm / 32767.0, cues, int(np.max(np.abs(pcm.astype(np.int32)))) if pcm.size else 0)
+    info = folder / "session.json"
+    schedule = json.loads(info.read_text())["schedule"] if info.exists() else []
+    tone = frozenset(s["step"] for s in schedule if (s.get("page") or {}).get("kind") == "calibration")
+    peak = int(np.max(np.abs(pcm.astype(np.int32)))) if pcm.size else 0
+    return Archive(float(rate), pcm / 32767.0, cues, peak, tone)
 
 
 def dbfs(x):
@@ -100,10 +106,16 @@ def check_peak(archive, ceiling_dbfs=CEILING_DBFS):
 
 
 def check_start_transients(archive, onset_s=ONSET_S, margin_db=0.0):
-    """Each step's first ``onset_s`` no louder (peak) than the rest of the step; returns [(step, onset, rest)]."""
+    """Each step's first ``onset_s`` no louder (peak) than the rest of the step; returns [(step, onset, rest)].
+
+    The level check's pages (session.json's calibration pages) are left out: their onset is the tone's ramp,
+    and the experimenter may confirm the level before the tone has lasted ``onset_s``.
+    """
     n = int(round(onset_s * archive.rate))
     found, bad = [], []
     for step, task, start, end in steps(archive):
+        if step in archive.tone_steps:
+            continue
         onset = peak_dbfs(archive.x[start:min(start + n, end)])
         rest = peak_dbfs(archive.x[start + n:end])
         found.append((step, onset, rest))
@@ -120,8 +132,9 @@ def check_silences(archive, silence_dbfs=SILENCE_DBFS, guard_s=GUARD_S):
     """
     guard = int(round(guard_s * archive.rate))
     spans = list(bow_spans(archive, on=False))
-    for _, task, start, end in steps(archive):
-        if task == "page" and not _has_tone(archive.x[start + guard:end - guard], archive.rate):
+    for step, task, start, end in steps(archive):
+        tone = step in archive.tone_steps or _has_tone(archive.x[start + guard:end - guard], archive.rate)
+        if task == "page" and not tone:
             spans.append((start, end))
     loudest, seconds, bad = -math.inf, 0.0, []
     for start, end in spans:

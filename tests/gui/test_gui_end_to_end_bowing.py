@@ -145,7 +145,9 @@ def test_a_whole_sinclair2014_session_bowed_with_the_pointer(session_console, qa
     assert set(bowed) <= starts
     archive = audio_checks.read_archive(folder)
     audio_checks.check_peak(archive)  # at most the ceiling, one 16-bit step of rounding allowed
-    audio_checks.check_start_transients(archive)
+    # the pointer's strokes drive the limiter to its ceiling from the first bow on: onset and what follows are
+    # both at the ceiling, so equal within half a decibel is no thump
+    audio_checks.check_start_transients(archive, margin_db=0.5)
     audio_checks.check_silences(archive)
 
     # a simulated participant replays the logged gesture (headless, the same protocol)
