@@ -20,8 +20,10 @@ setup: $(STAMP)
 run: $(STAMP)
 	$(VENV)/bin/studyapp gui
 
+# the suite on every core (at most 4), each worker with its own JACK server, Xvfb display and
+# temporary directory; a worker that runs out of tests takes some of another's (worksteal)
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -1,7 +1,10 @@
 """The ``jack_server`` fixture (registered in tests/conftest.py for every folder): a JACK server with its dummy driver: a real, clock-paced PortAudio device and JACK MIDI, no sound card.
 
 The server gets its own name (JACK_DEFAULT_SERVER, inherited by the engine's
-worker), so it never meets another JACK server on the machine. PortAudio in
+worker), so it never meets another JACK server on the machine: the name holds
+the pytest-xdist worker and the process id, so each worker of a parallel run
+(``make test``), and each of several runs at once, has its own server, and
+the virtual MIDI ports the tests open live on that server alone. PortAudio in
 this process, if loaded, lets go of it before it stops: a PortAudio still
 attached to a vanished server aborts Python at exit.
 
@@ -48,7 +51,7 @@ def jack_server(tmp_path_factory):
     jackd = shutil.which("jackd")
     if jackd is None or shutil.which("jack_wait") is None:
         pytest.skip("jackd not installed (Debian jackd2, listed in scripts/system-deps.txt)")
-    name = f"studyapp-test-{os.getpid()}"
+    name = f"studyapp-test-{os.environ.get('PYTEST_XDIST_WORKER', 'main')}-{os.getpid()}"
     period = int(os.environ.get("STUDYAPP_JACK_PERIOD", "1024"))
     saved = {k: os.environ.get(k) for k in ("JACK_DEFAULT_SERVER", "JACK_NO_START_SERVER")}
     os.environ["JACK_DEFAULT_SERVER"] = name

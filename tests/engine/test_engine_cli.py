@@ -40,8 +40,14 @@ def test_live_runs_for_the_given_time_and_prints_one_json_object(tmp_path):
     assert fs == 48000 and len(pcm) / fs == pytest.approx(result["seconds"], abs=0.3)
 
 
+def _ctrl_c_reaches_python():
+    # A suite started in the background by a shell without job control (a CI runner, `make test &`)
+    # inherits SIGINT ignored, and Python then leaves it ignored; a terminal's Ctrl-C is never ignored.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_stops_cleanly_with_the_summary():
-    proc = _live(["--audio", "null", "--midi", "none", "--json"])
+    proc = _live(["--audio", "null", "--midi", "none", "--json"], preexec_fn=_ctrl_c_reaches_python)
     deadline = time.monotonic() + 120
     lines = []
     while time.monotonic() < deadline:

@@ -84,7 +84,8 @@ def rate_signals(request):
     return request.param, signals(request.param)
 
 
-@pytest.mark.parametrize("setting", ["table1", "low", "high"])
+# at the high end the windowed estimators (FOAW, LEASTSQ) look back over the longest windows: 40-60 s each
+@pytest.mark.parametrize("setting", ["table1", "low", pytest.param("high", marks=pytest.mark.slow)])
 def test_finite_and_bounded(rate_signals, setting):
     rate, sigs = rate_signals
     chosen = table1_at(rate) if setting == "table1" else params_at(setting, rate)
