@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from scipy.io import wavfile
 
-from studyapp.engine.signal_chain import CEILING_DBFS
+from studyapp.engine.signal_chain import CEILING_DBFS, FADE_S
 from studyapp.model.stimulus_level import short_term_rms_dbfs
 
 SILENCE_DBFS = -60.0  # a silence's peak may not exceed this (the fades' last samples, smeared by the resampler)
@@ -132,10 +132,14 @@ def check_silences(archive, silence_dbfs=SILENCE_DBFS, guard_s=GUARD_S):
     """
     guard = int(round(guard_s * archive.rate))
     spans = list(bow_spans(archive, on=False))
+    # The tone is mixed after the chain's lookahead (FADE_S) while cues count it, so its ramp starts up to
+    # FADE_S before its page's start cue (docs/engine.md): the span before a tone page ends that much earlier.
+    tone_starts = {start for step, _, start, _ in steps(archive) if step in archive.tone_steps}
+    early = int(round(FADE_S * archive.rate))
     for step, task, start, end in steps(archive):
         tone = step in archive.tone_steps or _has_tone(archive.x[start + guard:end - guard], archive.rate)
         if task == "page" and not tone:
-            spans.append((start, end))
+            spans.append((start, end - early if any(0 <= s - end <= guard for s in tone_starts) else end))
     loudest, seconds, bad = -math.inf, 0.0, []
     for start, end in spans:
         x = archive.x[start + guard:max(end - guard, start + guard)]
