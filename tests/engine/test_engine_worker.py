@@ -124,7 +124,10 @@ def test_sigkill_of_the_worker_is_detected_within_100_ms():
         os.kill(pid, signal.SIGKILL)
         wait_for(lambda: engine.tripped, timeout=2.0, step=0.001)
         assert engine.fault_time - killed < 0.1
-        assert "died" in engine.faults[0] and "-9" in engine.faults[0]
+        # whichever sees it first names it: the parent's check of the process ("died", -9) or, on a loaded
+        # machine, the silent heartbeat (the force guard's 80 ms deadline); either cuts the force
+        assert ("died" in engine.faults[0] and "-9" in engine.faults[0]) or any(
+            word in engine.faults[0] for word in ("heartbeat", "watchdog", "guard")), engine.faults
         assert engine.force_output == 0.0
         assert not engine.alive
     finally:
