@@ -28,6 +28,7 @@ class EngineConfig:
     source: str = LVT_SENSOR  # an active estimator or a pseudo-source (model/sources.py)
     fmax: float = 1.0  # N
     gesture: str = "strokes"
+    bowing: bool = True  # the bow on the string from the first sample; a session starts it lifted (silent)
     f0: float | None = None  # Hz; None: the model's default
     seed: int = 0
     block: int | None = None  # samples per block; None: BLOCK_PERIOD worth

@@ -168,6 +168,7 @@ class Worker:
         self.loop = ClosedLoop(loop_config, device=make_device(config.device, config.rate))
         self.safety = Safety(self.loop, config.safety)
         self.loop.set_fmax(self.safety.clamp_fmax(config.fmax))
+        self.loop.set_bowing(config.bowing)  # a session's engine starts silent, before its first step
         self.channels = channels_for(self.loop.names)
         if self.channels != ring.channels:
             raise RuntimeError(f"telemetry channels {self.channels} differ from the ring's {ring.channels}")

@@ -285,7 +285,7 @@ class SessionController:
         p = self.protocol
         names = scene_conditions(p)
         config = EngineConfig(rate=p.rate, estimators={n: p.estimator_params(n) for n in names}, source=names[0],
-                              fmax=0.0, gesture=p.gesture, seed=int(seed) % 2**32, audio=self.audio, midi=self.midi,
+                              fmax=0.0, gesture=p.gesture, bowing=False, seed=int(seed) % 2**32, audio=self.audio, midi=self.midi,
                               actions=actions, realtime=self.realtime, device=self.device,
                               safety=SafetyLimits(fmax_ceiling=p.fmax_ceiling))  # the hard clamp, preview too
         if self.hang_timeout is not None:

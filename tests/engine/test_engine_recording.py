@@ -157,3 +157,20 @@ def test_recording_needs_a_sink_that_renders(tmp_path):
         time.sleep(0.2)
     assert not (tmp_path / "audio.wav").exists() and not (tmp_path / "audio_cues.csv").exists()
     assert any("null sink renders no audio: nothing to record" in n.text for n in notices)
+
+
+def test_an_engine_started_with_the_bow_lifted_is_silent_from_its_first_sample(tmp_path):
+    """A session's engine starts with the bow lifted (issue 22 item 4): before, the first blocks sounded
+    (about 30 ms at -17 dBFS peak in a GUI session's audio.wav) until the session's SetBowing(False) came."""
+    path = tmp_path / "start.wav"
+    config = EngineConfig(rate=5000.0, estimators={"LOWPASS": {}}, source="LOWPASS", fmax=0.0, bowing=False,
+                          audio=f"wav:{path}", midi="none", realtime=False)
+    with Engine(config) as engine:
+        time.sleep(0.5)
+    rate, pcm = wavfile.read(path)
+    assert pcm.size > 0.2 * rate and np.max(np.abs(pcm)) == 0
+    loud = tmp_path / "bowed.wav"
+    with Engine(EngineConfig(rate=5000.0, estimators={"LOWPASS": {}}, source="LOWPASS", fmax=0.0,
+                             audio=f"wav:{loud}", midi="none", realtime=False)):
+        time.sleep(0.5)
+    assert np.max(np.abs(wavfile.read(loud)[1])) > 0  # the default (studyapp live): bowing from the start
