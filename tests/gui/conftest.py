@@ -84,7 +84,11 @@ def idle_console(console, qapp):
         console.abort_session()
     if c.emergency:
         c.clear_emergency()
-    wait_until(qapp, lambda: c.engine is not None and c.state in ("idle", "finished", "aborted"), ENGINE_START)
+    try:
+        wait_until(qapp, lambda: c.engine is not None and c.state in ("idle", "finished", "aborted"), ENGINE_START)
+    except AssertionError as e:  # say what the console was doing (a full CI run once timed out here, 3 times)
+        raise AssertionError(f"{e}: state {c.state!r}, engine {c.engine!r}; console log: "
+                             f"{console.log.toPlainText()[-1500:]}") from None
     console.set_bowing(False)
     console.turn_knob(0, 0)
     return console
