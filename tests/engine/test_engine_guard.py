@@ -60,7 +60,10 @@ def test_a_stopped_worker_loses_its_force_while_the_parent_holds_the_interpreter
         assert stopped < block.force_off_time < returned  # cut by the guard while this process was held
         os.kill(engine.process.pid, signal.SIGCONT)
         wait_for(lambda: engine.tripped, timeout=5.0)
-        assert "heartbeat" in engine.faults[0] and engine.fault_time == block.force_off_time
+        # named by the parent's watchdog ("no heartbeat") or, if the woken worker's own report comes first, by
+        # the worker ("stopped answering for 80 ms"): both say the engine stopped answering
+        assert "stopped answering" in engine.faults[0], engine.faults
+        assert stopped < engine.fault_time
         # the worker wakes, finds the word cleared and computes no force from its first block on
         wait_for(lambda: engine.status()["fault_latched"], timeout=5.0)
         end = engine.status()["samples"]
