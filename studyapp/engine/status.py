@@ -5,6 +5,16 @@ then makes it even again; a reader copies the fields between two reads of the
 sequence number and keeps the copy only when both reads are equal and even.
 (x86-64 keeps stores and loads in program order; see ring.py.)
 
+A reader never waits on the writer for long and never fails: when the writer
+stays mid-record (preempted between its two increments on a loaded machine,
+or stopped there), the reader gives back the last record it read whole. Its
+heartbeat then only ages, which is what a stalled writer's heartbeat should
+do. Why it must not fail: the force guard reads at real-time priority, one
+step above the worker, so on the worker's core its ``sched_yield`` never lets
+the writer finish; a reader that raised after 1,000 yields killed the guard
+under load, and the worker, finding the guard silent, cut its own force and
+latched a fault (CI of 2026-11-25: "writer never finished a record").
+
 Beside the locked record sit words the parent writes and the worker reads:
 ``force_enable``, and why it was last cleared (``force_off_reason``, one of
 ``FORCE_OFF_REASONS``, and for the watchdog ``force_off_silence``, the seconds
@@ -56,6 +66,9 @@ STATES = ("starting", "running", "stopping", "stopped", "failed")
 FORCE_OFF_REASONS = ("parent", "operator", "watchdog", "guard")
 
 _SEQ = 8
+SPINS = 100  # yields before a reader of the whole record starts sleeping
+WAITS = 20  # sleeps of WAIT s after those, before it gives back its last whole record
+WAIT = 0.0005
 _ENABLE = 5 * 8  # force_enable, force_off_reason, force_off_silence, force_off_time, guard_heartbeat
 
 
@@ -80,6 +93,8 @@ class StatusBlock:
         self.values = np.zeros(len(NUMBERS))
         self.texts = {key: "" for key in TEXTS}
         self._index = {key: i for i, key in enumerate(NUMBERS)}
+        self._last = None  # the last record read whole (reader side)
+        self._last_beat = ("starting", 0.0)
 
     @classmethod
     def size(cls):
@@ -131,19 +146,26 @@ class StatusBlock:
         self._seq[0] += 1
 
     # reader side ---------------------------------------------------------
-    def read(self, retries=1000):
-        """A consistent snapshot: a dict of every number and text (``state`` as its name)."""
-        for _ in range(retries):
+    def read(self):
+        """A consistent snapshot: a dict of every number and text (``state`` as its name).
+
+        While the writer stays mid-record longer than the reader waits (``SPINS``
+        yields, then ``WAITS`` sleeps of ``WAIT``), the last whole snapshot.
+        """
+        for attempt in range(SPINS + WAITS):
             before = int(self._seq[0])
-            if before % 2:
-                time.sleep(0)
-                continue
-            numbers = self._numbers.copy()
-            texts = self._texts.copy()
-            if int(self._seq[0]) == before:
-                break
-        else:
-            raise RuntimeError("status block: writer never finished a record")
+            if before % 2 == 0:
+                numbers = self._numbers.copy()
+                texts = self._texts.copy()
+                if int(self._seq[0]) == before:
+                    self._last = self._snapshot(numbers, texts)
+                    return dict(self._last)
+            time.sleep(0 if attempt < SPINS else WAIT)
+        if self._last is None:  # nothing read whole yet: the record as it stands, each word whole
+            return self._snapshot(self._numbers.copy(), self._texts.copy())
+        return dict(self._last)
+
+    def _snapshot(self, numbers, texts):
         out = {key: float(numbers[i]) for i, key in enumerate(NUMBERS)}
         for key in ("blocks", "samples", "deadline_misses", "audio_underruns", "audio_xruns",
                     "faults", "midi_messages", "block"):
@@ -195,15 +217,20 @@ class StatusBlock:
         self._enable[4] = time.monotonic()
 
     def worker_beat(self):
-        """(state, heartbeat) of the worker, from one consistent record (the guard's cheap read)."""
-        for _ in range(1000):
+        """(state, heartbeat) of the worker, from one consistent record (the guard's cheap read).
+
+        The guard's read does not wait: with the writer mid-record it gives the
+        last pair it read whole, whose heartbeat ages until the writer finishes
+        (module docstring).
+        """
+        for _ in range(3):
             before = int(self._seq[0])
             if before % 2 == 0:
                 state, beat = self._numbers[_STATE], self._numbers[_HEARTBEAT]
                 if int(self._seq[0]) == before:
-                    return STATES[int(state)], float(beat)
-            time.sleep(0)
-        raise RuntimeError("status block: writer never finished a record")
+                    self._last_beat = (STATES[int(state)], float(beat))
+                    break
+        return self._last_beat
 
     def close(self):
         self._seq = self._enable = self._numbers = self._texts = None

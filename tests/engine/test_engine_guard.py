@@ -16,7 +16,7 @@ import numpy as np
 from studyapp.engine import guard
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
-from studyapp.engine.status import StatusBlock
+from studyapp.engine.status import NUMBERS, StatusBlock
 from tests.engine.waiting import wait_for
 
 RATE = 5000.0
@@ -43,6 +43,47 @@ def test_the_guard_clears_the_word_for_a_silent_running_worker_only():
         guard.watch(status, hang_timeout=0.08, rounds=1)
         assert not status.force_enable and status.force_off_reason == "watchdog"
         assert status.force_off_silence > 4.0 and status.force_off_time > 0
+    finally:
+        status.close()
+
+
+def _stay_mid_record(status):
+    """The writer's first increment without its second: a worker preempted, or stopped, inside ``publish``."""
+    status._seq[0] += 1
+
+
+def test_the_guard_lives_through_a_writer_that_stays_mid_record_and_cuts_when_its_silence_grows():
+    # on main the guard raised "writer never finished a record" after 1,000 yields: at real-time priority
+    # above the worker its yields never let the writer finish, so under load the guard died and the
+    # worker latched a "guard" fault (the idle_console and replay time-outs in CI of 2026-11-25)
+    status = StatusBlock.create()
+    try:
+        status.set(state="running", heartbeat=time.monotonic())
+        status.publish()
+        guard.watch(status, hang_timeout=10.0, rounds=1)
+        _stay_mid_record(status)
+        guard.watch(status, hang_timeout=10.0, rounds=3)
+        assert status.force_enable  # mid-record is no silence yet
+        time.sleep(0.05)
+        guard.watch(status, hang_timeout=0.02, rounds=1)
+        assert not status.force_enable and status.force_off_reason == "watchdog"
+        assert status.force_off_silence >= 0.05
+    finally:
+        status.close()
+
+
+def test_a_reader_gives_the_last_whole_record_while_the_writer_stays_mid_record():
+    status = StatusBlock.create()
+    try:
+        status.set(state="running", heartbeat=12.5, samples=400, fault="none")
+        status.publish(texts=True)
+        assert status.read()["samples"] == 400
+        _stay_mid_record(status)
+        status._numbers[NUMBERS.index("samples")] = 999.0  # half of a record being written
+        snap = status.read()
+        assert (snap["state"], snap["heartbeat"], snap["samples"], snap["fault"]) == ("running", 12.5, 400, "none")
+        status._seq[0] += 1  # the writer finishes
+        assert status.read()["samples"] == 999
     finally:
         status.close()
 
