@@ -181,6 +181,8 @@ CASES = {
     "evaluate-out-unwritable": ["evaluate", "{in}/rec.npz", "-o", UNWRITABLE],
     "evaluate-out-under-file": ["evaluate", "{in}/rec.npz", "-o", "{in}/good.csv/ev"],
     # optimise
+    "optimise-workers-beyond-the-machine": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--workers", "100000"],
+    "tradeoff-workers-beyond-the-machine": [*TRADEOFF, "-o", "{out}/t", "--tune", "--workers", "100000"],
     "optimise-seed-negative": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--seed", "-1"],
     "optimise-max-lag-nan": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--max-lag", "nan"],
     "optimise-binary": [*OPTIMISE, "{in}/binary.npz", "-o", "{out}/p.toml"],

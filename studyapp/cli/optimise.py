@@ -66,7 +66,7 @@ def run(args):
     from studyapp.evaluation.dataset import (
         RawObjectives, RecordingFiles, estimator_names, expand_paths, load_takes, warm_up,
     )
-    from studyapp.evaluation.executors import make_executor
+    from studyapp.evaluation.executors import check_workers, make_executor
     from studyapp.evaluation.optimiser import Optimiser
     from studyapp.evaluation.progress import Progress
     from studyapp.evaluation.provenance import provenance
@@ -86,8 +86,7 @@ def run(args):
         raise UserError(f"--patience {args.patience}: allowed is an integer of at least 1")
     if args.max_sets is not None and args.max_sets < 1:
         raise UserError(f"--max-sets {args.max_sets}: allowed is an integer of at least 1")
-    if args.workers is not None and args.workers < 1:
-        raise UserError(f"--workers {args.workers}: allowed is an integer of at least 1")
+    check_workers(args.workers)
     names = estimator_names(args.estimators, PAPER_ESTIMATORS)
     cases = perceptual_options.cases(args, 5000.0 if args.rate is None else args.rate, perceptual,
                                      "--objective perceptual")

@@ -58,7 +58,7 @@ def run(args):
     from studyapp.estimators.spec import RATE_MAX, validate_rate
     from studyapp.model.simulate import DURATION_MAX
     from studyapp.evaluation.dataset import file_sha256, warm_up
-    from studyapp.evaluation.executors import make_executor
+    from studyapp.evaluation.executors import check_workers, make_executor
     from studyapp.evaluation.parameter_sets import parameter_sets
     from studyapp.evaluation.progress import Progress
     from studyapp.evaluation.provenance import provenance
@@ -84,6 +84,7 @@ def run(args):
             raise UserError(f"{option} {value}: allowed only with --tune")
         if value is not None and value < 1:
             raise UserError(f"{option} {value}: allowed is an integer of at least 1")
+    check_workers(args.workers)
     patience = args.patience or DEFAULT_PATIENCE
     # Validated at the highest rate: a value that can exist at no rate is an error in the file;
     # one that cannot exist at some of the rates makes the estimator not available there.

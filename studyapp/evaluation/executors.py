@@ -60,6 +60,17 @@ def cpu_count():
         return os.cpu_count() or 1
 
 
+PER_CORE = 4  # worker processes beyond this many per core only add memory (each loads numba and the recordings)
+
+
+def check_workers(workers):
+    """``--workers``: an integer from 1 to ``PER_CORE`` per core of this machine (``UserError`` otherwise)."""
+    top = PER_CORE * cpu_count()
+    if workers is not None and not 1 <= workers <= top:
+        raise UserError(f"--workers {workers}: allowed is an integer from 1 to {top} "
+                        f"({PER_CORE} per core of this machine)")
+
+
 def make_executor(workers=None, scheduler=None, initializer=None, initargs=()):
     """The executor for ``--workers`` / ``--scheduler`` (``initializer`` runs once per local worker)."""
     if scheduler:
@@ -74,9 +85,8 @@ def make_executor(workers=None, scheduler=None, initializer=None, initargs=()):
         except (OSError, TimeoutError, ValueError) as exc:
             raise UserError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
         return ClusterExecutor(client)
+    check_workers(workers)
     workers = cpu_count() if workers is None else int(workers)
-    if workers < 1:
-        raise UserError(f"--workers {workers}: allowed is an integer of at least 1")
     if workers == 1:
         if initializer is not None:
             initializer(*initargs)
