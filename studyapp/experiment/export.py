@@ -62,6 +62,7 @@ from studyapp.errors import InputDataError, UserError
 from studyapp.experiment import response_event
 from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
+from studyapp.experiment.log_scan import written_twice
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
 
@@ -126,33 +127,6 @@ def _session_rows(folder, problems):
         base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
-
-
-def _repeats(values, lines):
-    """{value: [line numbers]} of the values (whole numbers) that occur more than once."""
-    seen = {}
-    for value, line in zip(values, lines):
-        if isinstance(value, int) and not isinstance(value, bool):
-            seen.setdefault(value, []).append(line)
-    return {value: at for value, at in seen.items() if len(at) > 1}
-
-
-def written_twice(log):
-    """What shows that two programs appended to one log (a ``LogScan``), or None.
-
-    Each program numbers its events ``seq`` from the end of the log it opened, and
-    a step is answered once (resume skips answered steps); a repeated ``seq`` or a
-    second ``response`` for a step means two writers at once (issue 21, item 1)."""
-    found = []
-    seqs = _repeats([e.get("seq") for e in log.events], log.lines)
-    responses = [(e.get("step"), line) for e, line in zip(log.events, log.lines) if e.get("type") == "response"]
-    steps = _repeats([s for s, _ in responses], [line for _, line in responses])
-    for what, repeats in (("step", steps), ("seq", seqs)):
-        if repeats:
-            value, lines = min(repeats.items(), key=lambda item: item[1][0])
-            kind = "steps with more than one response" if what == "step" else "seq values repeated"
-            found.append(f"{len(repeats)} {kind} (first: {what} {value}, lines {', '.join(map(str, lines))})")
-    return "; ".join(found) or None
 
 
 def _trial_health(events):

@@ -58,6 +58,7 @@ from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
+from studyapp.experiment.log_scan import written_twice
 from studyapp.experiment.session_files import EVENTS_FILE, FORMAT, SESSION_FILE
 from studyapp.experiment.session_info import (
     check_experimenter,
@@ -338,7 +339,13 @@ class Session:
             if order_row is not None and check_order_row(protocol, order_row) != info.get("order_row"):
                 raise UserError(f"order row {order_row}: session {folder} has order row {info.get('order_row')}: "
                                 "allowed is to leave it out when resuming")
-            events = read_events(folder / EVENTS_FILE)
+            log = read_log(folder / EVENTS_FILE)
+            twice = written_twice(log)
+            if twice:  # export skips such a log whole: what is added to it would be lost too
+                raise UserError(f"{folder / EVENTS_FILE}: {twice}: two programs wrote this log at once, so it "
+                                "cannot be continued (export skips it): allowed is to run the participant again "
+                                "under another participant ID")
+            events = log.events
             done = {e.get("step") for e in events if e.get("type") == "response"}
             if all(t["step"] in done for t in info["schedule"]):
                 # resuming is the way to repair a session, a complete one too: its session.json,

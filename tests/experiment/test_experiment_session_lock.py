@@ -273,3 +273,24 @@ def test_export_and_analyse_skip_a_log_two_programs_wrote_and_strict_refuses(tmp
     assert main(["analyse", str(results), "-o", str(tmp_path / "rep"), "--strict"]) == 2
     err = capsys.readouterr().err
     assert "two programs wrote this log at once" in err and not (tmp_path / "rep").exists()
+
+
+def test_resume_refuses_a_log_two_programs_wrote_and_leaves_it_as_it_was(tmp_path):
+    # on main resume continued such a log, and export, which skips it whole, then lost what the resumed
+    # session added too
+    from tests.experiment.demo_protocol import trials_only_demo
+
+    results = tmp_path / "results"
+    short = load_protocol(trials_only_demo(tmp_path))
+    folder = two_writers(results, short, "R01")
+    before = (folder / "events.jsonl").read_bytes()
+    with pytest.raises(UserError) as refused:
+        Session.resume(short, "R01", results)
+    line = str(refused.value)
+    assert f"{folder / 'events.jsonl'}: 1 steps with more than one response" in line
+    assert "two programs wrote this log at once" in line and "allowed is to run the participant again under another participant ID" in line
+    assert (folder / "events.jsonl").read_bytes() == before
+    Session.create(short, "R01b", results, seed=3).close()
+    Session.resume(short, "R01b", results).close()  # the refused resume let go of nothing it should not hold
+    with pytest.raises(UserError, match="two programs wrote"):  # and holds no lock: refused again, not locked out
+        Session.resume(short, "R01", results)
