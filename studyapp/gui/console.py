@@ -25,7 +25,7 @@ Abort, and closing the console, while a session runs ask first (``confirm``;
 ``abort_session(confirm=False)``, the default, is the programmatic abort, and
 ``shut_down()`` closes without asking).
 
-Every widget is a view of the ``SessionController`` (``studyapp.session``, no
+Every widget is a view of the ``SessionController`` (``studyapp.live``, no
 Qt in it): widgets call its methods, and its events update the widgets.
 Messages are coloured by their level (info, warning, error); a device's
 latest warning (its ``topic``: audio, midi) is shown beside that device. A ``QTimer`` calls
@@ -67,8 +67,8 @@ from studyapp.gui.scope import Scope
 from studyapp.gui.session_tools import SessionTools
 from studyapp.gui.setup_panel import SetupPanel
 from studyapp.gui.status_bar import StatusBar
-from studyapp.session.controller import GESTURES, REST, State
-from studyapp.session.simulated_session import SimulatedSession
+from studyapp.live.controller import GESTURES, REST, State
+from studyapp.live.simulated_session import SimulatedSession
 
 POLL_PERIOD_MS = 10
 STOP_STYLE = ("QPushButton { background: #c00; color: white; font-weight: bold; font-size: 14pt; "

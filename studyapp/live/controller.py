@@ -122,11 +122,11 @@ from studyapp.experiment.session_info import order_text
 from studyapp.experiment.session_notes import add_note, note_event
 from studyapp.experiment.session_runner import SessionRunner
 from studyapp.experiment.tasks import task_type
-from studyapp.session.engine_host import EngineHost
-from studyapp.session.engine_loop import EngineLoop
-from studyapp.session.evented import EventGroup
-from studyapp.session.knob_latency import KnobLatency
-from studyapp.session.master_sound import MasterSound
+from studyapp.live.engine_host import EngineHost
+from studyapp.live.engine_loop import EngineLoop
+from studyapp.live.evented import EventGroup
+from studyapp.live.knob_latency import KnobLatency
+from studyapp.live.master_sound import MasterSound
 
 AUDIO_FILE = "audio.wav"  # what the participant heard, in the session folder (audio-2.wav, ... per engine run)
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)

@@ -5,7 +5,7 @@ import pytest
 
 from studyapp.engine import commands as cmd
 from studyapp.errors import ParameterError
-from studyapp.session.engine_loop import EngineLoop
+from studyapp.live.engine_loop import EngineLoop
 
 RATE = 5000.0
 RATING = {"knob1": ("select", "KALLEV", 1.0)}

@@ -32,7 +32,7 @@ import numpy as np
 
 from studyapp.experiment.hand_trace import ReplayingHand
 from studyapp.experiment.simulated_participant import SimulatedParticipant
-from studyapp.session.controller import PAGE_SETTLE_S
+from studyapp.live.controller import PAGE_SETTLE_S
 
 WAIT_STEP = 0.004  # s between looks at the controller's progress
 ACTIVE = ("starting", "running", "paused", "emergency", "clearing", "engine_lost", "restarting")
