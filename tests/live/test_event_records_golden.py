@@ -83,15 +83,15 @@ def scripted_session(tmp_path):
     path = tmp_path / "golden.toml"
     path.write_text(PROTOCOL)
     results = tmp_path / "results"
-    c = SessionController(audio="null", midi="none", make_host=FakeHost, clock=SteppingClock())
+    clock = SteppingClock(step=0.0)  # time stands still until the first page is on screen
+    c = SessionController(audio="null", midi="none", make_host=FakeHost, clock=clock)
     c.load_protocol(str(path))
     up(c)
     c.start_session("P01", results)
     up(c)
-    c.clock = SteppingClock(step=0.0)
     c.pad(0)  # too soon after the page appeared: taken as a double press
     c.poll()
-    c.clock = SteppingClock()
+    clock.step = 1.0
     c.pad(0)  # the welcome page, by the participant's pad
     c.poll()
     through_pages(c)  # the level check, the instructions
