@@ -3,49 +3,39 @@
 The study logic lives in ``studyapp.experiment``: ``Session`` (the folder,
 schedule and crash-safe log) and ``SessionRunner`` (the tasks, everything
 logged). ``SessionController`` connects them to the engine and to whoever
-plays (a person with MIDI or on-screen knobs, or the simulated participant),
-and announces what changes through ``events`` (``evented.EventGroup``) for the
-views to show. Its parts, one idea each:
+plays (a person with MIDI or on-screen knobs, or the simulated participant):
+its methods are the experimenter's and the participant's actions, and it
+announces what changes through ``events`` (``evented.EventGroup``) for the
+views. Its parts, one idea each:
 
     states.py       the states and the transition functions (``fire``)
     apparatus.py    the engine and the trial's loop: the only sender of commands to the worker
+    steps.py        a trial or page started, held and ended on the engine
     controls.py     knobs and pads: routing, pickup, page settle, latency
-    trial_media.py  the audio recording and its cues, the reference tone, trial health
     hand.py         the bow and the hand's gesture, the mouse's bow pad
+    trial_media.py  the audio recording and its cues, the reference tone, trial health
 
 Time. ``poll()`` (a GUI timer calls it) never waits: it passes on the
 engine's messages, follows the engine's state, reads the telemetry written
 since the last call and, while a trial runs, hands it to the trial's
 ``EngineLoop`` (``consume``) and calls ``runner.advance(n / rate)``: the
-task's clock, the stability verdict and the logged events follow the samples
-the engine really ran. The stability verdict is the worker's own, published
-with every block.
+task's clock, the stability verdict (the worker's own, published with every
+block) and the logged events follow the samples the engine really ran.
 
-Steps. A page step (welcome, instructions, a break, the headphone level
-check, ...: ``studyapp.experiment.pages``) holds the loop silent: F_max 0,
-the bow lifted, an empty knob mapping tagged with the step's own number, so
-the confirm pad still reaches the page (as a pad press the worker reports
-back). Each step is announced by the ``trial`` event with its ``phase``
-(``page``, ``practice`` or ``trial``) and its ``number`` ``of`` the steps of
-that phase (of its task, for trials: "Practice 1 of 2", "Trial 2 of 12");
-a page also by the ``page`` event (``kind``, ``title``, ``text`` in
-Markdown, ``by``: who acknowledges it, ``step``, ``tone_hz``,
-``level_dbfs``). ``acknowledge_page(by)`` is the participant's Continue
-button or the experimenter's confirm (the only one a calibration page takes;
-its acknowledgement is logged with the tone, the level and who confirmed it).
-A refused confirm (a pad press the task does not accept yet) is a console
-message and a ``refused`` event with the reason, which the participant window
-shows (reasons name knobs, never conditions).
+Steps are announced by the ``trial`` event with their ``phase`` (``page``,
+``practice`` or ``trial``) and ``number`` ``of`` the steps of that phase ("Practice
+1 of 2", "Trial 2 of 12"); a page also by the ``page`` event (``kind``,
+``title``, ``text`` in Markdown, ``by``: who acknowledges it, ``step``,
+``tone_hz``, ``level_dbfs``). ``acknowledge_page(by)`` is the participant's
+Continue button or the experimenter's confirm (the only one a calibration page
+takes). A refused confirm is a console message and a ``refused`` event with
+the reason (reasons name knobs, never conditions). Pause holds the step and
+ignores the participant's controls; resume gives the settings back.
 
-Pause holds the loop (F_max 0, bow lifted, no knob mapping), stops the task's
-clock and ignores the participant's controls; resume gives the settings back.
-
-Notes and sound. ``add_note`` logs the experimenter's note (``note`` event,
-experiment/session_notes.py) in the running session, or after it in the
-latest session's log; ``set_volume`` (dB) and ``set_mute`` hold the console's
-master volume (master_sound.py: the engine's own ``SetVolume`` and
-``SetMute``, sent again to every engine that comes up), each change logged as
-a ``volume`` or ``mute`` event during a session.
+Notes and sound: ``add_note`` (experiment/session_notes.py: in the running
+session, or after it in the latest session's log), ``set_volume`` (dB) and
+``set_mute`` (master_sound.py: sent again to every engine that comes up),
+each logged during a session.
 """
 
 import time
@@ -108,27 +98,11 @@ class SessionController:
         self.state = State(state)
         self.events.state.emit(state=self.state)
 
-    @property
-    def emergency(self):
-        return self.state == State.EMERGENCY
-
-    @property
-    def in_session(self):
-        return self.session is not None
-
-    @property
-    def at_rest(self):
-        return self.state in REST
-
-    @property
-    def host(self):
-        return self.apparatus.host
-
-    @property
-    def engine(self):
-        """The running engine, or None (starting, failed or stopped)."""
-        return self.apparatus.engine
-
+    emergency = property(lambda self: self.state == State.EMERGENCY)
+    in_session = property(lambda self: self.session is not None)
+    at_rest = property(lambda self: self.state in REST)  # no session: the engine acts live
+    host = property(lambda self: self.apparatus.host)
+    engine = property(lambda self: self.apparatus.engine)  # the running engine, or None (starting, failed, stopped)
     audio = property(lambda self: self.apparatus.audio)
     midi = property(lambda self: self.apparatus.midi)
     latency = property(lambda self: self.controls.latency)  # knob_latency.py
@@ -276,15 +250,12 @@ class SessionController:
             self.take_records(runner.acknowledge_page(by))
 
     def set_bowing(self, on):
-        """Put the bow on the string (True) or lift it (False), with the hand's current gesture."""
         self.hand.set_bowing(on)
 
     def set_gesture(self, name):
-        """How the virtual hand moves the handle: ``strokes`` (scripted), ``hold``, or ``live`` (the mouse)."""
         self.hand.set_gesture(name)
 
     def bow_press(self, x_m):
-        """The mouse took the bow at ``x_m`` (m): the virtual hand follows it and the bow touches."""
         self.hand.press(x_m)
 
     def bow_move(self, x_m):
