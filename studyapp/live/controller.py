@@ -48,12 +48,12 @@ from studyapp.experiment.session import Session, check_participant
 from studyapp.experiment.session_notes import add_note, note_event
 from studyapp.live import states
 from studyapp.live.apparatus import Apparatus, preview_actions
-from studyapp.live.controls import PAGE_SETTLE_S, Controls  # noqa: F401 - PAGE_SETTLE_S: the views' too
+from studyapp.live.controls import PAGE_SETTLE_S, Controls  # noqa: F401 - PAGE_SETTLE_S: the tests' and scripts' too
 from studyapp.live.engine_host import EngineHost
 from studyapp.live.evented import EventGroup
-from studyapp.live.hand import GESTURES, Hand  # noqa: F401 - GESTURES: the views' too
+from studyapp.live.hand import Hand
 from studyapp.live.master_sound import MasterSound
-from studyapp.live.states import REST, TRANSITIONS, State  # noqa: F401 - the views' and tests' too
+from studyapp.live.states import REST, TRANSITIONS, State
 from studyapp.live.trial_media import TrialMedia
 
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
