@@ -60,7 +60,7 @@ VIOLATIONS = {
                                                "_bridge.py": "import studyapp.engine.ring\n"},
                                               LAYERS, "studyapp.estimators is not allowed to import studyapp.engine"),
     "live imports gui": ({"live/_bad.py": "import studyapp.gui.app\n"},
-                            LAYERS, "studyapp.live is not allowed to import studyapp.gui"),
+                         LAYERS, "studyapp.live is not allowed to import studyapp.gui"),
     "core imports Qt": ({"engine/_bad.py": "import PySide6.QtCore\n"},
                         "Qt only in studyapp.gui", "studyapp.engine._bad -> PySide6"),
 }
