@@ -59,7 +59,7 @@ def bow_on_surface(app, surface, fraction):
 def run(app, protocol, out, size, results, wanted=("welcome", "rating", "bowing", "break"), suffix=""):
     from studyapp.gui.console import Console
     from studyapp.gui.screenshot import save_widget
-    from studyapp.session.controller import PAGE_SETTLE_S, SessionController
+    from studyapp.live.controller import PAGE_SETTLE_S, SessionController
 
     c = SessionController(audio="null", midi="none", hang_timeout=0.5)
     console = Console(c)

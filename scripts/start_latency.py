@@ -58,7 +58,7 @@ def one_run(app, protocol, audio, results, participant):
     """{start_to_page, ack_to_sound, start_to_sound}: the times of one session of ``protocol`` (s, None
     for what it has not: a protocol without pages has no page)."""
     from studyapp.gui.console import Console
-    from studyapp.session.controller import PAGE_SETTLE_S, SessionController
+    from studyapp.live.controller import PAGE_SETTLE_S, SessionController
 
     c = SessionController(audio=audio, midi="none", hang_timeout=0.5)
     console = Console(c)

@@ -1,6 +1,6 @@
 """Checks of a session's archived audio (audio.wav and audio_cues.csv), for any test that has one.
 
-Made for the headless simulated session (tests/session/test_session_audio.py)
+Made for the headless simulated session (tests/live/test_session_audio.py)
 and meant for the GUI end-to-end test too: every function takes the session
 folder's ``Archive`` and returns what it measured, raising ``AssertionError``
 with the figures when a check fails.

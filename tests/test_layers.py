@@ -59,8 +59,8 @@ VIOLATIONS = {
     "indirect, through an unlayered module": ({"estimators/_bad.py": "import studyapp._bridge\n",
                                                "_bridge.py": "import studyapp.engine.ring\n"},
                                               LAYERS, "studyapp.estimators is not allowed to import studyapp.engine"),
-    "session imports gui": ({"session/_bad.py": "import studyapp.gui.app\n"},
-                            LAYERS, "studyapp.session is not allowed to import studyapp.gui"),
+    "live imports gui": ({"live/_bad.py": "import studyapp.gui.app\n"},
+                         LAYERS, "studyapp.live is not allowed to import studyapp.gui"),
     "core imports Qt": ({"engine/_bad.py": "import PySide6.QtCore\n"},
                         "Qt only in studyapp.gui", "studyapp.engine._bad -> PySide6"),
 }

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
-from studyapp.experiment.event_fields import TRIAL_MAX
+from studyapp.experiment.records import TRIAL_MAX
 from studyapp.experiment.tasks import task_names, task_type
 
 REQUIRED_COLUMNS = ["participant", "task", "condition", "trial", "fmax", "rating"]

@@ -56,7 +56,7 @@ def run(args):
     from studyapp.analysis.study import analyse
     from studyapp.cli import output_paths
     from studyapp.errors import ParameterError, UserError
-    from studyapp.experiment.event_fields import TRIAL_MAX
+    from studyapp.experiment.records import TRIAL_MAX
 
     if not 0.0 < args.alpha < 1.0:
         raise ParameterError(f"--alpha {args.alpha:g}: allowed 0 < alpha < 1")

@@ -112,7 +112,7 @@ def run(args):
     from studyapp.experiment.session_runner import SessionRunner
     from studyapp.experiment.session_info import order_text
     from studyapp.experiment.simulated_participant import SimulatedParticipant
-    from studyapp.session.headless_audio import ArchivingRunner
+    from studyapp.live.headless_audio import ArchivingRunner
 
     def progress(message):
         print(f"studyapp run: {message}", file=sys.stderr, flush=True)

@@ -59,12 +59,12 @@ from pathlib import Path
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
-from studyapp.experiment import response_event
+from studyapp.experiment import records
 from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.log_scan import written_twice
 from studyapp.experiment.session_log import read_log
-from studyapp.experiment.tasks import task_type
+from studyapp.experiment.tasks import TASK_TYPES, task_type
 
 HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
 SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
@@ -117,7 +117,7 @@ def _session_rows(folder, problems):
     for event in log.events:
         if event.get("type") != "response":
             continue
-        wrong = response_event.problem(event)
+        wrong = records.response_problem(event, TASK_TYPES)
         if wrong is not None:
             seq = event.get("seq") if isinstance(event, dict) else "?"
             raise InputDataError(f"{folder / EVENTS_FILE}: response event seq {seq}: {wrong}")

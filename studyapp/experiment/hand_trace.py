@@ -35,6 +35,7 @@ import math
 import numpy as np
 
 from studyapp.errors import UserError
+from studyapp.experiment import records
 
 SPACING_S = 0.02  # s: see the module docstring
 
@@ -71,8 +72,8 @@ class HandTrace:
         if not self.samples:
             return None
         t, x, bow = zip(*self.samples)
-        return {"type": "hand_trace", "trial": trial, "spacing_s": self.spacing,
-                "t": [round(v, 3) for v in t], "x_mm": [round(v * 1e3, 3) for v in x], "bow": list(bow)}
+        return records.hand_trace(trial, self.spacing, [round(v, 3) for v in t], [round(v * 1e3, 3) for v in x],
+                                  list(bow))
 
 
 def load_traces(events, source="the session log"):

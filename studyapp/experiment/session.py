@@ -54,6 +54,7 @@ import numpy as np
 from studyapp import __version__
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
+from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
@@ -71,8 +72,8 @@ from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_
 from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
 from studyapp.small_files import LIMIT_BYTES, open_regular
 
-CREATED = "session_created"
-SESSION_END = "session_end"
+CREATED = records.SESSION_CREATED
+SESSION_END = records.SESSION_END
 
 
 def check_participant(participant):
@@ -251,7 +252,7 @@ class Session:
                 _write_description(folder, info)
             session = cls(folder, lock)
             try:
-                session.log.append({"type": CREATED, "description": info})
+                session.log.append(records.session_created(info))
             except BaseException:
                 session.log.close()
                 raise
@@ -356,7 +357,7 @@ class Session:
                     repaired.append("its session.json rebuilt from events.jsonl")
                 if not any(e.get("type") == SESSION_END for e in events):
                     with SessionLog(folder / EVENTS_FILE) as log:
-                        log.append({"type": SESSION_END, "recovered": True})
+                        log.append(records.session_end(recovered=True))
                     repaired.append(f"its missing {SESSION_END} event written")
                 said = f" ({'; '.join(repaired)})" if repaired else ""
                 raise UserError(f"session {folder} is already complete{said}: nothing to resume")

@@ -36,6 +36,7 @@ from pathlib import Path
 
 from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
+from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, open_file
 from studyapp.experiment.log_scan import LOG_LIMIT, read_events, read_log, scan  # noqa: F401 - the log's readers, here too
 from studyapp.small_files import read_regular
@@ -112,7 +113,7 @@ class SessionLog:
             if log.completed:
                 what = " and ".join(filter(None, ["the damaged newline of the last confirmed event", what]))
             self.notes.append(f"{self.path}: {what} removed; a copy is kept in {copy.name}")
-            repairs.append({"type": "log_repaired", "dropped_bytes": len(log.cut), "copy": copy.name})
+            repairs.append(records.log_repaired(len(log.cut), copy.name))
         if log.completed:
             self._write(b"\n")
             self.notes.append(f"{self.path}: the last line lacked its newline (checksum valid: confirmed): completed")
@@ -125,7 +126,7 @@ class SessionLog:
             first_time = not side.exists() or side.read_bytes() != quarantined
             if first_time:
                 self._guard(lambda: _write_copy(side, quarantined))
-                repairs.append({"type": "log_damaged", "lines": [n for n, _, _ in bad], "copy": side.name})
+                repairs.append(records.log_damaged([n for n, _, _ in bad], side.name))
             self.notes.extend(f"{self.path} line {n}: damaged ({why}), set aside in {side.name}; "
                               "the lines after it are kept" for n, why, _ in bad)
         for event in repairs:

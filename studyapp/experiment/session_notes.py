@@ -29,12 +29,13 @@ from pathlib import Path
 import pandas as pd
 
 from studyapp.errors import UserError
+from studyapp.experiment import records
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description, session_folders
 from studyapp.experiment.session_info import check_notes
 from studyapp.experiment.session_lock import ParticipantLock
 from studyapp.experiment.session_log import SessionLog, read_log
 
-NOTE = "note"
+NOTE = records.NOTE
 NOTE_COLUMNS = ["study", "participant", "session", "wall", "step", "task", "text"]
 
 
@@ -43,7 +44,7 @@ def note_event(text):
     text = check_notes(text)
     if not text:
         raise UserError("note: empty: allowed is some text")
-    return {"type": NOTE, "text": text, "by": "experimenter"}
+    return records.note(text)
 
 
 def session_folder_of(path):

@@ -43,6 +43,7 @@ sudden return to a high F_max could be unsafe on a real device).
 import numpy as np
 
 from studyapp import __version__
+from studyapp.experiment import records
 from studyapp.experiment.hand_trace import HandTrace
 from studyapp.experiment.session_log import LogWriteError
 from studyapp.experiment.tasks import task_type
@@ -97,8 +98,7 @@ class SessionRunner:
         """Log the start of this run of the program (the first, or a resume)."""
         resumed = any(e.get("type") == "run_start" for e in self.session.events())
         done = len(self.session.finished_steps())
-        self.session.log.append({"type": "run_start", "resume": resumed, "app_version": __version__,
-                                 "finished_trials": done, "trials": len(self.session.schedule)})
+        self.session.log.append(records.run_start(resumed, __version__, done, len(self.session.schedule)))
 
     def start_trial(self):
         """Make the next unfinished trial current and return it (None when the session is done)."""
@@ -125,13 +125,11 @@ class SessionRunner:
         self.bowing = False
         self.gesture = p.gesture
         self.clock = 0.0
-        self.log({"type": "trial_start", "trial": trial.trial, "condition": trial.condition,
-                  "conditions": list(trial.conditions), "restart": bool(earlier),
-                  "restored_knobs": restored, "loop_seed": seed})
+        self.log(records.trial_start(trial.trial, trial.condition, list(trial.conditions), bool(earlier), restored,
+                                     seed))
         if self.loop is not None:
             if self._last_gesture not in (None, p.gesture):  # a change for one trial ends: logged too
-                self.log({"type": "gesture", "name": p.gesture, "from": self._last_gesture,
-                          "reason": "a trial starts with the protocol's gesture"})
+                self.log(records.gesture(p.gesture, self._last_gesture, "a trial starts with the protocol's gesture"))
             self._last_gesture = p.gesture
         self._apply()
         if getattr(spec, "bow", None) == "auto":
@@ -189,14 +187,14 @@ class SessionRunner:
         if self.loop is not None and on != self.bowing:
             self.loop.set_bowing(on)
             self.bowing = on
-            self.log({"type": "bowing", "on": on})
+            self.log(records.bowing(on))
             self.trace.bow(self.clock, on)
 
     def set_gesture(self, name):
         """Change how the virtual hand moves the handle (e.g. ``strokes``, ``hold`` to rest the bow, ``live``)."""
         if self.loop is not None and name != self.gesture:
             self.loop.set_gesture(name)
-            self.log({"type": "gesture", "name": name, "from": self.gesture})
+            self.log(records.gesture(name, self.gesture))
             self.gesture = self._last_gesture = name
 
     def set_hand_target(self, x_m):
@@ -225,11 +223,10 @@ class SessionRunner:
         broken = bool(self.loop.monitor.broken)
         if broken != self._broken:
             self._broken = broken
-            self.log({"type": "stability", "broken": broken, "score": float(self.loop.monitor.score),
-                      "fmax": self.task.fmax})
+            self.log(records.stability(broken, float(self.loop.monitor.score), self.task.fmax))
         if self.loop.fault is not None and self.loop.fault != self._fault:
             self._fault = self.loop.fault
-            self.log({"type": "fault", "message": str(self.loop.fault), "fmax": self.task.fmax})
+            self.log(records.fault(str(self.loop.fault), self.task.fmax))
         self.tick(n / self.loop.rate)
         return block
 
@@ -239,6 +236,6 @@ class SessionRunner:
         self.trial, self.task = None, None
         complete = self.session.complete
         if complete:
-            self.session.log.append({"type": "session_end"})
-        self.session.log.append({"type": "run_stop", "reason": reason})
+            self.session.log.append(records.session_end())
+        self.session.log.append(records.run_stop(reason))
         return complete

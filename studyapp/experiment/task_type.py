@@ -20,12 +20,12 @@ registered by name in ``studyapp.experiment.tasks``:
   counts); a task with an empty ``loop_conditions`` (``page``) runs without a
   loop, silent, and its state also takes ``acknowledge(by)``;
 - **live knobs**: ``knob_actions`` is the mapping the real-time worker applies
-  during a trial (a knob acts once, in the worker: studyapp.session);
+  during a trial (a knob acts once, in the worker: studyapp.live);
 - **captions**: ``heading``, ``knob_captions``, ``response_text`` are the text
   the console and the participant window show (never a condition name under
   blinding unless the task shows it on purpose);
 - **export**: ``response_problem`` checks a logged response's own fields
-  (``studyapp.experiment.response_event`` checks the common ones), ``export_rows`` turns a logged response into rows of the
+  (``studyapp.experiment.records`` checks the common ones), ``export_rows`` turns a logged response into rows of the
   responses table (``studyapp.experiment.export``);
 - **analysis**: ``measure`` says which column of those rows is the task's
   outcome, its valid range and which way is better (None: not analysed);

@@ -46,7 +46,7 @@ def default_protocol():
 def build(args):
     """The controller and console for ``args`` (not yet shown); ``UserError`` for bad arguments."""
     from studyapp.gui.console import Console
-    from studyapp.session.controller import SessionController
+    from studyapp.live.controller import SessionController
 
     protocol = getattr(args, "protocol", None) or default_protocol()
     if protocol is not None and getattr(args, "order_row", None) is not None:

@@ -25,7 +25,10 @@ Abort, and closing the console, while a session runs ask first (``confirm``;
 ``abort_session(confirm=False)``, the default, is the programmatic abort, and
 ``shut_down()`` closes without asking).
 
-Every widget is a view of the ``SessionController`` (``studyapp.session``, no
+Its parts: ``ProgressPanel`` (progress_panel.py), ``SessionButtons``
+(session_buttons.py), ``LiveTab`` (live_tab.py: scope, knobs and pads, the
+bowing pad), ``SessionTools``, ``SetupPanel``, ``PageControls``, ``StatusBar``.
+Every widget is a view of the ``SessionController`` (``studyapp.live``, no
 Qt in it): widgets call its methods, and its events update the widgets.
 Messages are coloured by their level (info, warning, error); a device's
 latest warning (its ``topic``: audio, midi) is shown beside that device. A ``QTimer`` calls
@@ -38,15 +41,9 @@ from PySide6.QtGui import QAction, QGuiApplication, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractButton,
     QCheckBox,
-    QComboBox,
-    QGroupBox,
-    QHBoxLayout,
-    QLabel,
     QMainWindow,
     QMessageBox,
     QPlainTextEdit,
-    QProgressBar,
-    QPushButton,
     QScrollArea,
     QSplitter,
     QTabWidget,
@@ -54,32 +51,23 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
 from studyapp.experiment.tasks import task_type
 from studyapp.gui.analysis_view import AnalysisView
-from studyapp.gui.bowing_pad import BowingPad
 from studyapp.gui.gui_thread import GuiThreadCaller
-from studyapp.gui.knobs import KnobPanel
+from studyapp.gui.live_tab import LiveTab
 from studyapp.gui.page_controls import PageControls
 from studyapp.gui.participant_window import ParticipantWindow
-from studyapp.gui.scope import Scope
+from studyapp.gui.progress_panel import ProgressPanel
+from studyapp.gui.session_buttons import SessionButtons
 from studyapp.gui.session_tools import SessionTools
 from studyapp.gui.setup_panel import SetupPanel
 from studyapp.gui.status_bar import StatusBar
-from studyapp.session.controller import GESTURES, REST, State
-from studyapp.session.simulated_session import SimulatedSession
+from studyapp.live.states import REST, State
+from studyapp.live.simulated_session import SimulatedSession
 
 POLL_PERIOD_MS = 10
-STOP_STYLE = ("QPushButton { background: #c00; color: white; font-weight: bold; font-size: 14pt; "
-              "padding: 10px; border-radius: 4px; } QPushButton:pressed { background: #800; }")
 LOG_LINES = 2000
-STATE_WORDS = {
-    State.IDLE: "No session", State.STARTING: "Starting the session's engine…", State.RUNNING: "Running",
-    State.PAUSED: "Paused", State.EMERGENCY: force_off_text("operator"),
-    State.CLEARING: "Clearing the emergency stop…", State.ENGINE_LOST: "Paused: the engine stopped",
-    State.RESTARTING: "Starting a new engine…", State.FINISHED: "Session complete", State.ABORTED: "Session aborted",
-}
 COLOURS = {"error": "#c00", "warning": "#a60"}
 MESSAGE_MS = 8000  # how long a warning stays in the status bar
 LEFT_WIDTH = 360  # px: the set-up side's share of the splitter at first
@@ -100,63 +88,31 @@ class Console(QMainWindow):
 
         self.setup = SetupPanel()
         self.setup.protocol_chosen.connect(self.choose_protocol)
-        self.start_button = QPushButton("Start session")
-        # not connected directly: ``clicked`` passes ``checked`` (False), which became the seed 0
-        self.start_button.clicked.connect(lambda: self.start_session())
-        self.pause_button = QPushButton("Pause")
-        self.pause_button.clicked.connect(self._pause_or_resume)
-        self.abort_button = QPushButton("Abort")
-        self.abort_button.clicked.connect(lambda: self.abort_session(confirm=True))
-        self.stop_button = QPushButton("EMERGENCY STOP")
-        self.stop_button.setStyleSheet(STOP_STYLE)
-        self.stop_button.setToolTip("zero the force now (Esc)")
-        self.stop_button.clicked.connect(controller.emergency_stop)
+        self.buttons = SessionButtons(controller, self.start_session, self.abort_session)
+        b = self.buttons
+        self.start_button, self.pause_button, self.abort_button = b.start_button, b.pause_button, b.abort_button
+        self.stop_button = b.stop_button
         stop_key = QAction("Emergency stop", self)
         stop_key.setShortcut(QKeySequence(Qt.Key.Key_Escape))
         stop_key.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
         stop_key.triggered.connect(controller.emergency_stop)
         self.addAction(stop_key)
 
-        self.state_label = QLabel("No session")
-        self.state_label.setStyleSheet("font-weight: bold;")
-        self.task_label = QLabel("")
-        self.trial_label = QLabel("")
-        for label in (self.state_label, self.task_label, self.trial_label):
-            label.setWordWrap(True)
-        self.progress_bar = QProgressBar()
-        self.progress_bar.setTextVisible(True)
-        self.condition_label = QLabel("")
-        self.condition_label.setWordWrap(True)
+        self.progress = ProgressPanel()  # the state, the step, the condition, the response, a pickup
+        p = self.progress
+        self.state_label, self.task_label, self.trial_label = p.state_label, p.task_label, p.trial_label
+        self.progress_bar, self.condition_label = p.progress_bar, p.condition_label
+        self.response_label, self.pickup_label = p.response_label, p.pickup_label
         self.blind = QCheckBox("Hide the condition (blinding)")
         self.blind.toggled.connect(self._blinding)
-        self.response_label = QLabel("")
-        self.pickup_label = QLabel("")  # a physical knob waiting for pickup (engine/pickup.py)
-        self.pickup_label.setStyleSheet("color: #06c; font-weight: bold;")
-        self.pickup_label.setWordWrap(True)
-        self.response_label.setWordWrap(True)
         self.page_controls = PageControls()  # the page the participant sees; the level check's confirm
         self.page_controls.confirmed.connect(lambda: controller.acknowledge_page("experimenter"))
-        self._condition_text = ""
 
-        buttons = QHBoxLayout()
-        buttons.addWidget(self.start_button)
-        buttons.addWidget(self.pause_button)
-        buttons.addWidget(self.abort_button)
-        progress = QGroupBox("Progress")
-        p = QVBoxLayout(progress)
-        p.addWidget(self.state_label)
-        p.addWidget(self.task_label)
-        p.addWidget(self.trial_label)
-        p.addWidget(self.progress_bar)
-        p.addWidget(QLabel("Current condition:"))
-        p.addWidget(self.condition_label)
-        p.addWidget(self.response_label)
-        p.addWidget(self.pickup_label)
         details = QWidget()
         dv = QVBoxLayout(details)
         dv.setContentsMargins(0, 0, 0, 0)
         dv.addWidget(self.setup)
-        dv.addWidget(progress)
+        dv.addWidget(self.progress)
         self.tools = SessionTools(controller, self.setup, self.blind.isChecked)  # run sheet, notes, sound
         dv.addWidget(self.tools)
         dv.addStretch(1)
@@ -171,44 +127,12 @@ class Console(QMainWindow):
         lv.addWidget(scroll, 1)
         lv.addWidget(self.blind)  # in view without scrolling, at 1,366 x 768 too
         lv.addWidget(self.page_controls)  # the level check's confirm stays in view, as the buttons do
-        lv.addLayout(buttons)
-        lv.addWidget(self.stop_button)
+        lv.addWidget(self.buttons)
 
-        self.scope = Scope()
-        self.scope.saved.connect(lambda path: controller.message(f"scope saved to {path}"))
-        self.knobs = KnobPanel()
-        self.knobs.knob_turned.connect(controller.knob)
-        self.knobs.pad_pressed.connect(controller.pad)
-        self.bowing_pad = BowingPad()
-        self.bowing_pad.bow_pressed.connect(controller.bow_press)
-        self.bowing_pad.bow_moved.connect(controller.bow_move)
-        self.bowing_pad.bow_released.connect(controller.bow_release)
-        self.gesture = QComboBox()
-        self.gesture.addItems(GESTURES)
-        self.gesture.setToolTip("the virtual hand: scripted strokes, holding the handle still, or the mouse (pad)")
-        self.gesture.activated.connect(lambda index: controller.set_gesture(self.gesture.itemText(index)))
-        self.bow_button = QPushButton("Bow")
-        self.bow_button.setCheckable(True)
-        self.bow_button.setStyleSheet("QPushButton:checked { background: #bcd7f0; font-weight: bold; }")
-        self.bow_button.setToolTip("put the bow on the string (the hand moves as the gesture says)")
-        self.bow_button.toggled.connect(controller.set_bowing)
-        knob_box = QGroupBox("Knobs and pads (mirror the MIDI controller)")
-        QVBoxLayout(knob_box).addWidget(self.knobs)
-        bow_box = QGroupBox("Bowing")
-        bv = QVBoxLayout(bow_box)
-        bv.addWidget(self.bowing_pad)
-        row = QHBoxLayout()
-        row.addWidget(QLabel("Hand"))
-        row.addWidget(self.gesture, 1)
-        row.addWidget(self.bow_button, 1)
-        bv.addLayout(row)
-        controls = QHBoxLayout()
-        controls.addWidget(knob_box, 3)
-        controls.addWidget(bow_box, 1)
-        live = QWidget()
-        lv2 = QVBoxLayout(live)
-        lv2.addWidget(self.scope, 1)
-        lv2.addLayout(controls)
+        live = LiveTab(controller)  # the scope, the knobs and pads, the bowing pad and the hand
+        self.live = live
+        self.scope, self.knobs, self.bowing_pad = live.scope, live.knobs, live.bowing_pad
+        self.gesture, self.bow_button = live.gesture, live.bow_button
 
         self.analysis = AnalysisView()
         self.log = QPlainTextEdit()
@@ -252,9 +176,9 @@ class Console(QMainWindow):
         e.trial.connect(self._on_trial)
         e.knob.connect(self._on_knob)
         e.selection.connect(self._on_selection)
-        e.bowing.connect(self._on_bowing)
-        e.gesture.connect(self._on_gesture)
-        e.telemetry.connect(self._on_telemetry)
+        e.bowing.connect(self.live.show_bowing)
+        e.gesture.connect(self.live.show_gesture)
+        e.telemetry.connect(self.live.show_telemetry)
         e.status.connect(self._on_status)
         e.message.connect(self._on_message)
         e.response.connect(self._on_response)
@@ -339,11 +263,6 @@ class Console(QMainWindow):
             self.confirmation = None
             box.deleteLater()
 
-    def _pause_or_resume(self):
-        c = self.controller
-        act = {State.EMERGENCY: c.clear_emergency, State.PAUSED: c.resume, State.ENGINE_LOST: c.restart_engine}
-        act.get(c.state, c.pause)()
-
     def analyse_results(self):
         self.tabs.setCurrentWidget(self.analysis)
         self.analysis.load(self.setup.results_folder)
@@ -398,33 +317,18 @@ class Console(QMainWindow):
 
     def _on_state(self, state):
         emergency = state == State.EMERGENCY
-        self.state_label.setText(STATE_WORDS[state])
-        self.state_label.setStyleSheet("font-weight: bold;" + (" color: #c00;" if emergency else ""))
+        self.progress.show_state(state)
         active = self.controller.in_session
-        self.start_button.setEnabled(state in REST)
-        self.abort_button.setEnabled(active)
-        self.pause_button.setEnabled(state in (State.RUNNING, State.PAUSED, State.EMERGENCY, State.ENGINE_LOST))
-        self.pause_button.setText("Pause" if state == State.RUNNING else "Resume")
+        self.buttons.show_state(state, active)
         self.setup.set_editable(not active)
-        accepting = self.controller.accepting
-        self.knobs.setEnabled(accepting)
-        self.bowing_pad.setEnabled(accepting)
-        self.gesture.setEnabled(accepting)
-        self.bow_button.setEnabled(accepting)
+        self.live.set_accepting(self.controller.accepting)
         self.participant_window.show_state(state, emergency)
         if state in REST:
-            self.task_label.setText("")
             self.knobs.set_captions([])
             self.page_controls.show_none()
-            if state != State.IDLE:
-                self.trial_label.setText(STATE_WORDS[state])
 
     def _on_trial(self, trial, step, total, instructions, phase="trial", number=None, of=None):
-        self.task_label.setText("Task: " + task_type(trial.task).heading(trial))
-        counted = "" if phase == "page" else f"{'Practice' if phase == 'practice' else 'Trial'} {number} of {of}, "
-        self.trial_label.setText(f"{counted}step {step + 1} of {total}")
-        self.progress_bar.setRange(0, total)
-        self.progress_bar.setValue(step)
+        self.progress.show_trial(trial, step, total, phase, number, of)
         self.participant_window.show_trial(step, total, instructions, phase, number, of)
         if phase != "page":
             self.page_controls.show_none()
@@ -439,31 +343,15 @@ class Console(QMainWindow):
         self.participant_window.knobs.show_knob(index, value)
 
     def _on_selection(self, source, fmax):
-        text = source or "none selected yet"
-        if fmax is not None:
-            text += f" at F_max = {fmax:.3g} N"
-        self._condition_text = text
+        self.progress.show_selection(source, fmax)
         self._blinding(self.blind.isChecked())
 
     def _blinding(self, hidden):
-        self.condition_label.setText("hidden (blinding)" if hidden else self._condition_text)
+        self.progress.show_condition(hidden)
         if self.controller.runner is not None and self.controller.runner.trial is not None:
             runner = self.controller.runner
             kind = task_type(runner.trial.task)
             self.knobs.set_captions(kind.knob_captions(runner.trial, runner.task, len(self.knobs.dials), hidden))
-
-    def _on_bowing(self, on):
-        self.bow_button.blockSignals(True)
-        self.bow_button.setChecked(bool(on))
-        self.bow_button.blockSignals(False)
-
-    def _on_gesture(self, name):
-        self.gesture.setCurrentIndex(self.gesture.findText(name))
-
-    def _on_telemetry(self, block):
-        self.scope.add(block)
-        if len(block["position"]):
-            self.bowing_pad.show_handle(block["position"][-1])
 
     def _on_status(self, status, lost, knob_latency):
         self.status.show_status(status, lost, knob_latency)
@@ -480,12 +368,11 @@ class Console(QMainWindow):
             self.status.show_message(text, MESSAGE_MS, COLOURS[level])
 
     def _on_pickup(self, control, index, pending, text):
-        self.pickup_label.setText(f"{control}: {text}" if pending else "")
+        self.progress.show_pickup(control, pending, text)
         self.participant_window.show_pickup(text)
 
     def _on_response(self, response, step):
-        self.response_label.setText(task_type(response["task"]).response_text(response))
-        self.progress_bar.setValue(step + 1)
+        self.progress.show_response(response, step)
 
     # closing ------------------------------------------------------------------
     def _stop_simulated(self):

@@ -46,7 +46,7 @@ from studyapp.gui.flow_layout import FlowLayout
 from studyapp.gui.frame_rate import FrameRateMeter
 from studyapp.model.device import DeviceLimits
 from studyapp.model.sensors import SensorSpec
-from studyapp.session.scope_buffer import MAX_SECONDS, ScopeBuffer
+from studyapp.live.scope_buffer import MAX_SECONDS, ScopeBuffer
 
 FRAME_PERIOD = 0.015  # s: aim above 60 fps; the measured rate is what counts
 MIN_SECONDS = 0.1

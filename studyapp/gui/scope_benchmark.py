@@ -12,7 +12,7 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
 from studyapp.gui.preview_bowing import PreviewBowing
-from studyapp.session.scope_buffer import MAX_SECONDS
+from studyapp.live.scope_buffer import MAX_SECONDS
 
 
 class ScopeBenchmark(PreviewBowing):

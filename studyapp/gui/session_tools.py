@@ -30,7 +30,7 @@ from PySide6.QtWidgets import (
 )
 
 from studyapp.errors import UserError
-from studyapp.session.master_sound import DB_RANGE
+from studyapp.live.master_sound import DB_RANGE
 
 
 class RunSheetDialog(QDialog):

@@ -10,7 +10,7 @@ from studyapp.cli import main
 from studyapp.engine import commands as cmd
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
-from studyapp.session.controller import SessionController
+from studyapp.live.controller import SessionController
 from tests.engine.waiting import wait_for
 
 DEMO = Path(__file__).resolve().parents[2] / "protocols" / "demo.toml"

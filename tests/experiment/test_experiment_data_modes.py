@@ -9,7 +9,7 @@ import pytest
 
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
-from tests.session.test_session_controller import controller  # noqa: F401 - the fixture
+from tests.live.test_session_controller import controller  # noqa: F401 - the fixture
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "protocols" / "demo.toml"
@@ -76,7 +76,7 @@ def test_the_audio_kept_with_a_session_gets_the_mode_of_its_files(tmp_path, monk
 @pytest.mark.parametrize("shared,file", [(None, 0o600), ("1", 0o660)])
 def test_the_session_controller_asks_the_engine_for_that_mode(controller, monkeypatch, shared, file):
     from studyapp.engine import commands as cmd
-    from tests.session.test_session_controller import start, up
+    from tests.live.test_session_controller import start, up
 
     if shared is None:
         monkeypatch.delenv("STUDYAPP_GROUP_SHARED", raising=False)

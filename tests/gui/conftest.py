@@ -63,7 +63,7 @@ def answer_question(console, qtbot, button):
 @pytest.fixture(scope="package")
 def console(qapp):
     from studyapp.gui.console import Console
-    from studyapp.session.controller import SessionController
+    from studyapp.live.controller import SessionController
 
     controller = SessionController(audio="device", midi="first", hang_timeout=0.5)
     window = Console(controller)

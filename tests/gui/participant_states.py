@@ -19,8 +19,8 @@ from types import SimpleNamespace
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.schedule import build_schedule
 from studyapp.experiment.tasks import task_type
-from studyapp.session.controller import instructions_for
-from studyapp.session.evented import EventGroup
+from studyapp.live.controller import instructions_for
+from studyapp.live.evented import EventGroup
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE_KINDS = ("welcome", "calibration", "instructions", "transition", "break", "goodbye")

@@ -10,7 +10,7 @@ from PySide6.QtCore import QPoint, QRect, Qt
 from PySide6.QtWidgets import QApplication, QScrollArea
 
 from studyapp.experiment.protocol import load_protocol
-from studyapp.session.controller import PAGE_SETTLE_S
+from studyapp.live.controller import PAGE_SETTLE_S
 from tests.gui.conftest import DEMO, ENGINE_START, ROOT, wait_until
 
 pytest.importorskip("pytestqt")

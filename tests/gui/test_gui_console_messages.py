@@ -59,8 +59,8 @@ def test_abort_without_a_session_asks_nothing(idle_console, monkeypatch):
 def fake_console(qapp, tmp_path):
     """A console over a fake engine host (no process): closing it must not stop the shared console's engine."""
     from studyapp.gui.console import Console
-    from studyapp.session.controller import SessionController
-    from tests.session.fakes import FakeHost
+    from studyapp.live.controller import SessionController
+    from tests.live.fakes import FakeHost
 
     controller = SessionController(audio="null", midi="none", make_host=FakeHost)
     console = Console(controller)

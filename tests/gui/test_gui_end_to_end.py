@@ -22,7 +22,7 @@ from PySide6.QtCore import Qt
 
 from studyapp.experiment.export import export_responses
 from studyapp.model.fmax_knob import fmax_from_knob
-from studyapp.session.controller import PAGE_SETTLE_S
+from studyapp.live.controller import PAGE_SETTLE_S
 from tests.gui.conftest import ENGINE_START, wait_until
 
 pytest.importorskip("pytestqt")
@@ -160,7 +160,7 @@ def listen(c, app, condition):
 @pytest.fixture
 def session_console(qapp, jack_server):
     from studyapp.gui.console import Console
-    from studyapp.session.controller import SessionController
+    from studyapp.live.controller import SessionController
 
     controller = SessionController(audio="device", midi="virtual", hang_timeout=0.5)
     window = Console(controller)

@@ -21,7 +21,7 @@ from PySide6.QtCore import QPoint, Qt
 
 from studyapp.experiment.export import export_responses
 from studyapp.experiment.protocol import load_protocol
-from studyapp.session.controller import PAGE_SETTLE_S
+from studyapp.live.controller import PAGE_SETTLE_S
 from tests import audio_checks
 from tests.gui.conftest import ENGINE_START, ROOT, wait_until
 from tests.gui.test_gui_end_to_end import Lpd8, session_console, step_of  # noqa: F401 (a fixture)

@@ -1,6 +1,6 @@
 """The participant's pages on screen (offscreen Qt): Markdown rendered, Continue, the level check's confirm.
 
-The console runs a session on a fake engine host (tests/session/fakes.py): no
+The console runs a session on a fake engine host (tests/live/fakes.py): no
 worker process, the controller polled by hand.
 """
 
@@ -14,8 +14,8 @@ from studyapp.experiment.pages import markdown
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.schedule import build_schedule
 from studyapp.gui.page_view import PageView
-from tests.session.fakes import FakeHost, SteppingClock
-from tests.session.test_session_pages import PROTOCOL
+from tests.live.fakes import FakeHost, SteppingClock
+from tests.live.test_session_pages import PROTOCOL
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -69,7 +69,7 @@ def test_the_experimenters_page_shows_no_continue(qapp):
 @pytest.fixture
 def paged_console(qapp, tmp_path):
     from studyapp.gui.console import Console
-    from studyapp.session.controller import SessionController
+    from studyapp.live.controller import SessionController
 
     path = tmp_path / "pages.toml"
     path.write_text(PROTOCOL)

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from studyapp.experiment.event_fields import integer, text
+from studyapp.experiment.records import integer, text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad

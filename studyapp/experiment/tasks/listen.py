@@ -15,7 +15,7 @@ The simulated participant bows through the whole trial.
 
 from dataclasses import dataclass
 
-from studyapp.experiment.event_fields import text
+from studyapp.experiment.records import text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.tasks.confirm_pad import check_knob_value
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases

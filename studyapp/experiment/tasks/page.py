@@ -18,7 +18,7 @@ acknowledged page again; how long it was read is the time between its
 and ``measure`` None (the log keeps when each page was acknowledged).
 """
 
-from studyapp.experiment.event_fields import text
+from studyapp.experiment.records import text
 from studyapp.experiment.pages import KINDS, WHO
 from studyapp.experiment.tasks.confirm_pad import check_knob_value
 

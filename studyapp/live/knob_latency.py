@@ -10,6 +10,8 @@ the status bar shows the last and the largest, and the session log gets one
 
 import numpy as np
 
+from studyapp.experiment import records
+
 
 class KnobLatency:
     def __init__(self):
@@ -29,5 +31,4 @@ class KnobLatency:
         values = np.array([latency for latency, _ in self._trial])
         midi = sum(origin == "midi" for _, origin in self._trial)
         self._trial = []
-        return {"type": "knob_latency", "controls": len(values), "midi": midi,
-                "median": float(np.median(values)), "max": float(values.max())}
+        return records.knob_latency(len(values), midi, float(np.median(values)), float(values.max()))

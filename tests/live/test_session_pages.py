@@ -7,8 +7,8 @@ import pytest
 
 from studyapp.engine import commands as cmd
 from studyapp.experiment.session_log import read_events
-from studyapp.session.controller import PAGE_SETTLE_S, SessionController, State
-from tests.session.fakes import FakeHost, SteppingClock
+from studyapp.live.controller import PAGE_SETTLE_S, SessionController, State
+from tests.live.fakes import FakeHost, SteppingClock
 
 PROTOCOL = """
 [study]

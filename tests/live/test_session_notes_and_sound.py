@@ -4,7 +4,7 @@ import pytest
 
 from studyapp.engine import commands as cmd
 from studyapp.errors import UserError
-from tests.session.test_session_controller import S, controller, log, play_rating, reach, start, up  # noqa: F401
+from tests.live.test_session_controller import S, controller, log, play_rating, reach, start, up  # noqa: F401
 
 
 def test_notes_during_and_after_a_session_are_logged_with_the_step(controller):

@@ -20,12 +20,17 @@ stability verdict is the worker's own (``broken`` and ``stability_score``,
 published per block by the loop's monitor, model/stability.py): breakdown is
 judged once, where the loop runs.
 
-Knob actions are applied by the worker itself (the trial's mapping: the
+One writer per setting. ``source``, ``fmax`` and ``bowing`` are the
+trial's settings as the worker has them (while held: as it gets them back).
+They are written from two places only, never guessed: what this loop sends,
+and what the worker reports it applied (``applied(commands)``, from its
+``events.Applied``): the worker applies the trial's knob actions itself (the
 rating knob j selects condition j at the rating F_max, the adjustment knob
-sets F_max on the protocol's logarithmic scale, model/fmax_knob.py).
-``applied(commands)`` records what the worker did, and a setting the runner
-then asks for is sent only if it differs from what the worker already has:
-a knob makes no round trip.
+sets F_max on the protocol's logarithmic scale, model/fmax_knob.py). A setting
+the runner asks for is sent only when it differs from the one in force, so
+the runner following a knob the worker has already applied sends nothing: a
+knob makes no round trip, and the worker stays the one writer of what its
+knobs set.
 
 Holding. ``hold(True)`` (pause, emergency stop) sends F_max = 0, lifts the bow
 and installs an empty mapping tagged ``-trial`` (so the held samples and any
@@ -74,61 +79,57 @@ class EngineLoop:
         self.held = False
         self._pending = None
         self._fault = None
-        self._in_engine = {}  # what the worker has in force, as far as this trial set it
         for command in (cmd.SetFmax(0.0), cmd.SetBowing(False), cmd.ResetString(), cmd.SetGesture(gesture),
                         cmd.SetSource(source),
                         cmd.InstallActions(self.actions, trial=self.trial, positions=dict(positions or {}))):
-            self._send(command)
-
-    def _send(self, command):
-        self.engine.send(command)
-        self.applied((command,))
+            self.engine.send(command)
 
     def applied(self, commands):
-        """Note settings the worker has applied (its own knob actions, or what was sent)."""
+        """The worker applied ``commands`` (its own knob action, reported in ``events.Applied``): in force now."""
         for command in commands:
             if isinstance(command, cmd.SetFmax):
-                self._in_engine["fmax"] = command.newtons
+                self.fmax = command.newtons
             elif isinstance(command, cmd.SetSource):
-                self._in_engine["source"] = command.name
+                self.source = command.name
             elif isinstance(command, cmd.SetBowing):
-                self._in_engine["bowing"] = command.on
+                self.bowing = command.on
 
-    def _set(self, key, value, make):
-        if self._in_engine.get(key) != value:
-            self._send(make(value))
-
-    # settings, as the runner makes them ---------------------------------------
+    # settings, as the runner makes them: sent when they change, and not while held ---------------
     def set_source(self, name):
-        self._set("source", name, cmd.SetSource)
-        self.source = name
+        if name != self.source:
+            self.source = name
+            self.engine.send(cmd.SetSource(name))
 
     def set_fmax(self, fmax):
-        self.fmax = float(fmax)
-        if not self.held:
-            self._set("fmax", self.fmax, cmd.SetFmax)
+        fmax = float(fmax)
+        if fmax != self.fmax:
+            self.fmax = fmax
+            if not self.held:
+                self.engine.send(cmd.SetFmax(fmax))
 
     def set_bowing(self, on):
-        self.bowing = bool(on)
-        if not self.held:
-            self._set("bowing", self.bowing, cmd.SetBowing)
+        on = bool(on)
+        if on != self.bowing:
+            self.bowing = on
+            if not self.held:
+                self.engine.send(cmd.SetBowing(on))
 
     def set_gesture(self, name):
         self.gesture = name
-        self._send(cmd.SetGesture(name))
+        self.engine.send(cmd.SetGesture(name))
 
     def set_hand_target(self, x_m):
-        self._send(cmd.SetHandTarget(float(x_m)))
+        self.engine.send(cmd.SetHandTarget(float(x_m)))
 
     def hold(self, on):
         """Zero F_max, lift the bow, take the knobs away (True); or give the runner's settings back (False)."""
         # always sent: a knob the worker applied but the controller has not read yet may have moved F_max
         self.held = bool(on)
-        self._send(cmd.SetFmax(0.0 if self.held else self.fmax))
-        self._send(cmd.SetBowing(False if self.held else self.bowing))
+        self.engine.send(cmd.SetFmax(0.0 if self.held else self.fmax))
+        self.engine.send(cmd.SetBowing(False if self.held else self.bowing))
         # while held the worker tags the samples and controls -trial: neither reaches the trial
-        self._send(cmd.InstallActions({}, trial=-self.trial) if self.held
-                   else cmd.InstallActions(self.actions, trial=self.trial))
+        self.engine.send(cmd.InstallActions({}, trial=-self.trial) if self.held
+                         else cmd.InstallActions(self.actions, trial=self.trial))
 
     # running --------------------------------------------------------------
     def consume(self, block):

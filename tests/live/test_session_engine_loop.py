@@ -5,7 +5,7 @@ import pytest
 
 from studyapp.engine import commands as cmd
 from studyapp.errors import ParameterError
-from studyapp.session.engine_loop import EngineLoop
+from studyapp.live.engine_loop import EngineLoop
 
 RATE = 5000.0
 RATING = {"knob1": ("select", "KALLEV", 1.0)}
@@ -97,3 +97,15 @@ def test_fault_is_the_engines_latched_fault():
 def test_refuses_a_condition_the_engine_does_not_run():
     with pytest.raises(ParameterError, match="KALLEV"):
         EngineLoop(RecordingEngine(["LVT"]), {"KALLEV": {}}, "KALLEV", "strokes")
+
+
+def test_what_the_worker_applied_is_the_setting_a_hold_gives_back():
+    """One record per setting: the worker's knob action is in force, so resuming gives it back, not an older wish."""
+    engine = RecordingEngine(["KALLEV"])
+    loop = EngineLoop(engine, {"KALLEV": {}}, "KALLEV", "hold", trial=3, actions=RATING)
+    loop.applied((cmd.SetSource("KALLEV"), cmd.SetFmax(1.0)))  # knob 1's action, run by the worker
+    loop.hold(True)
+    engine.sent.clear()
+    loop.hold(False)
+    assert engine.sent[0] == cmd.SetFmax(1.0)
+    assert (loop.source, loop.fmax) == ("KALLEV", 1.0)

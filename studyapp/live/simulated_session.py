@@ -32,10 +32,10 @@ import numpy as np
 
 from studyapp.experiment.hand_trace import ReplayingHand
 from studyapp.experiment.simulated_participant import SimulatedParticipant
-from studyapp.session.controller import PAGE_SETTLE_S
+from studyapp.live.controls import PAGE_SETTLE_S
+from studyapp.live.states import ACTIVE, State
 
 WAIT_STEP = 0.004  # s between looks at the controller's progress
-ACTIVE = ("starting", "running", "paused", "emergency", "clearing", "engine_lost", "restarting")
 
 
 class Stopped(Exception):
@@ -92,10 +92,10 @@ class ParticipantProxy:
     def start_trial(self):
         c = self.controller
         while True:
-            if c.state == "finished":
+            if c.state == State.FINISHED:
                 return None
             self._check()
-            if c.state == "running" and c.trial_serial > self._seen:
+            if c.state == State.RUNNING and c.trial_serial > self._seen:
                 self._seen = c.trial_serial
                 runner = c.runner
                 self._trial = runner.trial

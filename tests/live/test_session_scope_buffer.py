@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from studyapp.session.scope_buffer import ScopeBuffer, envelope
+from studyapp.live.scope_buffer import ScopeBuffer, envelope
 
 
 def reference_envelope(x, k):

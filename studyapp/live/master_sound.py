@@ -15,6 +15,7 @@ import math
 
 from studyapp.engine import commands as cmd
 from studyapp.errors import UserError
+from studyapp.experiment import records
 
 DB_RANGE = (-40.0, 0.0)
 
@@ -34,11 +35,11 @@ class MasterSound:
         if not (isinstance(db, (int, float)) and math.isfinite(db) and low <= db <= high):
             raise UserError(f"volume {db!r} dB: allowed is {low:g} to {high:g} dB")
         self.db = float(db)
-        return {"type": "volume", "db": self.db, "gain": self.gain}
+        return records.volume(self.db, self.gain)
 
     def set_muted(self, on):
         self.muted = bool(on)
-        return {"type": "mute", "on": self.muted}
+        return records.mute(self.muted)
 
     def commands(self):
         """The commands that give an engine this setting."""

@@ -8,8 +8,8 @@ import pytest
 from studyapp.engine import commands as cmd
 from studyapp.experiment.session_log import read_events
 from studyapp.model.fmax_knob import fmax_from_knob
-from studyapp.session.controller import TRANSITIONS, SessionController, State
-from tests.session.fakes import LATENCY, FakeHost
+from studyapp.live.controller import TRANSITIONS, SessionController, State
+from tests.live.fakes import LATENCY, FakeHost
 
 PROTOCOL = """
 [study]

@@ -1,0 +1,192 @@
+"""Every record the session log (events.jsonl) holds, made here, and the checks of a logged field.
+
+A record is a JSON object with a ``type``; ``SessionLog.append`` stamps it
+(``seq``, ``mono``, ``wall``) and ``SessionRunner.log`` puts the trial's
+``step``, ``task`` (and ``practice``) in front. The constructors below fix
+each kind's keys and their order, which is what the file holds byte for byte
+(tests/live/test_event_records_golden.py). The task types make their own
+``knob``, ``pad``, ``acknowledge`` and ``response`` records (their fields are
+the task's: ``studyapp.experiment.tasks``); ``response_problem`` checks the
+fields every response shares before export reads it.
+
+Checks. Every number has an upper bound as well: a value such as step 10^30
+or F_max 10^308 is valid JSON but no session writes it, and letting it
+through gave an overflow or a memory error further on (issue 21, item 14).
+"""
+
+import math
+
+from studyapp.model.loop import FMAX_LIMIT
+
+STEP_MAX = 10**6  # a session's steps: a few hundred
+TRIAL_MAX = 10_000  # trials of one task per condition (the protocol allows 100 plus practice)
+FMAX_MAX = FMAX_LIMIT  # N: no loop ran above it
+
+SESSION_CREATED = "session_created"
+SESSION_END = "session_end"
+NOTE = "note"
+ENGINE_NOTE = "one real-time engine per session: its seed, not the trials' loop_seed, seeds the sensor noise"
+
+
+# the session and its runs -------------------------------------------------------------------------
+def session_created(description: dict) -> dict:
+    return {"type": SESSION_CREATED, "description": description}
+
+
+def session_end(recovered: bool = False) -> dict:
+    """The session's last trial has its response (``recovered``: written when a later open found it missing)."""
+    return {"type": SESSION_END, "recovered": True} if recovered else {"type": SESSION_END}
+
+
+def run_start(resume: bool, app_version: str, finished_trials: int, trials: int) -> dict:
+    return {"type": "run_start", "resume": resume, "app_version": app_version, "finished_trials": finished_trials,
+            "trials": trials}
+
+
+def run_stop(reason: str) -> dict:
+    return {"type": "run_stop", "reason": reason}
+
+
+def log_repaired(dropped_bytes: int, copy: str) -> dict:
+    return {"type": "log_repaired", "dropped_bytes": dropped_bytes, "copy": copy}
+
+
+def log_damaged(lines: list, copy: str) -> dict:
+    return {"type": "log_damaged", "lines": lines, "copy": copy}
+
+
+def note(text: str) -> dict:
+    return {"type": NOTE, "text": text, "by": "experimenter"}
+
+
+# the live apparatus --------------------------------------------------------------------------------
+def engine(info: dict, seed: int) -> dict:
+    """A session's engine came up (``info``: ``Engine.info``)."""
+    return {"type": "engine", "rate": info["rate"], "block": info["block"], "audio": info["audio"],
+            "midi": info["midi"], "paced": info["paced"], "realtime": info["realtime"], "seed": seed,
+            "note": ENGINE_NOTE}
+
+
+def engine_failed(faults: list) -> dict:
+    return {"type": "engine_failed", "faults": faults}
+
+
+def volume(db: float, gain: float) -> dict:
+    return {"type": "volume", "db": db, "gain": gain}
+
+
+def mute(on: bool) -> dict:
+    return {"type": "mute", "on": on}
+
+
+def pause() -> dict:
+    return {"type": "pause"}
+
+
+def resume() -> dict:
+    return {"type": "resume"}
+
+
+def abort(reason: str | None = None) -> dict:
+    return {"type": "abort"} if reason is None else {"type": "abort", "reason": reason}
+
+
+def emergency_stop() -> dict:
+    return {"type": "emergency_stop"}
+
+
+def emergency_clear() -> dict:
+    return {"type": "emergency_clear"}
+
+
+# a trial ---------------------------------------------------------------------------------------------
+def trial_start(trial: int, condition, conditions: list, restart: bool, restored_knobs: int,
+                loop_seed: int) -> dict:
+    return {"type": "trial_start", "trial": trial, "condition": condition, "conditions": conditions,
+            "restart": restart, "restored_knobs": restored_knobs, "loop_seed": loop_seed}
+
+
+def gesture(name: str, previous: str, reason: str | None = None) -> dict:
+    record = {"type": "gesture", "name": name, "from": previous}
+    return record if reason is None else {**record, "reason": reason}
+
+
+def bowing(on: bool) -> dict:
+    return {"type": "bowing", "on": on}
+
+
+def stability(broken: bool, score: float, fmax: float) -> dict:
+    return {"type": "stability", "broken": broken, "score": score, "fmax": fmax}
+
+
+def fault(message: str, fmax: float) -> dict:
+    return {"type": "fault", "message": message, "fmax": fmax}
+
+
+def hand_trace(trial: int, spacing_s: float, t: list, x_mm: list, bow: list) -> dict:
+    return {"type": "hand_trace", "trial": trial, "spacing_s": spacing_s, "t": t, "x_mm": x_mm, "bow": bow}
+
+
+def pickup(control: str, trial: int, when: float | None, ignored: int) -> dict:
+    """A knob acted after waiting for pickup: ``when`` (the trial's clock, s), ``ignored`` messages."""
+    return {"type": "pickup", "control": control, "trial": trial, "when": when, "ignored": ignored}
+
+
+def press_too_soon(control: str, since: float) -> dict:
+    """The participant's press on a page shown ``since`` s ago, taken as the second press of a double press."""
+    return {"type": "acknowledge", "by": "participant", "control": control, "accepted": False,
+            "reason": f"pressed {since:.2f} s after the page appeared: taken as a double press"}
+
+
+def knob_latency(controls: int, midi: int, median: float, largest: float) -> dict:
+    return {"type": "knob_latency", "controls": controls, "midi": midi, "median": median, "max": largest}
+
+
+def trial_health(trial: int, deadline_misses: int, underruns: int, faults: int, events_dropped: int) -> dict:
+    """The engine's fault counters while a trial ran (``underruns``: the audio underruns)."""
+    return {"type": "trial_health", "trial": trial, "deadline_misses": deadline_misses, "underruns": underruns,
+            "faults": faults, "events_dropped": events_dropped}
+
+
+# checks of a logged field ------------------------------------------------------------------------------
+def integer(value, low, high=math.inf):
+    """An int (not a bool) from ``low`` to ``high``."""
+    return isinstance(value, int) and not isinstance(value, bool) and low <= value <= high
+
+
+def number(value, high=math.inf):
+    """A finite int or float (not a bool) from 0 to ``high``."""
+    return (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            and 0 <= value <= high)
+
+
+def text(value):
+    """A non-blank string."""
+    return isinstance(value, str) and value.strip() != ""
+
+
+def response_problem(event, task_types):
+    """None for a well-formed ``response`` record, else the problem as ``field = value: allowed ...``.
+
+    A log line can be valid JSON and still not be a response the tasks wrote (an
+    edited file, another program's line). Fields every response has: ``step`` an
+    integer from 0 to ``STEP_MAX``, ``task`` one of ``task_types`` (name -> task
+    type), ``trial`` an integer from 1 to ``TRIAL_MAX``, ``fmax`` a number from 0
+    to ``FMAX_MAX`` (N), ``wall`` the time as text, ``practice`` (when present)
+    true or false; the rest is the task type's (its ``response_problem``).
+    """
+    if not isinstance(event, dict):
+        return f"event {event!r}: allowed is a JSON object"
+    names = tuple(task_types)
+    checks = [
+        ("step", integer(event.get("step"), 0, STEP_MAX), f"an integer from 0 to {STEP_MAX}"),
+        ("task", isinstance(event.get("task"), str) and event.get("task") in names, ", ".join(names)),
+        ("trial", integer(event.get("trial"), 1, TRIAL_MAX), f"an integer from 1 to {TRIAL_MAX}"),
+        ("fmax", number(event.get("fmax"), FMAX_MAX), f"a number from 0 to {FMAX_MAX:g} (N)"),
+        ("wall", text(event.get("wall")), "the time as ISO-8601 text"),
+        ("practice", isinstance(event.get("practice", False), bool), "true or false (absent: false)"),
+    ]
+    for name, ok, allowed in checks:
+        if not ok:
+            return f"{name} = {event.get(name)!r}: allowed is {allowed}"
+    return task_types[event["task"]].response_problem(event)
