@@ -61,8 +61,8 @@ import pandas as pd
 from studyapp.errors import InputDataError, UserError
 from studyapp.experiment import records
 from studyapp.experiment.enrolment import is_simulated
-from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.log_scan import written_twice
+from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import TASK_TYPES, task_type
 
