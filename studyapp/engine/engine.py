@@ -59,11 +59,12 @@ from multiprocessing.connection import wait as wait_for
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine import guard, midi_hotplug
-from studyapp.engine.audio import parse as parse_audio
+from studyapp.engine.audio.sinks import parse as parse_audio
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
+from studyapp.engine.telemetry import channels_for
 from studyapp.errors import EngineError, ParameterError
 from studyapp.model.loop import GESTURES
 from studyapp.model.sources import with_pseudo_sources
@@ -125,7 +126,7 @@ class Engine:
         return names
 
     def start(self, timeout=START_TIMEOUT):
-        from studyapp.engine.worker import REALTIME_PRIORITY, channels_for, main
+        from studyapp.engine.worker import REALTIME_PRIORITY, main
 
         c = self.config
         capacity = max(int(c.telemetry_seconds * c.rate), 4 * c.block_size())
