@@ -9,7 +9,8 @@ from scipy.io import wavfile
 
 from studyapp.engine.audio.recorder import AudioRecorder
 from studyapp.engine.audio.sinks import WavSink
-from studyapp.engine.audio.wav import claim, numbered_names, open_wav, pcm16
+from studyapp.engine.audio.wav import open_wav, pcm16
+from studyapp.free_names import claim, first_free, numbered_names
 
 
 def test_pcm16_is_round_32767_x_clipped_to_full_scale():
@@ -28,8 +29,12 @@ def test_open_wav_writes_16_bit_mono_at_the_rate(tmp_path):
 def test_numbered_names_and_claims_never_take_an_existing_name(tmp_path):
     names = numbered_names(tmp_path / "take.wav")
     assert [next(names).name for _ in range(3)] == ["take.wav", "take-2.wav", "take-3.wav"]
+    assert first_free(tmp_path / "take.wav") == tmp_path / "take.wav"
     (tmp_path / "take.wav").write_bytes(b"earlier")
     (tmp_path / "take-3.wav").write_bytes(b"earlier too")
+    assert first_free(tmp_path / "take.wav") == tmp_path / "take-2.wav"
+    (tmp_path / "2026-11-25T15-00-00").mkdir()  # a session's folder: a name without a suffix
+    assert first_free(tmp_path / "2026-11-25T15-00-00").name == "2026-11-25T15-00-00-2"
     claimed = []
     for _ in range(3):
         fd, name = claim(tmp_path / "take.wav", 0o640)

@@ -21,7 +21,7 @@ Besides the steps' ``start`` and ``end`` the cues mark where the bow was put
 on the string and lifted (``bow_on``, ``bow_off``: the output is silent from
 a ``bow_off`` on, signal_chain.py) and every ``underrun``.
 
-Files are never overwritten (``wav.claim``): ``audio.wav`` is reserved with an
+Files are never overwritten (``free_names.claim``): ``audio.wav`` is reserved with an
 exclusive create, else ``audio-2.wav``, ``audio-3.wav``, ...: one file per
 engine run of a session (a resumed session, a restarted engine). The WAV file
 and ``audio_cues.csv`` are created with the permissions ``mode`` (the session's
@@ -48,7 +48,8 @@ import threading
 
 import numpy as np
 
-from studyapp.engine.audio.wav import claim, create, open_wav, pcm16
+from studyapp.engine.audio.wav import open_wav, pcm16
+from studyapp.free_names import claim, create
 
 QUEUE_SECONDS = 10.0  # of audio the writer may fall behind before blocks are dropped
 CUES_FILE = "audio_cues.csv"

@@ -40,10 +40,11 @@ import numpy as np
 
 from studyapp.atomic import default_mode
 from studyapp.engine.audio.fifo import Fifo
-from studyapp.engine.audio.wav import claim, numbered_names, open_wav, pcm16
+from studyapp.engine.audio.wav import open_wav, pcm16
 from studyapp.engine.native_stderr import captured_native_stderr
 from studyapp.engine.signal_chain import Gain, SignalChain
 from studyapp.errors import ParameterError
+from studyapp.free_names import claim, first_free
 
 DEVICE_RATE = 48_000.0
 WAV_RATE = 48_000.0
@@ -178,7 +179,7 @@ class WavSink(Sink):
     def __init__(self, path, haptic_rate, rate=WAV_RATE, say=print):
         super().__init__(haptic_rate, rate)
         self.say = say
-        self.path = str(next(name for name in numbered_names(path) if not os.path.lexists(name)))
+        self.path = str(first_free(path))
         if self.path != str(path):
             say(f"audio: {path} exists; writing {self.path} (never over an earlier file)")
         self.rate = float(rate)
