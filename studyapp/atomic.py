@@ -61,7 +61,7 @@ def _unheld(fd):
     return True
 
 
-def _default_mode():
+def default_mode():
     """The permissions ``open()`` would give a new file under the user's umask."""
     umask = os.umask(0)
     os.umask(umask)
@@ -142,7 +142,7 @@ def _temporary(target, mode, named):
             tmp = Path(name)
         _lock(fd)  # ours while we live: remove_stale leaves it alone
         # mkstemp and O_TMPFILE make the file private (0600); an output gets the usual permissions unless told
-        os.fchmod(fd, _default_mode() if mode is None else mode)
+        os.fchmod(fd, default_mode() if mode is None else mode)
         if named and tmp is None:
             tmp = _name(fd, target)
         yield fd, tmp

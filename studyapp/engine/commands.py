@@ -7,10 +7,11 @@ from ``sent`` to the start of the first block run with the new setting). The
 worker applies commands at block boundaries, in order, through a handler table
 (``worker.Worker.HANDLERS``: one method per command type).
 
-MIDI actions map a control (see midi.ControlMap) to a command. The worker
-applies them itself, in and out of a session, through the mapping in force:
+An action (model/controls.py: ``FmaxKnob``, ``Select``, ...) maps a control
+(see midi.ControlMap) to commands (``action_commands``). The worker applies
+them itself, in and out of a session, through the mapping in force:
 ``default_actions`` outside a session (knob 1 sets F_max through the app's one
-knob law, model/fmax_knob.py, the paper's logarithmic map of Sec. 8.2, over
+knob law, ``FmaxKnob``: the paper's logarithmic map of Sec. 8.2, over
 ``LIVE_RANGE``; knob 2 the volume; pad i selects the i-th velocity source of
 the scene), the trial's mapping during one (``InstallActions``). An on-screen
 knob reaches the same mapping as a ``Control`` command, so a knob takes one
@@ -20,8 +21,9 @@ route whatever the hand turned.
 import time
 from dataclasses import dataclass, field
 
-from studyapp.errors import ParameterError
-from studyapp.model.fmax_knob import KNOB_MAX, LIVE_RANGE, fmax_from_knob
+from studyapp.model.controls import (
+    LIVE_RANGE, Bowing, FmaxKnob, FmaxLinear, HandTarget, Select, Source, Volume, as_action, as_actions, knob_step,
+)
 
 
 @dataclass(frozen=True)
@@ -88,7 +90,7 @@ class ReferenceTone(Command):
 @dataclass(frozen=True)
 class RecordAudio(Command):
     """Keep what the participant hears in the WAV file ``path`` (the first free of ``audio.wav``,
-    ``audio-2.wav``, ...: never overwritten; engine/audio_recorder.py); None stops recording. The
+    ``audio-2.wav``, ...: never overwritten; engine/audio/recorder.py); None stops recording. The
     WAV file and ``audio_cues.csv`` get the permissions ``mode`` (participant data: the session's
     files' mode, experiment/data_modes.py), whatever the umask."""
 
@@ -128,7 +130,7 @@ class Stop(Command):
 
 @dataclass(frozen=True)
 class InstallActions(Command):
-    """The ``{control: action}`` mapping from now on; ``trial`` tags the controls it applies.
+    """The ``{control: action}`` mapping (model/controls.py) from now on; ``trial`` tags the controls it applies.
 
     ``positions``: the rating knobs' positions (``{control: 0..127}``, a rated
     knob's level for pickup) from now on; None keeps the worker's (a pause).
@@ -137,6 +139,9 @@ class InstallActions(Command):
     actions: dict
     trial: int = 0
     positions: dict | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "actions", as_actions(self.actions))  # typed, whichever spelling was given
 
 
 @dataclass(frozen=True)
@@ -149,27 +154,28 @@ class Control(Command):
 
 def default_actions(sources, fmax_range=LIVE_RANGE):
     """``{control: action}`` for live use: knob1 F_max, knob2 volume, pad i the i-th source."""
-    actions = {"knob1": ("fmax_log", *fmax_range), "knob2": ("volume",)}
+    actions = {"knob1": FmaxKnob(*fmax_range), "knob2": Volume()}
     for i, name in enumerate(list(sources)[:8], start=1):
-        actions[f"pad{i}"] = ("source", name)
+        actions[f"pad{i}"] = Source(name)
     return actions
 
 
-_ACTIONS = {
-    "fmax_log": lambda a, v, s: (SetFmax(fmax_from_knob(v * KNOB_MAX, a[1], a[2]), sent=s),),
-    "fmax_linear": lambda a, v, s: (SetFmax(a[1] + v * (a[2] - a[1]), sent=s),),
-    "volume": lambda a, v, s: (SetVolume(v, sent=s),),
-    "source": lambda a, v, s: (SetSource(a[1], sent=s),) if v > 0 else (),  # a pad: pressed, not released
-    # a rating knob: any movement selects its condition, at the task's F_max when one is given
-    "select": lambda a, v, s: (SetSource(a[1], sent=s),) + tuple(SetFmax(f, sent=s) for f in a[2:3]),
-    "bowing": lambda a, v, s: (SetBowing(v > 0, sent=s),),
-    "hand_target": lambda a, v, s: (SetHandTarget(a[1] + v * (a[2] - a[1]), sent=s),),
-}
-
-
 def action_commands(action, value, sent):
-    """The commands an action makes from a control value in [0, 1] (none, e.g. for a pad released)."""
-    make = _ACTIONS.get(action[0])
-    if make is None:
-        raise ParameterError(f"MIDI action {action[0]!r}: allowed are {', '.join(_ACTIONS)}")
-    return make(action, value, sent)
+    """The commands an action (model/controls.py) makes from a control value in [0, 1] (none, e.g. for a
+    pad released); its compact spelling ``(kind, *fields)`` is read too."""
+    match as_action(action):
+        case FmaxKnob() as knob:
+            return (SetFmax(knob.fmax(knob_step(value)), sent=sent),)
+        case FmaxLinear() as linear:
+            return (SetFmax(linear.fmax(value), sent=sent),)
+        case Volume():
+            return (SetVolume(value, sent=sent),)
+        case Source(name):
+            return (SetSource(name, sent=sent),) if value > 0 else ()  # a pad: pressed, not released
+        case Select(condition, fmax):
+            # a rating knob: any movement selects its condition, at the task's F_max when one is given
+            return (SetSource(condition, sent=sent),) + (() if fmax is None else (SetFmax(fmax, sent=sent),))
+        case Bowing():
+            return (SetBowing(value > 0, sent=sent),)
+        case HandTarget() as hand:
+            return (SetHandTarget(hand.metres(value), sent=sent),)

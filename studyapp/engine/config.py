@@ -36,7 +36,7 @@ class EngineConfig:
     lead: float = 0.03  # s of audio queued ahead of a device
     midi: str = "none"  # PORT | first | virtual | none  (midi.open_input)
     midi_map: dict | None = None  # protocol's map (midi.ControlMap.from_protocol); None: LPD8 factory
-    actions: dict | None = None  # control -> action (commands.action_commands); None: default_actions
+    actions: dict | None = None  # control -> action (model/controls.py); None: commands.default_actions
     safety: SafetyLimits = field(default_factory=SafetyLimits)
     telemetry_seconds: float = 4.0  # history kept in the rings
     realtime: bool = True  # ask for SCHED_FIFO for the worker's loop thread (falls back silently)

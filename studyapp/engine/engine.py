@@ -10,35 +10,12 @@ The parent creates the shared memory (a ring for the telemetry, the status
 block, a ring of events from the worker), spawns the force guard
 (``guard.main``, a process of its own: nothing the parent does can delay it)
 and the worker (``worker.main``), and, once the worker reports ready, runs a
-watchdog thread that drains the worker's events and reports faults. The
-guard, not this thread, cuts the force of a worker whose heartbeat is older
-than ``hang_timeout`` (default 80 ms): it clears the ``force_enable`` word
-within ``hang_timeout + guard.POLL``, whatever the parent is doing (busy in
-Python, collecting garbage, stopped). The worker in turn switches its own force
-off when the guard's heartbeat is older than ``guard_timeout``. The watchdog
-thread wakes every ``POLL`` seconds, or at once when the worker or the guard
-ends (it waits on their sentinels), so:
-
-- a worker that dies (crash, SIGKILL) is noticed within a few milliseconds;
-- a worker whose heartbeat is older than ``hang_timeout`` is called hung: the
-  guard's cut (``force_off_time``) is reported, or the thread's own finding
-  if it comes first (both clear the same word);
-- a guard that dies is a fault too: only a restart brings supervision back.
-
-Either way the fault is reported (``faults``, ``on_fault``), the
-``force_enable`` word is cleared, with the reason "watchdog" and how long the
-worker was silent beside it (``StatusBlock.disable_force``; a worker that was only slow zeroes its force
-at its next block and latches a fault) and ``force_output`` reads 0: the
-simulated device, which lives in the worker, stops with it. ``stop()`` asks
-the worker to finish, waits for it, kills it if it will not go, ends the
-guard and unlinks
-the shared memory: no orphan process, no leaked segment. It waits only while
-the worker shows signs of life: a running worker whose heartbeat is older than
-``STALL_GRACE`` (or its ``hang_timeout``, the longer), or a worker closing its
-devices that has said nothing for ``CLOSE_GRACE``, is stalled (stopped by
-SIGSTOP, hung in native code) and gets SIGKILL at once: a stopped process
-handles neither the stop command nor SIGTERM, and waiting out the polite
-timeout kept the parent 12 s behind a stalled worker.
+watchdog thread (engine/watchdog.py) that drains the worker's events and
+reports faults: a dead or hung worker, a dead guard. The worker in turn
+switches its own force off when the guard's heartbeat is older than
+``guard_timeout``. ``stop()`` asks the worker to finish, waits for it while it
+shows signs of life, kills it if it will not go, ends the guard and unlinks
+the shared memory: no orphan process, no leaked segment.
 
 An engine whose MIDI input waits for its controller (JACK, ``--midi first``
 or a port name, none there at the start) gets a ``MidiHotplug`` thread that
@@ -54,29 +31,27 @@ import contextlib
 import multiprocessing
 import threading
 import time
-from multiprocessing.connection import wait as wait_for
 
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine import guard, midi_hotplug
-from studyapp.engine.audio import parse as parse_audio
+from studyapp.engine.audio.sinks import parse as parse_audio
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
+from studyapp.engine.telemetry import channels_for
+from studyapp.engine.watchdog import POLL, Watchdog
 from studyapp.errors import EngineError, ParameterError
 from studyapp.model.loop import GESTURES
 from studyapp.model.sources import with_pseudo_sources
 
 __all__ = ["Engine", "EngineError"]
 
-POLL = 0.01  # s between watchdog checks
 START_TIMEOUT = 120.0  # s for the worker to import, compile and prime
-STALL_GRACE = 0.5  # s: a running worker's heartbeat this old at stop() means it is stalled
-CLOSE_GRACE = 3.0  # s: a worker closing its devices may be this quiet (a device close gives up after 2 s)
 
 
-class Engine:
+class Engine(Watchdog):
     def __init__(self, config=None, on_fault=None, on_notice=None):
         self.config = config or EngineConfig()
         self.on_fault = on_fault
@@ -125,7 +100,7 @@ class Engine:
         return names
 
     def start(self, timeout=START_TIMEOUT):
-        from studyapp.engine.worker import REALTIME_PRIORITY, channels_for, main
+        from studyapp.engine.worker import REALTIME_PRIORITY, main
 
         c = self.config
         capacity = max(int(c.telemetry_seconds * c.rate), 4 * c.block_size())
@@ -291,58 +266,6 @@ class Engine:
         if self.on_fault is not None:
             self.on_fault(text)
 
-    def _trip(self, text, when, silence=0.0):
-        block = self.status_block
-        if block.force_enable:
-            block.disable_force("watchdog", silence)
-        elif block.force_off_reason == "watchdog":  # the guard was first: its moment is the cut's
-            when = block.force_off_time
-        self.tripped = True
-        self._fault(text, when)
-
-    def _hung(self, silence):
-        return (f"watchdog: the engine stopped answering (no heartbeat for {1e3 * silence:.0f} ms, "
-                f"{1e3 * self.config.hang_timeout:.0f} ms allowed); force switched off for safety")
-
-    def _watch(self):
-        sentinels = [self.process.sentinel, self.guard.sentinel]
-        timeout = self.config.hang_timeout
-        while not self._stop_watch.is_set():
-            ended = wait_for(sentinels, POLL)
-            now = time.monotonic()
-            while (event := self._next_event(0)) is not None:
-                self._handle(event)
-            worker_ended = self.process.sentinel in ended
-            guard_ended = self.guard.sentinel in ended
-            if guard_ended:
-                sentinels.remove(self.guard.sentinel)  # a process ends once: wait on it no more
-            if self._stopping or self.tripped:
-                if worker_ended:
-                    return
-                continue  # keep passing on the worker's events until stop()
-            if worker_ended:
-                self.process.join(0.1)
-                self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero", now)
-                return
-            if guard_ended:
-                self.guard.join(0.1)
-                self._trip(f"watchdog: the force guard died (exit code {self.guard.exitcode}); force switched off "
-                           "for safety: restart the engine", now)
-                continue
-            block = self.status_block
-            if not block.force_enable and block.force_off_reason == "watchdog":
-                self.process.join(0.05)  # a killed worker's exit can lag its silence: say it died if it did
-                if self.process.exitcode is not None:
-                    self._trip(f"watchdog: the worker died (exit code {self.process.exitcode}); force is zero",
-                               block.force_off_time)
-                    return
-                self._trip(self._hung(block.force_off_silence), block.force_off_time)
-                continue
-            snap = block.read()
-            silence = now - snap["heartbeat"]
-            if snap["state"] == "running" and silence > timeout:
-                self._trip(self._hung(silence), now, silence)
-
     # shutting down ---------------------------------------------------------
     def stop(self, timeout=10.0):
         """Stop the worker (politely, then by force), unlink the shared memory; returns its summary."""
@@ -357,7 +280,7 @@ class Engine:
                 self._commands.put(cmd.Stop())
             end = time.monotonic() + timeout
             heard = time.monotonic()
-            while self.process.is_alive() and time.monotonic() < end and not self._stalled(heard):
+            while self.process.is_alive() and time.monotonic() < end and not self.stalled(heard):
                 event = self._next_event(0.05)
                 if event is not None:
                     self._handle(event)
@@ -373,14 +296,6 @@ class Engine:
             self._handle(event)
         self._cleanup()
         return self.summary
-
-    def _stalled(self, heard):
-        """The worker has shown no sign of life for longer than it may (module docstring)."""
-        snap = self.status_block.read()
-        now = time.monotonic()
-        if snap["state"] == "running":
-            return now - max(snap["heartbeat"], heard) > max(STALL_GRACE, self.config.hang_timeout)
-        return now - max(snap["heartbeat"], heard) > CLOSE_GRACE
 
     def _end_guard(self):
         if self.guard is not None:

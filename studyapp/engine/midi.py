@@ -60,6 +60,7 @@ import mido
 
 from studyapp.engine.native_stderr import captured_native_stderr
 from studyapp.errors import ParameterError
+from studyapp.model.controls import knob_value
 
 CLIENT = "studyapp"
 VIRTUAL_PORT = "studyapp MIDI in"
@@ -133,7 +134,7 @@ class ControlMap:
     def lookup(self, msg):
         """``(control, value)`` for a mapped message, else ``None``; binds it first in learn mode."""
         if msg.type == "control_change":
-            key, value = ("cc", msg.channel + 1, msg.control), msg.value / 127.0
+            key, value = ("cc", msg.channel + 1, msg.control), knob_value(msg.value)
         elif msg.type == "note_on":
             key, value = ("note", msg.channel + 1, msg.note), (1.0 if msg.velocity > 0 else 0.0)
         elif msg.type == "note_off":

@@ -154,7 +154,7 @@ def flood(rate, seconds, progress=print):
     """One run: the engine under ``rate`` control changes per second for ``seconds``; the figures."""
     import numpy as np
 
-    from studyapp.model.fmax_knob import LIVE_RANGE, fmax_from_knob
+    from studyapp.model.controls import LIVE_RANGE, FmaxKnob, knob_value
 
     background = quiet(seconds)
     engine = _engine()
@@ -179,8 +179,8 @@ def flood(rate, seconds, progress=print):
         if isinstance(event, Applied):
             last[event.control] = event.value
     final = {f"knob{k}": v for k, v in ((int(k), v) for k, v in sent["final"].items())}
-    missing = sum(1 for knob, value in final.items() if last.get(knob) != value / 127.0)
-    missing += 0 if np.isclose(fmax, fmax_from_knob(final["knob1"], *LIVE_RANGE)) else 1
+    missing = sum(1 for knob, value in final.items() if last.get(knob) != knob_value(value))
+    missing += 0 if np.isclose(fmax, FmaxKnob(*LIVE_RANGE).fmax(final["knob1"])) else 1
     result = {
         "rate": rate, "seconds": sent["seconds"], "sent": sent["sent"],
         "midi_received": summary.get("midi_messages", 0), "control_events": len(controls),

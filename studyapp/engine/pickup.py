@@ -1,24 +1,36 @@
-"""Soft takeover ("pickup"): a physical knob acts only once it has passed through the level in force.
+"""The worker's control routing: a knob or pad (MIDI or on screen) -> its action -> commands, with soft takeover.
 
-A MIDI knob has no motor: when a trial starts (F_max back to 0) or a pause
-ends, the knob is still where the hand left it, and its first message would
-jump the level to that position (issue 14: LEVANT straight to 3.29 N, above
-its breakdown). So a knob whose action sets a level (F_max, volume, a rating)
-takes effect only when its movement covers the knob position ``target`` of
-the level in force: with ``previous`` its last position seen (any mapping,
-held or not; None if never seen) and ``value`` the new one, it acts when
+Every control takes one route, in and out of a session: the mapping installed
+last (``commands.InstallActions``; ``commands.default_actions`` until then)
+names its action (model/controls.py), ``commands.action_commands`` turns the
+control's value into commands, and the worker applies them at the block
+boundary and reports an ``events.Applied`` (what was done, the latency, the
+mapping's ``trial`` tag).
+
+Soft takeover ("pickup"): a physical knob acts only once it has passed through
+the level in force. A MIDI knob has no motor: when a trial starts (F_max back
+to 0) or a pause ends, the knob is still where the hand left it, and its first
+message would jump the level to that position (issue 14: LEVANT straight to
+3.29 N, above its breakdown). So a knob whose action sets a level (F_max,
+volume, a rating) takes effect only when its movement covers the knob position
+``target`` of the level in force: with ``previous`` its last position seen (any
+mapping, held or not; None if never seen) and ``value`` the new one, it acts
+when
 
     min(previous, value) <= target <= max(previous, value)    (just value == target without a previous)
 
 A knob that set the level itself keeps acting (its previous position is the
 target); one whose level was changed by anything else (a new trial, a pause,
 an on-screen knob) must first be turned through the new level. Positions are
-knob steps (0..127).
+knob steps (0..127). On-screen knobs show the level itself and need no pickup.
 """
 
-from studyapp.model.fmax_knob import KNOB_MAX, knob_from_fmax
+from studyapp.engine import commands as cmd
+from studyapp.engine import events as ev
+from studyapp.engine.midi import coalesce
+from studyapp.model.controls import KNOB_MAX, FmaxKnob, FmaxLinear, Select, Volume, as_action, knob_step, knob_value
 
-LEVEL_ACTIONS = ("fmax_log", "fmax_linear", "volume", "select")
+LEVEL_ACTIONS = (FmaxKnob, FmaxLinear, Volume, Select)
 
 
 def passes_through(target, previous, value):
@@ -34,17 +46,80 @@ def level_position(action, fmax, volume, rating=None):
     ``fmax`` (N) and ``volume`` (linear gain) are the worker's; ``rating`` the
     rating knob's position (None: not rated yet, so nothing can jump).
     """
-    kind = action[0]
-    if kind == "fmax_log":
-        return knob_from_fmax(fmax, action[1], action[2])
-    if kind == "fmax_linear":
-        return _step((fmax - action[1]) / (action[2] - action[1]))
-    if kind == "volume":
-        return _step(volume)
-    if kind == "select":
-        return rating
+    match as_action(action):
+        case FmaxKnob() as knob:
+            return knob.step(fmax)
+        case FmaxLinear(low, high):
+            return _step((fmax - low) / (high - low))
+        case Volume():
+            return _step(volume)
+        case Select():
+            return rating
     return None
 
 
 def _step(fraction):
-    return min(max(round(fraction * KNOB_MAX), 0), KNOB_MAX)
+    return min(max(knob_step(fraction), 0), KNOB_MAX)
+
+
+class ControlRouting:
+    """The worker's side of the controls (mixed into ``worker.Worker``, whose loop, sink, MIDI input,
+    control map and events it uses).
+
+    State: ``actions`` (the mapping in force), ``trial`` (its tag), ``knob_seen``
+    (each MIDI control's last step, whatever the mapping: for pickup),
+    ``ratings`` (each rating knob's step: the level its ``Select`` sets).
+    """
+
+    def init_controls(self, actions):
+        self.actions = actions
+        self.trial = 0
+        self.knob_seen = {}
+        self.ratings = {}
+
+    def install(self, c):
+        """``InstallActions``: the mapping, its tag and (unless None) the rating knobs' positions from now on."""
+        self.actions = dict(c.actions)
+        self.trial = int(c.trial)
+        if c.positions is not None:
+            self.ratings = dict(c.positions)
+
+    def take_midi(self):
+        """The MIDI messages received since the last block, coalesced (midi.py), each control to its action."""
+        received = self.midi.poll()
+        self.status.set(midi_messages=self.midi.received)
+        for msg, arrived, block in coalesce(received):
+            learning = self.cmap.learning
+            hit = self.cmap.lookup(msg)
+            if hit is None:
+                continue
+            control, value = hit
+            if learning is not None and self.cmap.learning is None:
+                self.events.put(ev.Learned(control, self.cmap.to_dict()[control]))
+            self.control(control, value, arrived, block)
+
+    def control(self, control, value, arrived, block, origin="midi"):
+        """A control moved (MIDI, or on screen): apply its action, tell the parent."""
+        action = self.actions.get(control)
+        step = knob_step(value)
+        target = self._pickup_target(control, action, step) if origin == "midi" else None
+        commands = cmd.action_commands(action, value, arrived) if action and target is None else ()
+        latency = None
+        for command in commands:
+            latency = self.apply(command)
+        if commands and isinstance(action, Select):
+            self.ratings[control] = step
+        self.events.put(ev.Applied(control, value, arrived, latency, self.k - block, self.k, self.trial,
+                                   commands, origin, pending_pickup=target is not None,
+                                   pickup_target=None if target is None else knob_value(target)))
+
+    def _pickup_target(self, control, action, step):
+        """The knob step a physical knob must pass through before it acts; None when it acts now."""
+        previous, self.knob_seen[control] = self.knob_seen.get(control), step
+        if not isinstance(action, LEVEL_ACTIONS):
+            return None
+        volume = self.sink.gain.volume if isinstance(action, Volume) else None
+        target = level_position(action, self.loop.fmax, volume, self.ratings.get(control))
+        if target is None or passes_through(target, previous, step):
+            return None
+        return target

@@ -70,6 +70,7 @@ from studyapp.experiment.session_info import (
 )
 from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
 from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
+from studyapp.free_names import first_free
 from studyapp.small_files import LIMIT_BYTES, open_regular
 
 CREATED = records.SESSION_CREATED
@@ -278,11 +279,7 @@ class Session:
         order_row = index % rows if order_row is None else order_row  # the same orders as the index itself
         schedule, squares = build_schedule(protocol, index, order_row=order_row)
         started = datetime.now().astimezone()
-        folder = participant_folder / started.strftime("%Y-%m-%dT%H-%M-%S")
-        suffix = 1
-        while folder.exists():
-            suffix += 1
-            folder = participant_folder / f"{started.strftime('%Y-%m-%dT%H-%M-%S')}-{suffix}"
+        folder = first_free(participant_folder / started.strftime("%Y-%m-%dT%H-%M-%S"))
         info = {
             "format": FORMAT,
             "study": protocol.study,

@@ -3,7 +3,7 @@
     RESULTS/<study>/<participant>/.lock                     the participant's lock (session_lock)
     RESULTS/<study>/<participant>/<session>/session.json    the description (session)
     RESULTS/<study>/<participant>/<session>/events.jsonl    the event log (session_log)
-    RESULTS/<study>/<participant>/<session>/audio*.wav, audio_cues.csv   what was heard (engine/audio_recorder.py)
+    RESULTS/<study>/<participant>/<session>/audio*.wav, audio_cues.csv   what was heard (engine/audio/recorder.py)
 """
 
 import os

@@ -25,7 +25,7 @@ import numpy as np
 
 from studyapp.experiment.noisiness import velocity_noise
 from studyapp.experiment.tasks import task_type
-from studyapp.model.fmax_knob import KNOB_MAX
+from studyapp.model.controls import KNOB_MAX
 
 
 class SimulatedParticipant:

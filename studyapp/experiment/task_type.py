@@ -123,9 +123,9 @@ class TaskType(Protocol):
         """A caption per knob (empty string: none); ``hidden`` is the console's blinding switch."""
 
     def knob_actions(self, trial, state: TrialState) -> dict:
-        """{control: action} the engine's worker applies during the trial, in the worker's action
-        vocabulary (``studyapp.engine.commands``): e.g. ``("select", condition, fmax)`` or
-        ``("fmax_log", ceiling, decades)``; {} for a trial without knobs."""
+        """{control: action} the engine's worker applies during the trial, as typed actions
+        (``studyapp.model.controls``): e.g. ``Select(condition, fmax)`` or
+        ``FmaxKnob(ceiling, decades)``; {} for a trial without knobs."""
 
     def response_text(self, response: dict) -> str:
         """What the console says when ``response`` is logged, blind-safe."""

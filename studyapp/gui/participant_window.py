@@ -55,6 +55,7 @@ from studyapp.experiment.tasks import task_type
 from studyapp.gui.bowing_surface import BowingSurface
 from studyapp.gui.knobs import KnobPanel
 from studyapp.gui.page_view import PageView
+from studyapp.model.controls import Select
 
 BODY_PT = 22
 HEADING_PT = 28
@@ -97,9 +98,8 @@ def trial_controls(trial, state):
         if knob is None:
             continue
         knobs.append(knob)
-        for word in action:
-            if isinstance(word, str):
-                sounds.setdefault(word, knob)
+        if isinstance(action, Select):
+            sounds.setdefault(action.condition, knob)
     pad = getattr(state, "confirm_pad", None)
     return sorted(knobs), ([] if pad is None else [pad]), sounds
 

@@ -15,7 +15,7 @@ import time
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
-from studyapp.model.fmax_knob import LIVE_RANGE, knob_from_fmax
+from studyapp.model.controls import LIVE_RANGE, FmaxKnob
 
 PREVIEW_FMAX = 1.0  # N, the rating task's F_max
 
@@ -51,7 +51,7 @@ class PreviewBowing:
             return
         if self.bowing_since is None:
             if c.state not in ("starting", "running", "paused"):
-                self.console.turn_knob(0, knob_from_fmax(PREVIEW_FMAX, *LIVE_RANGE))
+                self.console.turn_knob(0, FmaxKnob(*LIVE_RANGE).step(PREVIEW_FMAX))
                 self.console.set_gesture("strokes")
                 self.console.set_bowing(True)
             self.bowing_since = self.clock()

@@ -19,8 +19,8 @@ simulated experimenter listens to the tone before confirming the level
 (``PageType.simulate``), so the tone is in the file.
 """
 
-from studyapp.engine.audio import WAV_RATE
-from studyapp.engine.audio_recorder import AudioRecorder
+from studyapp.engine.audio.recorder import AudioRecorder
+from studyapp.engine.audio.sinks import WAV_RATE
 from studyapp.engine.signal_chain import SignalChain
 from studyapp.experiment.data_modes import file_mode
 from studyapp.experiment.session_runner import SessionRunner, closed_loop_factory

@@ -1,6 +1,6 @@
 """A ``Worker`` without its process, loop or devices: for testing how it applies commands and controls."""
 
-from studyapp.engine.audio import Gain
+from studyapp.engine.audio.sinks import Gain
 from studyapp.engine.status import StatusBlock
 from studyapp.engine.worker import Worker
 

@@ -11,7 +11,8 @@ import pytest
 from scipy.io import wavfile
 from scipy.signal import resample_poly
 
-from studyapp.engine.audio import Fifo, Gain, Sink, WavSink, open_sink, parse
+from studyapp.engine.audio.fifo import Fifo
+from studyapp.engine.audio.sinks import Gain, Sink, WavSink, open_sink, parse
 from studyapp.engine.signal_chain import FADE_S
 from studyapp.errors import ParameterError
 
@@ -79,7 +80,7 @@ def test_sink_specs(spec, kind, tmp_path):
 
 
 PROBE = textwrap.dedent("""
-    from studyapp.engine.audio import open_sink
+    from studyapp.engine.audio.sinks import open_sink
     lines = []
     sink = open_sink("device", 5000.0, say=lines.append)
     print(type(sink).__name__)

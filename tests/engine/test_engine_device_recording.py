@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from scipy.io import wavfile
 
-from studyapp.engine import device_sink
-from studyapp.engine.audio_recorder import AudioRecorder, pcm16
-from studyapp.engine.device_sink import DeviceSink
+from studyapp.engine.audio import sinks as device_sink
+from studyapp.engine.audio.recorder import AudioRecorder
+from studyapp.engine.audio.wav import pcm16
+from studyapp.engine.audio.sinks import DeviceSink
 
 PERIOD = 256  # frames per device callback
 

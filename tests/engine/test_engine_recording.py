@@ -10,8 +10,9 @@ from numpy.lib.stride_tricks import sliding_window_view
 from scipy.io import wavfile
 
 from studyapp.engine import commands as cmd
-from studyapp.engine.audio import open_sink
-from studyapp.engine.audio_recorder import CUE_COLUMNS, AudioRecorder, pcm16
+from studyapp.engine.audio.recorder import CUE_COLUMNS, AudioRecorder
+from studyapp.engine.audio.sinks import open_sink
+from studyapp.engine.audio.wav import pcm16
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
 from studyapp.engine.resampler import Resampler
@@ -51,7 +52,7 @@ def test_the_recorder_writes_every_block_as_16_bit_pcm_and_the_cues_at_their_fra
 def test_a_recorder_that_falls_behind_drops_blocks_and_writes_them_as_silence(tmp_path, monkeypatch):
     import threading
 
-    import studyapp.engine.audio_recorder as module
+    import studyapp.engine.audio.recorder as module
     from tests.engine.waiting import wait_for
 
     gate = threading.Event()

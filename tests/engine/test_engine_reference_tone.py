@@ -8,7 +8,7 @@ import pytest
 from scipy.io import wavfile
 
 from studyapp.engine import commands as cmd
-from studyapp.engine.audio import Sink, open_sink
+from studyapp.engine.audio.sinks import Sink, open_sink
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
 from studyapp.engine.reference_tone import RAMP, ReferenceTone

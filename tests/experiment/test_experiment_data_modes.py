@@ -54,7 +54,7 @@ def test_the_audio_kept_with_a_session_gets_the_mode_of_its_files(tmp_path, monk
     import numpy as np
 
     from studyapp.engine import commands as cmd
-    from studyapp.engine.audio_recorder import AudioRecorder
+    from studyapp.engine.audio.recorder import AudioRecorder
     from studyapp.experiment.data_modes import file_mode
 
     if shared is None:

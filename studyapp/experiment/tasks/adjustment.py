@@ -3,7 +3,7 @@
 Each condition is played in ``trials`` repetitions; repetition r follows row
 r of the task's balanced Latin square from the participant's row on. A trial
 starts at F_max = 0. The adjustment knob sets F_max through the one knob law
-(``studyapp.model.fmax_knob``: 0 at the bottom, then logarithmically from
+(``studyapp.model.controls.FmaxKnob``: 0 at the bottom, then logarithmically from
 ``ceiling`` * 10^-``decades`` to the protocol's ``ceiling``); the participant
 turns it up until the string "breaks down" (the margin of stability), turns
 back if they overshot, and confirms with the pad. The response is the F_max
@@ -47,7 +47,7 @@ from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
-from studyapp.model.fmax_knob import KNOB_MAX, fmax_from_knob
+from studyapp.model.controls import KNOB_MAX, FmaxKnob
 from studyapp.model.loop import FMAX_LIMIT
 
 
@@ -70,6 +70,7 @@ class AdjustmentTrial(ConfirmPadTrial):
         self.condition = condition
         self.ceiling = float(ceiling)
         self.decades = float(decades)
+        self.action = FmaxKnob(self.ceiling, self.decades)  # the knob's action, for the worker and for fmax
         self.knob_index = knob
         self.value = 0
         self.peak_value = 0
@@ -80,7 +81,7 @@ class AdjustmentTrial(ConfirmPadTrial):
 
     @property
     def fmax(self):
-        return fmax_from_knob(self.value, self.ceiling, self.decades)
+        return self.action.fmax(self.value)
 
     def knob(self, index, value):
         check_knob_value(value)
@@ -102,7 +103,7 @@ class AdjustmentTrial(ConfirmPadTrial):
             "trial": self.trial,
             "fmax": self.fmax,
             "value": self.value,
-            "peak_fmax": fmax_from_knob(self.peak_value, self.ceiling, self.decades),
+            "peak_fmax": self.action.fmax(self.peak_value),
             "duration": self.elapsed,
         }
 
@@ -159,7 +160,7 @@ class Adjustment:
         return ["F_max" if i == state.knob_index else "" for i in range(knobs)]
 
     def knob_actions(self, trial, state):
-        return {f"knob{state.knob_index + 1}": ("fmax_log", state.ceiling, state.decades)}
+        return {f"knob{state.knob_index + 1}": state.action}
 
     def response_text(self, response):
         return f"Response recorded: F_max = {response['fmax']:.3g} N."

@@ -22,7 +22,7 @@ condition as ``listen_short``. Knob values are 7-bit MIDI positions
 
 import math
 
-from studyapp.model.fmax_knob import KNOB_MAX
+from studyapp.model.controls import KNOB_MAX
 
 LISTEN_SLACK = 1e-9  # s: what float sums of block times may fall short of a whole second
 

@@ -43,7 +43,7 @@ from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
-from studyapp.model.fmax_knob import KNOB_MAX
+from studyapp.model.controls import KNOB_MAX, Select
 from studyapp.model.loop import FMAX_LIMIT
 
 
@@ -169,7 +169,7 @@ class Rating:
         return [] if hidden else list(trial.conditions)
 
     def knob_actions(self, trial, state):
-        return {f"knob{j + 1}": ("select", c, state.rating_fmax) for j, c in enumerate(state.conditions)}
+        return {f"knob{j + 1}": Select(c, state.rating_fmax) for j, c in enumerate(state.conditions)}
 
     def response_text(self, response):
         return "Ratings recorded."

@@ -5,18 +5,19 @@ the signal chain (``signal_chain.SignalChain``: silence while the bow is
 lifted and fades at every start, stop and cut, the resampler to the sink's
 rate, volume and mute, the headphone check's reference tone, and a soft
 limiter under ``CEILING_DBFS``), and plays or stores it. The session's
-recorder (``audio_recorder``), if one is attached, gets what reached the
-device: a device sink tees it in its callback, gaps included (an underrun is
-silence in the file, and marked), a file sink as it writes. Choose one with
+recorder (``recorder.AudioRecorder``), if one is attached, gets what reached
+the device: a device sink tees it in its callback (``DeviceSink.play``), gaps
+included (an underrun is silence in the file, and marked in audio_cues.csv),
+a file sink as it writes. Choose one with
 ``open_sink(spec, haptic_rate)``::
 
     "device" | "device:NAME"   PortAudio output (sounddevice), NAME a substring of the device name
-    "wav:FILE"                 16-bit mono WAV at 48 kHz, written atomically when the sink closes; never
-                               over an existing file: FILE taken, it is FILE-2, FILE-3, ... (a notice says which)
+    "wav:FILE"                 16-bit mono WAV at 48 kHz (wav.py), written atomically when the sink closes;
+                               never over an existing file: FILE taken, it is FILE-2, FILE-3, ... (a notice says which)
     "null"                     nothing rendered at all
     "discard"                  rendered and resampled, then dropped (what audio costs, for benchmarks)
 
-A device sink (``device_sink.DeviceSink``) plays from a FIFO that the engine
+A device sink (``DeviceSink``) plays from a FIFO (fifo.py) that the engine
 keeps filled ``lead`` seconds ahead; PortAudio's callback reads it. When the FIFO cannot fill a device
 period the callback plays silence for the rest and counts an *underrun*; when
 the device itself reports one (``output_underflow``, e.g. a JACK xrun) that is
@@ -30,16 +31,20 @@ which must take the GIL to run; the worker lowers Python's switch interval so
 that thread waits at most about half a millisecond.
 """
 
+import contextlib
 import os
 import tempfile
-import wave
+import threading
 
 import numpy as np
 
-from studyapp.engine.audio_recorder import numbered
+from studyapp.atomic import default_mode
+from studyapp.engine.audio.fifo import Fifo
+from studyapp.engine.audio.wav import open_wav, pcm16
 from studyapp.engine.native_stderr import captured_native_stderr
 from studyapp.engine.signal_chain import Gain, SignalChain
 from studyapp.errors import ParameterError
+from studyapp.free_names import claim, first_free
 
 DEVICE_RATE = 48_000.0
 WAV_RATE = 48_000.0
@@ -80,47 +85,6 @@ def load_sounddevice():
         except OSError as exc:
             raise AudioUnavailable(f"PortAudio not found ({exc}); install libportaudio2") from None
     return sounddevice
-
-
-class Fifo:
-    """Single-producer, single-consumer float32 FIFO between the engine thread and the audio callback.
-
-    Each side moves only its own counter, after touching the data, and a
-    Python int assignment is atomic under the GIL, so no lock is needed.
-    """
-
-    def __init__(self, capacity):
-        self.capacity = int(capacity)
-        self._data = np.zeros(self.capacity, dtype=np.float32)
-        self._written = 0
-        self._read = 0
-
-    @property
-    def level(self):
-        return self._written - self._read
-
-    @property
-    def read_position(self):
-        """Frames read so far: the position in the written stream of the next frame read."""
-        return self._read
-
-    def write(self, samples):
-        n = min(samples.shape[0], self.capacity - self.level)
-        start = self._written % self.capacity
-        split = min(n, self.capacity - start)
-        self._data[start:start + split] = samples[:split]
-        self._data[:n - split] = samples[split:n]
-        self._written += n
-        return n
-
-    def read_into(self, out):
-        n = min(out.shape[0], self.level)
-        start = self._read % self.capacity
-        split = min(n, self.capacity - start)
-        out[:split] = self._data[start:start + split]
-        out[split:n] = self._data[:n - split]
-        self._read += n
-        return n
 
 
 class Sink:
@@ -215,18 +179,15 @@ class WavSink(Sink):
     def __init__(self, path, haptic_rate, rate=WAV_RATE, say=print):
         super().__init__(haptic_rate, rate)
         self.say = say
-        self.path = str(_free_name(path))
+        self.path = str(first_free(path))
         if self.path != str(path):
             say(f"audio: {path} exists; writing {self.path} (never over an earlier file)")
         self.rate = float(rate)
         folder, name = os.path.split(os.path.abspath(self.path))
         fd, self._tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".wav", dir=folder)
-        os.fchmod(fd, 0o666 & ~_umask())  # an output's usual permissions, not mkstemp's private ones
+        os.fchmod(fd, default_mode())  # an output's usual permissions, not mkstemp's private ones
         os.close(fd)
-        self._wav = wave.open(str(self._tmp), "wb")
-        self._wav.setnchannels(1)
-        self._wav.setsampwidth(2)
-        self._wav.setframerate(int(round(self.rate)))
+        self._wav = open_wav(str(self._tmp), self.rate)
         self.frames = 0
 
     @property
@@ -234,9 +195,8 @@ class WavSink(Sink):
         return f"wav:{self.path} ({self.rate:g} Hz)"
 
     def _write(self, out):
-        pcm = np.round(out * 32767.0).astype("<i2")
-        self._wav.writeframesraw(pcm.tobytes())
-        self.frames += pcm.shape[0]
+        self._wav.writeframesraw(pcm16(out))
+        self.frames += out.shape[0]
 
     def push(self, audio, sounding=True, cut=False):
         self._write(self._heard(audio, sounding, cut))
@@ -253,35 +213,152 @@ class WavSink(Sink):
             self.say(f"audio: {chosen} appeared meanwhile; wrote {self.path} (never over an earlier file)")
 
 
-def _umask():
-    umask = os.umask(0)
-    os.umask(umask)
-    return umask
-
-
-def _free_name(path):
-    """``path``, or the first of ``path-2``, ``path-3``, ... that does not exist."""
-    number = 1
-    while os.path.lexists(numbered(path, number)):
-        number += 1
-    return numbered(path, number)
-
-
 def _move_free(source, path):
     """Move ``source`` to ``path`` or the first free numbered name after it; never replaces another's file.
 
     The name is reserved by an exclusive create, then ``source`` renamed over that empty file of ours.
     """
-    number = 1
-    while True:
-        target = numbered(path, number)
+    fd, target = claim(path)
+    os.close(fd)
+    os.replace(source, target)
+    return target
+
+
+class DeviceSink(Sink):
+    """A PortAudio output stream fed from a FIFO kept ``lead`` seconds ahead; paces the loop."""
+
+    render = True
+    paced = True
+
+    def __init__(self, haptic_rate, device=None, rate=None, lead=0.03, channels=2):
+        sd = load_sounddevice()
+        self._sd = sd
         try:
-            os.close(os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
-        except FileExistsError:
-            number += 1
-            continue
-        os.replace(source, target)
-        return target
+            with captured_native_stderr() as chatter:
+                index = self._find(sd, device)
+                info = sd.query_devices(index)
+                self.rate = float(rate or info["default_samplerate"] or DEVICE_RATE)
+                channels = max(1, min(channels, int(info["max_output_channels"])))
+                self._stream = sd.OutputStream(
+                    device=index, samplerate=self.rate, channels=channels, dtype="float32",
+                    callback=self._callback, latency="low",
+                )
+        except (sd.PortAudioError, ValueError) as exc:
+            detail = str(exc).strip().splitlines()[0] if str(exc).strip() else "no detail"
+            hint = chatter.text.strip().splitlines()
+            raise AudioUnavailable(f"no usable output device ({detail}{'; ' + hint[0] if hint else ''})") from None
+        self.name = info["name"]
+        self.hostapi = sd.query_hostapis(info["hostapi"])["name"]
+        super().__init__(haptic_rate, self.rate)
+        self.lead_frames = int(lead * self.rate)
+        self.fifo = Fifo(max(4 * self.lead_frames, int(self.rate)))
+        self.fifo_dropped = 0  # frames the FIFO had no room for (the device stopped calling back)
+        self._wanted = threading.Event()
+        self._scratch = np.zeros(0, dtype=np.float32)
+        self.stuck = False
+        self.period_frames = 0
+        self.callbacks = 0
+
+    @staticmethod
+    def _find(sd, device):
+        outputs = [d for d in sd.query_devices() if d["max_output_channels"] > 0]
+        if not outputs:
+            raise sd.PortAudioError("PortAudio sees no output device")
+        if device is None:
+            default = sd.default.device[1]
+            return default if default is not None and default >= 0 else outputs[0]["index"]
+        for d in outputs:
+            if device.lower() in d["name"].lower():
+                return d["index"]
+        names = ", ".join(d["name"] for d in outputs)
+        raise sd.PortAudioError(f"no output device matches {device!r} (have: {names})")
+
+    @property
+    def description(self):
+        return f"{self.name} via {self.hostapi} ({self.rate:g} Hz, lead {1e3 * self.lead_frames / self.rate:.0f} ms)"
+
+    @property
+    def level(self):
+        """Frames queued ahead of the device."""
+        return self.fifo.level
+
+    def _callback(self, outdata, frames, time_info, status):
+        outdata[:] = self.play(frames, status.output_underflow)[:, None]
+
+    def play(self, frames, underflow=False):
+        """The next device period: from the FIFO, silence for what it lacks; teed to the recorder as played."""
+        if self._scratch.shape[0] != frames:
+            self._scratch = np.zeros(frames, dtype=np.float32)
+        start = self.fifo.read_position
+        got = self.fifo.read_into(self._scratch)
+        self.period_frames = max(self.period_frames, frames)
+        short = got < frames
+        if short:
+            self._scratch[got:] = 0.0
+            self.shortfalls += 1
+        if underflow:
+            self.xruns += 1
+        if short or underflow:
+            self.underruns += 1
+        recorder = self.recorder
+        if recorder is not None:
+            # what reached the device, sample for sample: a gap is silence in the file, and marked
+            recorder.write(self._scratch, start, got=got, underflow=bool(underflow))
+        self.callbacks += 1
+        self.frames_played += frames
+        self._wanted.set()
+        return self._scratch
+
+    def push(self, audio, sounding=True, cut=False):
+        # the whole chain before the FIFO: the FIFO holds what is heard
+        out = self._heard(audio, sounding, cut).astype(np.float32)
+        self.fifo_dropped += out.shape[0] - self.fifo.write(out)
+
+    def next_frame(self):
+        """The next block's first sample as a FIFO position (what the callback's recorder counts in)."""
+        return self.chain.next_frame() - self.fifo_dropped
+
+    @property
+    def target(self):
+        """Frames to keep queued: the lead, and at least two device periods."""
+        return max(self.lead_frames, 2 * self.period_frames)
+
+    def wait(self, timeout):
+        while self.fifo.level >= self.target:
+            self._wanted.clear()
+            if self.fifo.level < self.target:
+                break
+            if not self._wanted.wait(timeout):
+                return False
+        return True
+
+    def start(self):
+        """Start the stream; call once the FIFO holds ``lead`` (the engine primes it)."""
+        self._stream.start()
+
+    def close(self, timeout=2.0):
+        """Abort and close the stream; ``False`` if PortAudio did not let go within ``timeout``.
+
+        PortAudio's JACK back-end waits up to ten minutes for its callback to
+        acknowledge a stop; a server that has dropped the client (after a long
+        stall) never runs that callback again. So the stream is closed on a
+        helper thread, and a sink that stays stuck is left behind
+        (``self.stuck``): the worker then exits without terminating PortAudio.
+        """
+        if self._stream is None:
+            return not self.stuck
+        stream, self._stream = self._stream, None
+        done = threading.Event()
+
+        def shut():
+            with contextlib.suppress(self._sd.PortAudioError):
+                stream.abort()
+                stream.close()
+            done.set()
+
+        threading.Thread(target=shut, name="studyapp-audio-close", daemon=True).start()
+        self.stuck = not done.wait(timeout)
+        return not self.stuck
 
 
 def open_sink(spec, haptic_rate, say=print, lead=0.03):
@@ -293,8 +370,6 @@ def open_sink(spec, haptic_rate, say=print, lead=0.03):
         return DiscardSink(haptic_rate)
     if kind == "wav":
         return WavSink(arg, haptic_rate, say=say)
-    from studyapp.engine.device_sink import DeviceSink
-
     try:
         return DeviceSink(haptic_rate, device=arg, lead=lead)
     except AudioUnavailable as exc:

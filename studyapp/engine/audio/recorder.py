@@ -10,10 +10,8 @@ marked by an ``underrun`` row in the cues (as is a period the device itself
 reported as an underflow). ``write`` also takes the period's place in the
 sink's output *stream* (``start``: the FIFO's read position) and how many of
 its frames came from it (``got``); the writer maps stream positions to file
-frames with them. a writer thread of the worker process turns
-the queue into a 16-bit PCM mono WAV at the sink's rate (the stdlib ``wave``
-module writes integer PCM only; 16 bits keep 96 dB, more than headphones in a
-quiet room show). The file is written as it grows, its header made valid
+frames with them. A writer thread of the worker process turns
+the queue into a WAV file at the sink's rate (wav.py: 16-bit PCM mono). The file is written as it grows, its header made valid
 after every write, so a worker that is killed leaves a readable file up to its
 last write. If the writer falls ``QUEUE_SECONDS`` behind (a stalled disk),
 blocks are dropped rather than waiting, counted in ``dropped`` and written as
@@ -23,7 +21,7 @@ Besides the steps' ``start`` and ``end`` the cues mark where the bow was put
 on the string and lifted (``bow_on``, ``bow_off``: the output is silent from
 a ``bow_off`` on, signal_chain.py) and every ``underrun``.
 
-Files are never overwritten (``free_path``): ``audio.wav`` is reserved with an
+Files are never overwritten (``free_names.claim``): ``audio.wav`` is reserved with an
 exclusive create, else ``audio-2.wav``, ``audio-3.wav``, ...: one file per
 engine run of a session (a resumed session, a restarted engine). The WAV file
 and ``audio_cues.csv`` are created with the permissions ``mode`` (the session's
@@ -47,49 +45,23 @@ import csv
 import os
 import queue
 import threading
-import wave
-from pathlib import Path
 
 import numpy as np
+
+from studyapp.engine.audio.wav import open_wav, pcm16
+from studyapp.free_names import claim, create
 
 QUEUE_SECONDS = 10.0  # of audio the writer may fall behind before blocks are dropped
 CUES_FILE = "audio_cues.csv"
 CUE_COLUMNS = ("file", "sample", "seconds", "step", "task", "trial", "event")
 
 
-def numbered(path, number):
-    """``take.wav`` for 1, ``take-2.wav`` for 2, ..."""
-    path = Path(path)
-    return path if number == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
-
-
-def create(path, mode):
-    """An fd of the new file ``path`` (``FileExistsError`` if it exists) with permissions ``mode``, not the umask's."""
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode)
-    os.fchmod(fd, mode)
-    return fd
-
-
-def free_path(path, mode=0o600):
-    """``(file object, path)``: ``path`` or the first free numbered name, created exclusively (never overwriting)."""
-    number = 1
-    while True:
-        candidate = numbered(path, number)
-        try:
-            return open(create(candidate, mode), "wb"), candidate  # noqa: SIM115 - the writer thread closes it
-        except FileExistsError:
-            number += 1
-
-
-def pcm16(samples):
-    return np.round(np.clip(samples, -1.0, 1.0) * 32767.0).astype("<i2").tobytes()
-
-
 class AudioRecorder:
     def __init__(self, path, rate, mode=0o600):
         self.rate = float(rate)
         self.mode = mode
-        self._file, self.path = free_path(path, mode)
+        fd, self.path = claim(path, mode)
+        self._file = open(fd, "wb")  # noqa: SIM115 - the writer thread closes it
         self.cues_path = self.path.parent / CUES_FILE
         self.capacity = int(QUEUE_SECONDS * self.rate)
         self.frames = 0  # frames of the file's timeline so far, dropped ones included
@@ -146,10 +118,7 @@ class AudioRecorder:
         with contextlib.suppress(OSError, AttributeError):  # leave the worker's real-time priority
             os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
         try:
-            with self._file, wave.open(self._file, "wb") as wav:
-                wav.setnchannels(1)
-                wav.setsampwidth(2)
-                wav.setframerate(int(round(self.rate)))
+            with self._file, open_wav(self._file, self.rate) as wav:
                 self._write_all(wav)
         except OSError as exc:
             self.error = f"{self.path}: {exc.strerror or exc}"
@@ -224,3 +193,52 @@ class AudioRecorder:
         while not self._stopped and (item := self._queue.get()) is not None:
             if item[0] == "audio":
                 self._taken += item[-1].shape[0]
+
+
+class Recordings:
+    """A worker's recordings of what is heard: the one in progress, fed by ``sink``, and every one of the run.
+
+    ``notice(text, level, topic)`` tells the parent what happened to them.
+    """
+
+    def __init__(self, sink, notice):
+        self.sink = sink
+        self.notice = notice
+        self.current = None  # the recording in progress (RecordAudio), or None
+        self.made = []  # every recorder of this run: closed, with what it wrote, in close()
+
+    def record(self, path, mode):
+        """Stop the recording in progress (its writer finishes on its own), then start one at ``path`` (None: none)."""
+        if self.current is not None:
+            self.current.stop()
+            self.sink.recorder = self.current = None
+        if path is None:
+            return
+        if not self.sink.render:
+            self.notice(f"audio: the {self.sink.description} sink renders no audio: nothing to record", "warning", "audio")
+            return
+        self.current = self.sink.recorder = AudioRecorder(path, self.sink.rate, mode)
+        self.made.append(self.current)
+        self.notice(f"audio: recording what is heard to {self.current.path}", "info", "audio")
+
+    def cue(self, step, task, trial, event):
+        """A row of the cues, at the block the worker runs next (``None`` step: the last cue's trial)."""
+        if self.current is not None:
+            self.current.cue(step, task, trial, event, at=self.sink.next_frame())
+
+    def close(self, timeout=5.0):
+        """Let every recording's writer finish; say what one could not write."""
+        if self.current is not None:
+            self.current.stop()
+            self.sink.recorder = self.current = None  # the sink's flush on close is not the session's
+        for recorder in self.made:
+            if not recorder.join(timeout):
+                self.notice(f"audio: {recorder.path}: the writer did not finish within {timeout:g} s", "warning", "audio")
+            if recorder.error:
+                self.notice(f"audio: recording stopped: {recorder.error}", "warning", "audio")
+            if recorder.dropped:
+                self.notice(f"audio: {recorder.path}: {recorder.dropped} frames dropped (the disk fell behind), "
+                            "written as silence", "warning", "audio")
+
+    def summary(self):
+        return [{"file": str(r.path), "frames": r.frames, "dropped": r.dropped, "error": r.error} for r in self.made]

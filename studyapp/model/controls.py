@@ -1,0 +1,133 @@
+"""What a knob or pad does while the engine runs: the typed actions a task gives and the worker applies.
+
+A task type names, per control, an action (``TaskType.knob_actions``:
+experiment/tasks); the real-time worker applies it to every value that control
+sends (engine/commands.py ``action_commands``, engine/pickup.py). The two
+layers never import each other: this module is where they meet.
+
+A control's value v lies in [0, 1]: a MIDI 7-bit value k / 127, an on-screen
+knob's step k / 127, a pad pressed (1) or released (0). A knob's *step* is
+k = round(127 v) (``knob_step``), its value again v = k / 127
+(``knob_value``): the only two conversions between them.
+
+    FmaxKnob(ceiling, decades)   F_max on the app's one knob law (model/fmax_knob.py, the paper's
+                                 logarithmic map, Sec. 8.2): F_max = 0 at step 0, else
+                                 ceiling * 10^(-decades (127 - k) / 126); applied here only (``fmax``)
+    FmaxLinear(low, high)        F_max = low + v (high - low)
+    Volume()                     the linear gain v
+    Source(name)                 a pad: selects the velocity source ``name`` when pressed
+    Select(condition, fmax)      a rating knob: any movement selects ``condition``, at ``fmax`` if given
+    Bowing()                     the bow on the string while v > 0
+    HandTarget(low, high)        the hand's target position low + v (high - low) (m)
+
+An action also has a compact spelling, the tuple ``(kind, *fields)`` with the
+kinds of ``KINDS`` (e.g. ``("fmax_log", 40.0, 2.0)``, ``("select", "KALLEV",
+1.0)``); ``as_action`` reads it.
+"""
+
+from dataclasses import dataclass, fields
+
+from studyapp.errors import ParameterError
+from studyapp.model.fmax_knob import KNOB_MAX, LIVE_RANGE, fmax_from_knob, knob_from_fmax
+
+__all__ = ["KNOB_MAX", "LIVE_RANGE", "FmaxKnob", "FmaxLinear", "Volume", "Source", "Select", "Bowing",
+           "HandTarget", "as_action", "as_actions", "knob_step", "knob_value"]
+
+
+def knob_step(value):
+    """The knob step (0..127) of a control value in [0, 1]."""
+    return round(value * KNOB_MAX)
+
+
+def knob_value(step):
+    """The control value in [0, 1] of knob step ``step`` (0..127)."""
+    return step / KNOB_MAX
+
+
+@dataclass(frozen=True)
+class FmaxKnob:
+    """F_max on the logarithmic knob law over ``decades`` decades up to ``ceiling`` (N)."""
+
+    ceiling: float
+    decades: float
+
+    def fmax(self, step):
+        """F_max (N) at knob step ``step`` (0..127): the one place the knob law is applied."""
+        return fmax_from_knob(step, self.ceiling, self.decades)
+
+    def step(self, fmax):
+        """The knob step whose F_max is nearest ``fmax`` (N): the law's inverse."""
+        return knob_from_fmax(fmax, self.ceiling, self.decades)
+
+
+@dataclass(frozen=True)
+class FmaxLinear:
+    """F_max from ``low`` (value 0) to ``high`` (value 1), N, linearly."""
+
+    low: float
+    high: float
+
+    def fmax(self, value):
+        return self.low + value * (self.high - self.low)
+
+
+@dataclass(frozen=True)
+class Volume:
+    """The sink's linear gain: the control's value."""
+
+
+@dataclass(frozen=True)
+class Source:
+    """A pad: selects the velocity source ``name`` when pressed (an estimator or a pseudo-source)."""
+
+    name: str
+
+
+@dataclass(frozen=True)
+class Select:
+    """A rating knob: any movement selects ``condition``, at ``fmax`` (N) when one is given."""
+
+    condition: str
+    fmax: float | None = None
+
+
+@dataclass(frozen=True)
+class Bowing:
+    """The bow on the string while the control's value is above 0."""
+
+
+@dataclass(frozen=True)
+class HandTarget:
+    """The hand's target position (m) from ``low`` (value 0) to ``high`` (value 1)."""
+
+    low: float
+    high: float
+
+    def metres(self, value):
+        return self.low + value * (self.high - self.low)
+
+
+ACTIONS = (FmaxKnob, FmaxLinear, Volume, Source, Select, Bowing, HandTarget)
+KINDS = {"fmax_log": FmaxKnob, "fmax_linear": FmaxLinear, "volume": Volume, "source": Source,
+         "select": Select, "bowing": Bowing, "hand_target": HandTarget}
+
+
+def as_action(action):
+    """An action from itself or its compact spelling ``(kind, *fields)``; ``ParameterError`` otherwise."""
+    if isinstance(action, ACTIONS):
+        return action
+    kind = action[0] if isinstance(action, (tuple, list)) and action else action
+    make = KINDS.get(kind) if isinstance(kind, str) and kind is not action else None
+    if make is None:
+        raise ParameterError(f"MIDI action {kind!r}: allowed are {', '.join(KINDS)}")
+    try:
+        return make(*action[1:])
+    except TypeError:
+        names = ", ".join(f.name for f in fields(make)) or "nothing"
+        raise ParameterError(f"MIDI action {tuple(action)!r}: {kind} takes {names}") from None
+
+
+def as_actions(mapping):
+    """``{control: action}`` with every action read by ``as_action``."""
+    return {control: as_action(action) for control, action in dict(mapping).items()}
+
