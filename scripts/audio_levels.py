@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from studyapp.engine.audio import WAV_RATE
+from studyapp.engine.audio.sinks import WAV_RATE
 from studyapp.engine.signal_chain import CEILING_DBFS, KNEE_DB, SignalChain
 from studyapp.experiment.level_check import stimulus_rms_dbfs
 from studyapp.experiment.protocol import load_protocol

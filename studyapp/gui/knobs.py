@@ -35,7 +35,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-KNOB_MAX = 127
+from studyapp.model.controls import KNOB_MAX
+
 PAD_MIN_WIDTH = 36  # px
 PARTICIPANT_DIAL = 110  # px: a large target for the mouse, eight of them fit in 1,366 px
 

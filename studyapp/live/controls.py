@@ -32,6 +32,7 @@ from studyapp.engine import commands as cmd
 from studyapp.engine.events import Learned
 from studyapp.experiment import records
 from studyapp.live.knob_latency import KnobLatency
+from studyapp.model.controls import knob_step, knob_value
 
 PAGE_SETTLE_S = 0.5  # s a page shows before the participant can end it
 
@@ -54,7 +55,7 @@ class Controls:
     # on screen ----------------------------------------------------------------------------------------
     def knob(self, index, value):
         """Knob ``index`` (from 0) moved to ``value`` (0..127) on screen: to the worker, as MIDI would."""
-        self._send(cmd.Control(f"knob{index + 1}", int(value) / 127))
+        self._send(cmd.Control(f"knob{index + 1}", knob_value(int(value))))
 
     def pad(self, index):
         """Pad ``index`` (from 0) pressed on screen."""
@@ -108,13 +109,13 @@ class Controls:
         if record.latency is not None:
             self.latency.add(record.latency, record.origin)
         if knob is not None:
-            live.events.knob.emit(index=knob, value=round(record.value * 127))
+            live.events.knob.emit(index=knob, value=knob_step(record.value))
         if not ours:
             return
         if runner.loop is not None:
             runner.loop.applied(record.commands)
         if knob is not None:
-            live.take_records(runner.knob(knob, round(record.value * 127)))
+            live.take_records(runner.knob(knob, knob_step(record.value)))
         elif pad is not None and record.value > 0:
             if runner.trial.page is not None and self.settling(record.control):
                 return

@@ -1,7 +1,7 @@
 """The experimenter's master volume and mute for a session: what the console's sound controls hold.
 
 They send the engine's existing commands (``SetVolume`` with a linear gain,
-``SetMute``; engine/audio.py applies them, ramped, before the rest of the
+``SetMute``; engine/audio/sinks.py applies them, ramped, before the rest of the
 audio chain), so this adds no second volume stage. The console sets the
 volume in decibels, -40 to 0 dB (gain 10^(dB/20), 0.01 to 1): an
 attenuator, never louder than the chain's own full level. The setting

@@ -7,7 +7,7 @@ asked to record what the participant hears into the session folder
 resumed session; the worker picks the free name); the recording stops when
 the session ends. Each step's start (right after its knob mapping, so at the
 same block boundary) and end is sent as an ``AudioCue``: the worker writes it
-to audio_cues.csv at its own audio frame counter (engine/audio_recorder.py),
+to audio_cues.csv at its own audio frame counter (engine/audio/recorder.py),
 so no sample position crosses the process boundary.
 
 The reference tone. A calibration page (the headphone level check) sends
