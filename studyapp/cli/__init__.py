@@ -100,7 +100,7 @@ def main(argv=None):
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
     except OSError as exc:
-        # the outputs are atomic (studyapp.atomic): a failed write leaves no partial file to mention
+        # the outputs are atomic (studyapp.io.atomic): a failed write leaves no partial file to mention
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"studyapp: error: {one_line(f'{where}{exc.strerror or exc}')}: nothing written", file=sys.stderr)
         return 2

@@ -42,7 +42,7 @@ def check_gesture(name):
 def run(args):
     import sys
 
-    from studyapp import recording
+    from studyapp.io import recording
     from studyapp.cli import output_paths
     from studyapp.estimators.spec import validate_rate
     from studyapp.model import simulate

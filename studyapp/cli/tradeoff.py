@@ -138,7 +138,7 @@ def write_outputs(output, trade, info):
     import json
     import math
 
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
     from studyapp.evaluation import figures
     from studyapp.evaluation.tables import write_csv
     from studyapp.evaluation.tradeoff import COLUMNS

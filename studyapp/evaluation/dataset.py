@@ -61,7 +61,7 @@ def reference_column(reference):
 
 
 def take_from_recording(recording, name, reference="lvt", sha256=None):
-    """A ``Take`` from a ``studyapp.recording.Recording`` (columns by the CSV names)."""
+    """A ``Take`` from a ``studyapp.io.recording.Recording`` (columns by the CSV names)."""
     columns = recording.columns
     wanted = ["position", "acceleration", "velocity_lvt", reference_column(reference)]
     for column in wanted:
@@ -93,7 +93,7 @@ def file_sha256(path):
 
 def load_takes(paths, reference="lvt"):
     """Load recording files (``.h5``, ``.npz`` or ``.csv``) as takes; one-line errors name the file."""
-    from studyapp.recording import load
+    from studyapp.io.recording import load
 
     takes = []
     for path in paths:

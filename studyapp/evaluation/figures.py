@@ -47,7 +47,7 @@ def _pyplot():
 
 def save(fig, stem):
     """Write ``stem``.png and ``stem``.svg atomically; return both paths."""
-    from studyapp.atomic import atomic_path
+    from studyapp.io.atomic import atomic_path
 
     paths = []
     for suffix in (".png", ".svg"):

@@ -218,7 +218,7 @@ def write_responses(results_dir, output, problems=None):
 
 def save_responses(frame, results_dir, output):
     """Write the exported ``frame`` to the CSV file ``output`` atomically (refused when it is empty)."""
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
 
     if frame.empty:
         raise UserError(f"{results_dir}: no responses found (no {SESSION_FILE} with confirmed responses)")

@@ -36,7 +36,7 @@ from pathlib import Path
 
 from studyapp.errors import UserError
 from studyapp.model.device import DeviceLimits
-from studyapp.small_files import parse_toml, read_bytes
+from studyapp.io.small_files import parse_toml, read_bytes
 
 SAFE_CEILING = DeviceLimits().sustained  # N: the motors' sustained limit, the engine's default ceiling
 FMAX_FIELDS = ("fmax", "ceiling")  # the task fields that set an F_max level

@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from studyapp import __version__
-from studyapp.atomic import atomic_open
+from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
@@ -68,7 +68,7 @@ from studyapp.experiment.session_info import (
 )
 from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
 from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
-from studyapp.small_files import LIMIT_BYTES, open_regular
+from studyapp.io.small_files import LIMIT_BYTES, open_regular
 
 CREATED = "session_created"
 SESSION_END = "session_end"

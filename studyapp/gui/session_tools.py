@@ -54,7 +54,7 @@ class RunSheetDialog(QDialog):
         self.resize(760, 600)
 
     def save(self, path):
-        from studyapp.atomic import atomic_open
+        from studyapp.io.atomic import atomic_open
 
         with atomic_open(path, encoding="utf-8") as f:
             f.write(self.markdown)

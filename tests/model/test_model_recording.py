@@ -9,7 +9,7 @@ import pytest
 from studyapp.cli import main
 from studyapp.errors import InputDataError, UserError
 from studyapp.model import PAPER_FMAX, simulate
-from studyapp.recording import COLUMNS, Recording, load, save
+from studyapp.io.recording import COLUMNS, Recording, load, save
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ Units are SI: t (s), position (m), velocity_lvt, velocity_true, string_velocity 
 acceleration, acceleration_true (m/s^2), force (N, the force commanded on the handle),
 audio (arbitrary units, the body filter's output).
 
-Writes are atomic (``studyapp.atomic``): a failure leaves no partial file. ``load``
+Writes are atomic (``studyapp.io.atomic``): a failure leaves no partial file. ``load``
 raises ``InputDataError`` naming the file and what is wrong with it.
 """
 
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from studyapp.atomic import atomic_open, atomic_path
+from studyapp.io.atomic import atomic_open, atomic_path
 from studyapp.errors import InputDataError, UserError
 
 COLUMNS = (

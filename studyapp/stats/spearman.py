@@ -16,7 +16,7 @@ is constant: a ranking needs at least two distinct values to compare.
 import numpy as np
 from scipy.special import stdtr
 
-from studyapp.evaluation.ranks import average_ranks
+from studyapp.stats.ranks import average_ranks
 
 
 def spearman(x, y):

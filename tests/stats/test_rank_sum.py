@@ -1,4 +1,4 @@
-"""The one rank-sum test (evaluation/rank_sum.py): hand-computed examples, scipy on the same data, exact p."""
+"""The one rank-sum test (stats/rank_sum.py): hand-computed examples, scipy on the same data, exact p."""
 
 import math
 
@@ -7,8 +7,8 @@ import pytest
 from scipy import stats
 
 from studyapp.errors import InputDataError
-from studyapp.evaluation.rank_sum import EXACT_MAX_SMALLER, rank_sum_test, u_distribution
-from studyapp.evaluation.ranks import average_ranks, tie_sizes
+from studyapp.stats.rank_sum import EXACT_MAX_SMALLER, rank_sum_test, u_distribution
+from studyapp.stats.ranks import average_ranks, tie_sizes
 
 
 def test_average_ranks_with_ties_by_hand():

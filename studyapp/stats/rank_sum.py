@@ -41,7 +41,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from studyapp.errors import InputDataError
-from studyapp.evaluation.ranks import average_ranks, tie_sizes
+from studyapp.stats.ranks import average_ranks, tie_sizes
 
 EXACT_MAX_SMALLER = 8
 

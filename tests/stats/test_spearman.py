@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from studyapp.analysis.spearman import spearman
+from studyapp.stats.spearman import spearman
 
 
 def test_rho_without_ties_by_hand():

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from studyapp.evaluation.ranks import average_ranks
+from studyapp.stats.ranks import average_ranks
 from studyapp.errors import InputDataError
 
 ZERO_METHOD = "wilcox"
