@@ -45,7 +45,7 @@ def run(args):
     from studyapp.io import recording
     from studyapp.cli import output_paths
     from studyapp.estimators.spec import validate_rate
-    from studyapp.model import simulate
+    from studyapp.model.simulate import simulate
     from studyapp.model.loop import check_fmax
     from studyapp.model.sources import LVT_SENSOR
 

@@ -65,7 +65,7 @@ from studyapp.engine.event_ring import EventRing
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
 from studyapp.errors import EngineError, ParameterError
-from studyapp.model.loop import GESTURES
+from studyapp.model.limits import GESTURES
 from studyapp.model.sources import with_pseudo_sources
 
 __all__ = ["Engine", "EngineError"]

@@ -83,7 +83,7 @@ class Cases:
         return {**asdict(self), "fmax": list(self.fmax), "seeds": list(self.seeds), "reference": REFERENCE_SOURCE}
 
     def simulate(self, source, fmax, seed, params=None):
-        from studyapp.model import simulate
+        from studyapp.model.simulate import simulate
 
         estimators = {} if is_pseudo(source) else {source: dict(params or {})}
         return simulate(fmax, rate=self.rate, duration=self.duration, source=source, gesture=self.gesture,
@@ -155,7 +155,7 @@ def perceptual_objective_task(cases, name, params):
 
 def warm_up(cases, names):
     """Load (or compile) the closed loop and each estimator's kernel in this process, on a few samples."""
-    from studyapp.model import simulate
+    from studyapp.model.simulate import simulate
 
     short = frame_length(cases.rate) / cases.rate
     for name in (REFERENCE_SOURCE, *names):

@@ -26,7 +26,7 @@ def make_dataset(takes, max_lag_s=DEFAULT_MAX_LAG_S, delay_method=DEFAULT_METHOD
 
 def simulate_takes(rate, fmax_values, duration, seed, reference="lvt"):
     """Short recordings simulated at ``rate``, one per F_max, as takes."""
-    from studyapp.model import simulate
+    from studyapp.model.simulate import simulate
 
     takes = []
     for i, fmax in enumerate(fmax_values):

@@ -64,8 +64,8 @@ from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
+from studyapp.experiment.trial_health import HEALTH_COLUMNS
 
-HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
 SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
            "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS,

@@ -35,10 +35,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from studyapp.errors import UserError
-from studyapp.model.device import DeviceLimits
+from studyapp.model.limits import SESSION_GESTURES, SUSTAINED_FORCE
 from studyapp.io.small_files import parse_toml, read_bytes
 
-SAFE_CEILING = DeviceLimits().sustained  # N: the motors' sustained limit, the engine's default ceiling
+SAFE_CEILING = SUSTAINED_FORCE  # N: the motors' sustained limit, the engine's default ceiling
 FMAX_FIELDS = ("fmax", "ceiling")  # the task fields that set an F_max level
 
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
@@ -192,7 +192,6 @@ def parse_protocol(text, source="<protocol>"):
     from studyapp.experiment.task_type import Bounds
     from studyapp.experiment.tasks import protocol_task_names as task_names
     from studyapp.experiment.tasks import task_type
-    from studyapp.model.loop import GESTURES
 
     document = parse_toml(text, source)
     known_tables = ("study", "apparatus", "estimators", "pages", *task_names())
@@ -216,10 +215,9 @@ def parse_protocol(text, source="<protocol>"):
     rate = apparatus.number("rate", RATE_MIN, RATE_MAX, "Hz")
     knobs = apparatus.integer("knobs", 1, 64, default=8)
     pads = apparatus.integer("pads", 1, 64, default=8)
-    gestures = [g for g in GESTURES if g != "playback"]  # playback needs a recorded trajectory
-    gesture = apparatus.string("gesture", "one of " + ", ".join(gestures), default="strokes")
-    if gesture not in gestures:
-        apparatus.fail("gesture", f"= {gesture!r}", "one of " + ", ".join(gestures))
+    gesture = apparatus.string("gesture", "one of " + ", ".join(SESSION_GESTURES), default="strokes")
+    if gesture not in SESSION_GESTURES:
+        apparatus.fail("gesture", f"= {gesture!r}", "one of " + ", ".join(SESSION_GESTURES))
     ceiling = None
     if "fmax_ceiling" in apparatus.values:
         ceiling = apparatus.number("fmax_ceiling", 0.0, SAFE_CEILING, "N (the motors' sustained limit)",

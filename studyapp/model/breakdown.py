@@ -41,13 +41,13 @@ import numpy as np
 from studyapp.errors import ParameterError
 from studyapp.model import bowing_reference, stability
 from studyapp.model.calibration import F0
+from studyapp.model.limits import BREAKDOWN_GESTURES, FMAX_LIMIT
 from studyapp.model.sources import is_pseudo, with_pseudo_sources
 
 SETTLE = 0.25  # s before the monitor's verdict counts (its window)
 BLOCK = 0.05  # s
 LOW = 0.05  # N, the search's lowest F_max
-HIGH = 200.0  # N, the search's highest F_max (loop.FMAX_LIMIT)
-GESTURES = ("hold", "strokes")
+HIGH = FMAX_LIMIT  # N, the search's highest F_max
 MAX_SEEDS = 100  # a source's search takes about 0.3 s per seed at 5 kHz; --all with 100 seeds about 10 min
 DURATION_RANGE = (0.5, 60.0)  # s per trial; below about 2 s a late onset is missed (the verdict lags ~1 s)
 DURATION = 5.0  # s per trial by default: about ten strokes
@@ -75,8 +75,8 @@ def check_seeds(n, label="seeds"):
 
 
 def check_gesture(name, label="gesture"):
-    if name not in GESTURES:
-        raise ParameterError(f"{label} {name!r}: allowed are {', '.join(GESTURES)}")
+    if name not in BREAKDOWN_GESTURES:
+        raise ParameterError(f"{label} {name!r}: allowed are {', '.join(BREAKDOWN_GESTURES)}")
     return name
 
 

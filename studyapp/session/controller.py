@@ -122,6 +122,8 @@ from studyapp.experiment.session_info import order_text
 from studyapp.experiment.session_notes import add_note, note_event
 from studyapp.experiment.session_runner import SessionRunner
 from studyapp.experiment.tasks import task_type
+from studyapp.experiment.trial_health import HEALTH
+from studyapp.model.limits import CONSOLE_GESTURES as GESTURES
 from studyapp.session.engine_host import EngineHost
 from studyapp.session.engine_loop import EngineLoop
 from studyapp.session.evented import EventGroup
@@ -133,10 +135,6 @@ STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
 # s a page shows before the participant can end it: the second press of a double press on a trial's
 # confirm pad would otherwise end the page that follows it unread (logged, not announced)
 PAGE_SETTLE_S = 0.5
-GESTURES = ("strokes", "hold", "live")
-# the engine's fault counters a trial_health record logs, and their names there
-HEALTH = {"deadline_misses": "deadline_misses", "audio_underruns": "underruns", "faults": "faults",
-          "events_dropped": "events_dropped"}  # what the console offers: scripted strokes, a held handle, the mouse
 
 
 class State(StrEnum):

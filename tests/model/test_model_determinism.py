@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from studyapp.model import simulate
+from studyapp.model.simulate import simulate
 from studyapp.model.loop import OUTPUTS, ClosedLoop, LoopConfig
 from studyapp.io.recording import COLUMNS
 

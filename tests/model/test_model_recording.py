@@ -8,7 +8,8 @@ import pytest
 
 from studyapp.cli import main
 from studyapp.errors import InputDataError, UserError
-from studyapp.model import PAPER_FMAX, simulate
+from studyapp.model.data_set import PAPER_FMAX
+from studyapp.model.simulate import simulate
 from studyapp.io.recording import COLUMNS, Recording, load, save
 
 
