@@ -31,7 +31,6 @@ COLUMNS = (
     "acceleration_true", "force", "string_velocity", "audio",
 )
 SUFFIXES = (".h5", ".npz", ".csv")
-META_KEYS = ("fmax", "rate", "source", "gesture", "f0", "seed", "duration", "version")
 FORMAT_VERSION = 1  # stored as meta["format"]; meta["version"] is the app's version
 
 
