@@ -37,8 +37,10 @@ import json
 import math
 from pathlib import Path
 
-from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
+from studyapp.estimators import conventions
+from studyapp.estimators.registry import SPECS
+from studyapp.io.atomic import atomic_open
 from studyapp.io.small_files import read_toml
 
 META_TABLES = ("provenance", "objective", "conventions")
@@ -46,8 +48,6 @@ META_TABLES = ("provenance", "objective", "conventions")
 
 def read(path):
     """(params, provenance): params is name -> {parameter: value}; names are checked, values are not."""
-    from studyapp.estimators.registry import SPECS
-
     path = Path(path)
     _, data = read_toml(path, "parameter (PARAMS.toml)")
     params = {}
@@ -99,7 +99,6 @@ def dumps(params, provenance=None, objective=None, comment=None):
     lines = []
     if comment:
         lines += [f"# {line}" for line in comment.splitlines()] + [""]
-    from studyapp.estimators import conventions
 
     tables = []
     if provenance:

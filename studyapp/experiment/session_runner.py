@@ -52,7 +52,7 @@ def closed_loop_factory(protocol, audio=False):
     """``make_loop`` building the model's ClosedLoop in-process for ``protocol``."""
 
     def make_loop(estimators, source, seed):
-        from studyapp.model.loop import ClosedLoop, LoopConfig
+        from studyapp.model.loop import ClosedLoop, LoopConfig  # numba: not in the GUI, which passes its own
 
         config = LoopConfig(rate=protocol.rate, estimators=estimators, source=source, fmax=0.0,
                             gesture=protocol.gesture, seed=seed, audio=audio)

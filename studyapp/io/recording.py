@@ -23,8 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from studyapp.io.atomic import atomic_open, atomic_path
+from studyapp import __version__
 from studyapp.errors import InputDataError, UserError
+from studyapp.io.atomic import atomic_open, atomic_path
 
 COLUMNS = (
     "t", "position", "velocity_lvt", "acceleration", "velocity_true",
@@ -69,8 +70,6 @@ def check_path(path):
 
 
 def _meta_json(recording):
-    from studyapp import __version__
-
     meta = {"format": FORMAT_VERSION, "version": __version__, **recording.meta, "rate": recording.rate}
     return json.dumps(meta, sort_keys=True, default=_plain)
 

@@ -13,7 +13,7 @@ from studyapp.model.loop import make_gesture
 
 # modules that read a limit or the knob law and must not load the compiled simulation
 LIGHT = ["studyapp.model.limits", "studyapp.model.fmax_knob", "studyapp.experiment.tasks",
-         "studyapp.experiment.protocol"]
+         "studyapp.experiment.protocol", "studyapp.experiment.schedule"]
 
 
 @pytest.mark.parametrize("module", LIGHT)
