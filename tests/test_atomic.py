@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from studyapp.atomic import atomic_open, atomic_path
+from studyapp.io.atomic import atomic_open, atomic_path
 
 
 def test_complete_write_replaces_target(tmp_path):
@@ -47,7 +47,7 @@ def test_permissions_follow_the_umask(tmp_path):
 REPO = Path(__file__).resolve().parents[1]
 
 KILLED_WRITER = """import sys, time
-from studyapp.atomic import atomic_open, atomic_path
+from studyapp.io.atomic import atomic_open, atomic_path
 if sys.argv[2] == "open":
     with atomic_open(sys.argv[1]) as f:
         f.write("half")

@@ -28,7 +28,7 @@ RATE = 5000.0
 
 
 def _recording(path, drop=()):
-    from studyapp.recording import Recording, save
+    from studyapp.io.recording import Recording, save
     from studyapp.synthetic import stick_slip
 
     sig = stick_slip(RATE, 0.1, seed=1)
@@ -313,7 +313,7 @@ def test_bad_input_is_refused_by_the_command(case, inputs, tmp_path):
 
 
 def test_a_recording_csv_with_a_byte_order_mark_is_accepted(tmp_path):
-    from studyapp.recording import COLUMNS, Recording, load, save
+    from studyapp.io.recording import COLUMNS, Recording, load, save
 
     rec = Recording(1000.0, {name: np.arange(5.0) * (i + 1) / 1000 for i, name in enumerate(COLUMNS)})
     save(rec, tmp_path / "plain.csv")

@@ -6,7 +6,7 @@ import numpy as np
 
 from studyapp.cli import main
 from studyapp.cli.memory_benchmark import COLUMNS, write_csv, write_npz
-from studyapp.recording_blocks import RecordingBlocks
+from studyapp.io.recording_blocks import RecordingBlocks
 
 
 def test_generated_npz_is_a_recording_numpy_reads(tmp_path):

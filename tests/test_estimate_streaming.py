@@ -12,7 +12,7 @@ import pytest
 
 from studyapp import estimators
 from studyapp.cli import main
-from studyapp.recording import Recording, save
+from studyapp.io.recording import Recording, save
 from studyapp.synthetic import stick_slip
 
 RATE = 5000.0

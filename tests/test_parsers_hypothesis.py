@@ -20,8 +20,8 @@ from hypothesis import strategies as st
 from studyapp.errors import UserError
 from studyapp.evaluation import params_file
 from studyapp.experiment.protocol import parse_protocol
-from studyapp.recording_blocks import RecordingBlocks
-from studyapp.sample_table import SampleTable
+from studyapp.io.recording_blocks import RecordingBlocks
+from studyapp.io.sample_table import SampleTable
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO = (REPO / "protocols" / "demo.toml").read_text(encoding="utf-8")

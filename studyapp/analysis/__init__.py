@@ -6,7 +6,8 @@
     report_folder.write_report_folder(...) writes the CSV tables, Figs. 7-9 (PNG, SVG) and report.html
     report_folder.open_study(path)        -> StudyAnalysis of a report folder, results folder or .csv
 
-The statistics (rank_sum, holm, spearman, summary, consistency) are plain
-functions on arrays and DataFrames; figures.py draws on matplotlib Figures
+The statistical tests themselves live in studyapp.stats (shared with the
+numerical evaluation); rank_sum, summary and consistency here apply them to the
+study's responses as plain functions on DataFrames; figures.py draws on matplotlib Figures
 without pyplot, so the GUI shows the report's own figures.
 """

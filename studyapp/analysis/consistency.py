@@ -22,7 +22,7 @@ and report it as ``intra_lower_pct``.
 import numpy as np
 import pandas as pd
 
-from studyapp.analysis.spearman import spearman
+from studyapp.stats.spearman import spearman
 
 SPEARMAN_COLUMNS = ["participant", "rho", "p_value"]
 VARIANCE_COLUMNS = ["condition", "participants", "intra_variance", "inter_variance", "total_variance", "intra_lower_pct"]

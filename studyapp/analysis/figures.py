@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 from matplotlib.transforms import blended_transform_factory
 
 from studyapp.analysis.rank_sum import POOLED
-from studyapp.atomic import atomic_path
+from studyapp.io.atomic import atomic_path
 
 FORMATS = ("png", "svg")
 _SIZE = (7.5, 4.8)

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from studyapp.analysis.spearman import spearman
+from studyapp.stats.spearman import spearman
 from studyapp.errors import InputDataError
 
 NUMERICAL_COLUMNS = ["comparison", "subjective", "numerical", "metric", "n", "rho", "p_value", "conditions"]

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from studyapp.analysis.numerical import number_or_numbers, numerical_scores
-from studyapp.analysis.spearman import spearman
+from studyapp.stats.spearman import spearman
 
 PERCEPTUAL_COLUMNS = ["comparison", "metric", "n", "rho", "p_value", "paper_rho", "conditions"]
 PAPER_ERROR_RHO = 0.61  # paper Sec. 10: noisiness medians against delay-corrected error medians

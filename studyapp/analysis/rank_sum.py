@@ -1,7 +1,7 @@
 """The paper's pairwise Wilcoxon rank-sum tests between conditions (paper Sec. 9, ref. [28]).
 
 The test itself (statistic z, exact or tie-corrected normal p) has one
-definition, studyapp/evaluation/rank_sum.py, shared with ``studyapp evaluate``.
+definition, studyapp/stats/rank_sum.py, shared with ``studyapp evaluate``.
 
 The analysis applies it as the paper did, to every trial of every participant
 pooled per condition. The test assumes independent samples, which the trials
@@ -16,8 +16,8 @@ from itertools import combinations
 import numpy as np
 import pandas as pd
 
-from studyapp.analysis.holm import holm_adjust
-from studyapp.evaluation.rank_sum import rank_sum_test
+from studyapp.stats.holm import holm_adjust
+from studyapp.stats.rank_sum import rank_sum_test
 
 POOLED = "pooled across participants, as the paper did; trials are not independent"
 WILCOXON_COLUMNS = ["condition_a", "condition_b", "statistic", "p_value", "significant"]

@@ -14,7 +14,7 @@ import numpy as np
 from studyapp import __version__
 from studyapp.analysis.missing_trials import describe_missing
 from studyapp.analysis.rank_sum import POOLED
-from studyapp.analysis.signed_rank import EXACT_LIMIT
+from studyapp.stats.signed_rank import EXACT_LIMIT
 from studyapp.experiment.tasks import task_type
 
 _STYLE = """

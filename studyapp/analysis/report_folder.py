@@ -42,7 +42,7 @@ from studyapp.analysis.responses import load_responses
 from studyapp.analysis.study import analyse
 from studyapp.analysis.summary import SUMMARY_COLUMNS
 from studyapp.analysis.within_subject import FRIEDMAN_COLUMNS, SIGNED_RANK_COLUMNS
-from studyapp.atomic import atomic_open
+from studyapp.io.atomic import atomic_open
 from studyapp.errors import InputDataError
 
 RESPONSES_FILE = "responses_analysed.csv"

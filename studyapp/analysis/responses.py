@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 from studyapp.errors import InputDataError, UserError
+from studyapp.experiment.export import export_responses
 from studyapp.experiment.records import TRIAL_MAX
 from studyapp.experiment.tasks import task_names, task_type
 
@@ -61,13 +62,6 @@ def load_responses(source, problems=None, include_practice=False, include_simula
         return check_responses(frame, str(path), csv_rows=True, include_practice=include_practice,
                                include_simulated=include_simulated), str(path)
     if path.is_dir():
-        try:
-            from studyapp.experiment.export import export_responses
-        except ImportError:
-            raise UserError(
-                f"{path}: reading a results folder needs studyapp.experiment.export, which is not "
-                "installed; pass an exported responses.csv instead"
-            ) from None
         return check_responses(export_responses(path, problems), str(path),
                                include_practice=include_practice, include_simulated=include_simulated), str(path)
     raise UserError(f"{path}: expected a results folder or an exported responses .csv file")

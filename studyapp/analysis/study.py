@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from studyapp.analysis.compact_letters import compact_letters
+from studyapp.stats.compact_letters import compact_letters
 from studyapp.analysis.consistency import participant_spearman, variance_decomposition
 from studyapp.analysis.missing_trials import describe_missing, find_missing_trials
 from studyapp.analysis.numerical import compare_with_numerical

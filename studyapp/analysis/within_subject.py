@@ -34,11 +34,11 @@ from itertools import combinations
 
 import pandas as pd
 
-from studyapp.analysis.friedman import MIN_CONDITIONS, RELIABLE_PARTICIPANTS, Friedman, friedman_test
-from studyapp.analysis.friedman import minimum_p as friedman_minimum_p
-from studyapp.analysis.holm import holm_adjust
-from studyapp.analysis.signed_rank import minimum_p as signed_rank_minimum_p
-from studyapp.analysis.signed_rank import participants_needed, signed_rank_test
+from studyapp.stats.friedman import MIN_CONDITIONS, RELIABLE_PARTICIPANTS, Friedman, friedman_test
+from studyapp.stats.friedman import minimum_p as friedman_minimum_p
+from studyapp.stats.holm import holm_adjust
+from studyapp.stats.signed_rank import minimum_p as signed_rank_minimum_p
+from studyapp.stats.signed_rank import participants_needed, signed_rank_test
 
 SIGNED_RANK_COLUMNS = ["condition_a", "condition_b", "statistic", "p_value", "p_holm", "effect_size", "significant"]
 FRIEDMAN_COLUMNS = ["task", "statistic", "p_value", "n_participants"]

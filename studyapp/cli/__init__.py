@@ -13,34 +13,20 @@ path or value named holds a newline: it is shown escaped (``one_line``).
 """
 
 import argparse
-import importlib
+import os
 import sys
 
 from studyapp import __version__
-from studyapp.cli import number_options
+from studyapp.cli import (
+    analyse, bench, breakdown, demo, estimate, estimators, evaluate, export, gui, live, notes, optimise, plan, run,
+    simulate, simulate_set, tradeoff,
+)
+from studyapp.cli.number_options import finite_float, integer
 from studyapp.errors import EngineError, UserError
 
-# Module names under studyapp.cli, in the order shown by --help. A module that
-# does not exist yet is skipped, so layers can land one at a time.
-COMMANDS = [
-    "gui",
-    "demo",
-    "estimators",
-    "estimate",
-    "simulate",
-    "simulate_set",
-    "breakdown",
-    "optimise",
-    "evaluate",
-    "tradeoff",
-    "live",
-    "run",
-    "plan",
-    "notes",
-    "export",
-    "analyse",
-    "bench",
-]
+# the sub-commands' modules, in the order shown by --help
+COMMANDS = [gui, demo, estimators, estimate, simulate, simulate_set, breakdown, optimise, evaluate, tradeoff, live, run,
+            plan, notes, export, analyse, bench]
 
 
 class UsageError(UserError):
@@ -48,7 +34,18 @@ class UsageError(UserError):
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse with errors raised, not printed with the usage: ``main`` prints them as one line."""
+    """argparse with errors raised, not printed with the usage: ``main`` prints them as one line.
+
+    Every option of ``type=float`` or ``type=int``, in this parser, its groups and its
+    sub-commands' parsers (argparse makes those of this class too), is read by
+    ``number_options`` (finite floats, no digit grouping): argparse looks a type up in
+    the parser's registry before calling it.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("type", float, finite_float)
+        self.register("type", int, integer)
 
     def error(self, message):
         raise UsageError(f"{message} (see '{self.prog} --help')")
@@ -61,15 +58,8 @@ def build_parser():
     )
     parser.add_argument("--version", action="version", version=f"studyapp {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMANDS:
-        try:
-            module = importlib.import_module(f"studyapp.cli.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"studyapp.cli.{name}":
-                continue
-            raise
+    for module in COMMANDS:
         module.register(sub)
-    number_options.checked(parser)
     return parser
 
 
@@ -78,11 +68,7 @@ def main(argv=None):
     try:
         args = parser.parse_args(argv)
         if args.command is None:
-            if "gui" in parser._subparsers._group_actions[0].choices:
-                args = parser.parse_args(["gui"])
-            else:
-                parser.print_help()
-                return 0
+            args = parser.parse_args(["gui"])
         return args.func(args) or 0
     except UserError as exc:
         print(f"studyapp: error: {one_line(exc)}", file=sys.stderr)
@@ -95,12 +81,10 @@ def main(argv=None):
         return 130
     except BrokenPipeError:
         # the reader (e.g. `| head`) has gone: stop quietly, as Unix tools do
-        import os
-
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
     except OSError as exc:
-        # the outputs are atomic (studyapp.atomic): a failed write leaves no partial file to mention
+        # the outputs are atomic (studyapp.io.atomic): a failed write leaves no partial file to mention
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"studyapp: error: {one_line(f'{where}{exc.strerror or exc}')}: nothing written", file=sys.stderr)
         return 2

@@ -107,7 +107,7 @@ def write(path, results, args):
     import json
     from pathlib import Path
 
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
 
     suffix = Path(path).suffix.lower()
     with atomic_open(path, "w", newline="", encoding="utf-8") as f:

@@ -12,7 +12,7 @@ defaults cannot exist at ``--rate`` (COMP2's 2,254 Hz high-pass below 4.6 kHz)
 is listed as not available, with the reason.
 """
 
-from studyapp.cli import delay_option
+from studyapp.cli import delay_option, number_options
 
 F0 = 110.0  # Hz, the synthetic signal's stick-slip frequency
 
@@ -21,7 +21,7 @@ def register(sub):
     parser = sub.add_parser("demo", help="headless demo: every estimator on a stick-slip signal")
     parser.add_argument("--rate", type=float, default=5000.0, help="sample rate in Hz (default 5000)")
     parser.add_argument("--seconds", type=float, default=2.0, help="signal length (default 2 s)")
-    parser.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    parser.add_argument("--seed", type=number_options.seed, default=0, help="noise seed (default 0)")
     delay_option.add(parser)
     parser.set_defaults(func=run)
 

@@ -70,7 +70,7 @@ class _Input:
     def __init__(self, path, rate):
         from pathlib import Path
 
-        from studyapp import recording_blocks, sample_table
+        from studyapp.io import recording_blocks, sample_table
         from studyapp.errors import ParameterError
 
         self.path = path
@@ -118,10 +118,10 @@ def run(args):
     import sys
 
     from studyapp import estimators
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
     from studyapp.cli import output_paths
     from studyapp.errors import ParameterError
-    from studyapp.sample_table import write_header, write_rows
+    from studyapp.io.sample_table import write_header, write_rows
 
     if not 1 <= args.block <= BLOCK_MAX:  # a block's rows are held in memory at once
         raise ParameterError(f"--block {args.block}: allowed is an integer from 1 to {BLOCK_MAX}")

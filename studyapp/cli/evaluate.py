@@ -128,7 +128,7 @@ def _write_outputs(output, result, document, validation):
     import json
     import sys
 
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
     from studyapp.evaluation import figures
     from studyapp.evaluation.report import GROUP_TITLES, GROUPS
     from studyapp.evaluation.significance import pairwise

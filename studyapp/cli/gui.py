@@ -20,6 +20,7 @@ checks them). See docs/gui.md.
 
 import re
 
+from studyapp.cli import number_options
 from studyapp.cli.session_info_options import add_session_info_options
 
 SIZES = ((800, 600), (7680, 4320))  # px: the smallest and largest window --size allows
@@ -45,7 +46,7 @@ def register(sub):
     parser.add_argument("--resume", action="store_true", help="tick 'resume the unfinished session'")
     parser.add_argument("--simulated-participant", action="store_true", help="a simulated participant plays")
     parser.add_argument("--start", action="store_true", help="start the session at once (needs --participant)")
-    parser.add_argument("--seed", type=int, default=None, metavar="N", help="session seed (with --start)")
+    parser.add_argument("--seed", type=number_options.seed, default=None, metavar="N", help="session seed (with --start)")
     parser.add_argument("--audio", default="device", metavar="SPEC",
                         help="device | device:NAME | wav:FILE | null (default: device, or no sound if none is found)")
     parser.add_argument("--midi", default="first", metavar="SPEC",

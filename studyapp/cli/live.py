@@ -12,6 +12,8 @@ the motors' sustained limit. Every setting is checked before the worker starts:
 a bad one is one line, exit 2.
 """
 
+from studyapp.cli import number_options
+
 
 def register(sub):
     p = sub.add_parser("live", help="run the haptic loop in real time (audio out, MIDI knobs in)")
@@ -28,7 +30,7 @@ def register(sub):
     p.add_argument("--seconds", type=float, default=None, help="stop after this long (default: run until Ctrl-C)")
     p.add_argument("--gesture", default="strokes", help="scripted gesture (default strokes)")
     p.add_argument("--block", type=int, default=None, help="samples per block (default: 2 ms worth)")
-    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    p.add_argument("--seed", type=number_options.seed, default=0, help="noise seed (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object at exit")
     p.set_defaults(func=run)
 

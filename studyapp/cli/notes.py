@@ -23,7 +23,7 @@ def run(args):
 
     import pandas as pd
 
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
     from studyapp.cli import output_paths
     from studyapp.errors import UserError
     from studyapp.experiment.session_notes import add_note, list_notes, note_event, session_folder_of

@@ -2,7 +2,9 @@
 
 argparse's ``float`` takes ``nan`` and ``inf``, and ``int`` takes ``-1``; no
 option of ours means anything by them (an open-ended option is left out
-instead), so ``checked`` replaces those types on every sub-command's options.
+instead). The command line's parser (``studyapp.cli.Parser``) reads every
+``type=float`` option with ``finite_float`` and every ``type=int`` one with
+``integer``, on every sub-command; a ``--seed`` says ``type=seed`` (0 to 2**63 - 1).
 Both also take ``5_000`` (Python's digit grouping), which is refused too
 (``studyapp.number_text``).
 The error then goes through argparse, naming the option:
@@ -42,17 +44,3 @@ def seed(text):
     if not 0 <= value <= SEED_MAX:
         raise argparse.ArgumentTypeError(f"{text!r}: allowed is an integer from 0 to 2**63 - 1")
     return value
-
-
-def checked(parser):
-    """Give every ``type=float`` option ``finite_float`` and every integer ``--seed`` ``seed``, recursively."""
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            for sub in action.choices.values():
-                checked(sub)
-        elif action.type is float:
-            action.type = finite_float
-        elif action.type is int and action.dest == "seed":
-            action.type = seed
-        elif action.type is int:
-            action.type = integer

@@ -11,7 +11,7 @@ the closed loop on the perceptual cases (cli/perceptual_options.py), so no
 recordings are read; the default patience is then ``PERCEPTUAL_PATIENCE``.
 """
 
-from studyapp.cli import delay_option, output_paths, perceptual_options
+from studyapp.cli import delay_option, number_options, output_paths, perceptual_options
 
 PAPER_PATIENCE = 1000  # the paper's stopping rule
 # Each set costs a closed-loop simulation per case (eight by default): at a tenth of the paper's rule a run
@@ -35,7 +35,7 @@ def register(sub):
     p.add_argument("--patience", type=int,
                    help=f"stop an estimator after this many new sets without improvement "
                         f"(default {PAPER_PATIENCE}; {PERCEPTUAL_PATIENCE} with --objective perceptual)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=number_options.seed, default=0, help="random seed (default 0)")
     p.add_argument("--reference", choices=("lvt", "true"), default="lvt",
                    help="reference velocity: the LVT tachometer (paper) or the true velocity (default lvt)")
     p.add_argument("--tune", choices=("paper", "all"), default="paper",

@@ -3,7 +3,7 @@
 A check creates and removes one temporary file in the nearest existing folder
 above the output: the only way to know a folder is writable (root passes
 ``os.access`` on a read-only mount). The writes themselves are atomic
-(``studyapp.atomic``); an error later (a full disk) is reported by
+(``studyapp.io.atomic``); an error later (a full disk) is reported by
 ``studyapp.cli.main`` in one line.
 
 Participant data is never an output. No command writes into a session folder

@@ -30,7 +30,7 @@ def run(args):
     import sys
     from pathlib import Path
 
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
     from studyapp.cli import output_paths
     from studyapp.errors import UserError
     from studyapp.experiment.protocol import load_protocol

@@ -26,6 +26,7 @@ simulated participant's hand moves as that session's participant bowed
 (its ``hand_trace`` records, experiment/hand_trace.py), trial by trial.
 """
 
+from studyapp.cli import number_options
 from studyapp.cli.session_info_options import add_session_info_options, session_info_of
 
 
@@ -40,7 +41,7 @@ def register(sub):
                         help="no display: run in this process (needs --simulated-participant)")
     parser.add_argument("--resume", action="store_true", help="continue the participant's unfinished session")
     parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
-    parser.add_argument("--seed", type=int, default=None, metavar="N",
+    parser.add_argument("--seed", type=number_options.seed, default=None, metavar="N",
                         help="session seed (default: from the study seed and the participant's enrolment)")
     parser.add_argument("--audio", default=None, metavar="SPEC",
                         help="headless: wav (audio.wav and audio_cues.csv in the session folder) or null (default); "
@@ -153,14 +154,6 @@ def run(args):
 
 
 def _run_in_gui(args):
-    import importlib
+    from studyapp import gui
 
-    from studyapp.errors import UserError
-
-    try:
-        gui = importlib.import_module("studyapp.gui")
-    except ImportError as exc:
-        raise UserError(f"the GUI cannot start ({exc}): allowed is --simulated-participant --headless") from None
-    if not hasattr(gui, "run_session"):
-        raise UserError("the GUI (studyapp.gui) is not available yet: run with --simulated-participant --headless")
     return gui.run_session(args)

@@ -1,5 +1,7 @@
 """``studyapp simulate``: one simulated recording of bowing the string through the closed loop."""
 
+from studyapp.cli import number_options
+
 SOURCES_HELP = "velocity source in the loop: an estimator name, LVT or TRUE (default LVT)"
 
 
@@ -16,7 +18,7 @@ def register(subparsers):
     p.add_argument("--source", default=None, help=SOURCES_HELP)
     p.add_argument("--gesture", default="strokes", help="strokes, strokes-validation or hold (default strokes)")
     p.add_argument("--f0", type=float, default=None, help="string pitch in Hz (default: the model's)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=number_options.seed, default=0, help="random seed (default 0)")
     p.add_argument("-o", "--output", required=True, help="output file: .h5, .npz or .csv")
     p.set_defaults(func=run)
 
@@ -42,10 +44,10 @@ def check_gesture(name):
 def run(args):
     import sys
 
-    from studyapp import recording
+    from studyapp.io import recording
     from studyapp.cli import output_paths
     from studyapp.estimators.spec import validate_rate
-    from studyapp.model import simulate
+    from studyapp.model.simulate import simulate
     from studyapp.model.loop import check_fmax
     from studyapp.model.sources import LVT_SENSOR
 

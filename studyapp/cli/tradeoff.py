@@ -11,6 +11,8 @@ objective with the Pareto front, a panel per rate), ``pareto_<RATE>Hz.png/svg``
 goes to stderr; the Pareto fronts and the estimators not available go to stdout.
 """
 
+from studyapp.cli import number_options
+
 # A short run: a full default run took 4 min 17 s on 2 shared cores (docs/evaluation.md, 2026-11-22).
 DEFAULT_PATIENCE = 20
 
@@ -38,7 +40,7 @@ def register(sub):
                    help="F_max of the simulated recordings, one recording each (default 0.5 1.4 2.2 4.4 7.7)")
     p.add_argument("--duration", type=float, default=2.0, metavar="SECONDS",
                    help="length of each simulated recording (default 2 s)")
-    p.add_argument("--seed", type=int, default=0,
+    p.add_argument("--seed", type=number_options.seed, default=0,
                    help="seed of the first simulated recording and of the tuning (default 0)")
     p.add_argument("--reference", choices=("lvt", "true"), default="lvt", help="reference velocity (default lvt)")
     p.add_argument("--windows", choices=("seconds", "samples"), default="seconds",
@@ -139,7 +141,7 @@ def write_outputs(output, trade, info):
     import json
     import math
 
-    from studyapp.atomic import atomic_open
+    from studyapp.io.atomic import atomic_open
     from studyapp.evaluation import figures
     from studyapp.evaluation.tables import write_csv
     from studyapp.evaluation.tradeoff import COLUMNS

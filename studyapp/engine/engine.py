@@ -43,7 +43,7 @@ from studyapp.engine.status import StatusBlock
 from studyapp.engine.telemetry import channels_for
 from studyapp.engine.watchdog import POLL, Watchdog
 from studyapp.errors import EngineError, ParameterError
-from studyapp.model.loop import GESTURES
+from studyapp.model.limits import GESTURES
 from studyapp.model.sources import with_pseudo_sources
 
 __all__ = ["Engine", "EngineError"]

@@ -88,7 +88,7 @@ State (KALMAN, ``KALMAN_STATE`` = 10):
 State (KALPOS, ``KALPOS_STATE`` = 6): ``[started, y0, y1, u01, d0, d1]``.
 Parameters (KALMAN, ``KALMAN_PARAMS`` = 12):
 ``[rate, T^2, q_g, r_pos, T^4 r_acc, P0_x, T^2 P0_v, T^4 P0_a, g_0, g_1, q_h, q_e]``.
-Parameters (KALPOS, ``KALPOS_PARAMS`` = 6): ``[rate, q_g, r_pos, P0_x, T^2 P0_v, q_e]``.
+Parameters (KALPOS, 6): ``[rate, q_g, r_pos, P0_x, T^2 P0_v, q_e]``.
 """
 
 import numpy as np
@@ -103,7 +103,6 @@ P0_ACCELERATION = 100.0  # m/s^2: standard deviation of the initial acceleration
 KALMAN_STATE = 10
 KALPOS_STATE = 6
 KALMAN_PARAMS = 12
-KALPOS_PARAMS = 6
 
 
 def q_param(default):
@@ -155,26 +154,6 @@ def build_kalpos(rate, params):
 
 def build_kalman(rate, params):
     return kalman_params(rate, params), KALMAN_STATE
-
-
-def unscaled_posterior(state, rate):
-    """(mean, covariance) of the posterior in SI units from a KALPOS or KALMAN state slice.
-
-    For inspection and tests; ``state`` is the kernel's own state (after the
-    input guard); ``len(state)`` tells the order. P = S^-1 U D U^T S^-1.
-    """
-    t = 1.0 / rate
-    if len(state) == KALPOS_STATE:
-        y = np.array(state[1:3])
-        u = np.array([[1.0, state[3]], [0.0, 1.0]])
-        d = np.array(state[4:6])
-    else:
-        y = np.array(state[1:4])
-        u = np.array([[1.0, state[4], state[5]], [0.0, 1.0, state[6]], [0.0, 0.0, 1.0]])
-        d = np.array(state[7:10])
-    s_inv = np.array([1.0, 1.0 / t, 1.0 / (t * t)])[: len(y)]
-    us = u * s_inv[:, None]
-    return y * s_inv, (us * d) @ us.T
 
 
 @njit(cache=True, inline="always")

@@ -5,6 +5,7 @@ The paper's linear velocity transducer (Trans-Tek Series 100, flat to 500 Hz,
 reference condition of the study (Sec. 8.4).
 """
 
+import numpy as np
 from numba import njit
 
 from studyapp.estimators import kinds
@@ -14,8 +15,6 @@ NAME = "LVT"  # the estimator; the sensor pseudo-source of the same text is mode
 
 
 def build(rate, params):
-    import numpy as np
-
     return np.zeros(1), 1
 
 

@@ -21,8 +21,6 @@ RATE_MIN = 1_000.0
 RATE_MAX = 96_000.0
 NYQUIST_FRACTION = 0.49  # cut-offs must stay below this fraction of the rate (Table 1 has 2,254 Hz at 5 kHz)
 
-INPUTS = ("position", "acceleration", "velocity")
-
 
 @dataclass(frozen=True)
 class Param:

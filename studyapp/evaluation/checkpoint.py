@@ -12,7 +12,7 @@ is only resumed for the same fingerprint.
 import json
 from pathlib import Path
 
-from studyapp.atomic import atomic_open
+from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
 
 FORMAT = "studyapp-optimise-checkpoint/1"

@@ -24,12 +24,16 @@ from pathlib import Path
 
 import numpy as np
 
-from studyapp.errors import InputDataError, UserError
+from studyapp.errors import InputDataError, ParameterError, UserError
+from studyapp.estimators import create
 from studyapp.estimators.bounds import all_good
+from studyapp.estimators.registry import spec
+from studyapp.estimators.spec import RATE_MAX
 from studyapp.evaluation import kernels
 from studyapp.evaluation.batch import batches
 from studyapp.evaluation.metric import DEFAULT_METHOD, Reference, check_method
 from studyapp.evaluation.normalisation import raw_objectives
+from studyapp.io.recording import load
 
 REFERENCE_COLUMNS = {"lvt": "velocity_lvt", "true": "velocity_true"}
 DEFAULT_MAX_LAG_S = 0.02  # 100 samples at 5 kHz: far beyond any useful estimator's delay
@@ -61,7 +65,7 @@ def reference_column(reference):
 
 
 def take_from_recording(recording, name, reference="lvt", sha256=None):
-    """A ``Take`` from a ``studyapp.recording.Recording`` (columns by the CSV names)."""
+    """A ``Take`` from a ``studyapp.io.recording.Recording`` (columns by the CSV names)."""
     columns = recording.columns
     wanted = ["position", "acceleration", "velocity_lvt", reference_column(reference)]
     for column in wanted:
@@ -93,8 +97,6 @@ def file_sha256(path):
 
 def load_takes(paths, reference="lvt"):
     """Load recording files (``.h5``, ``.npz`` or ``.csv``) as takes; one-line errors name the file."""
-    from studyapp.recording import load
-
     takes = []
     for path in paths:
         path = Path(path)
@@ -147,8 +149,6 @@ class Dataset:
 
     def estimate(self, take, name, params):
         """The velocity estimate of ``name`` with ``params`` on one take, started from rest."""
-        from studyapp.estimators import create
-
         estimator = create(name, take.rate, **params)
         if self.fast:
             return kernels.run(estimator, take.position, take.acceleration, take.velocity, take.finite)
@@ -187,10 +187,6 @@ def warm_up(names, rate=5000.0, fast=False):
     defaults cannot exist at ``rate`` (COMP2's high-pass below 4.6 kHz) is
     run at the highest rate instead.
     """
-    from studyapp.errors import ParameterError
-    from studyapp.estimators import create
-    from studyapp.estimators.spec import RATE_MAX
-
     x = np.zeros(16)
     side = np.zeros((16, 2))
     for name in names:
@@ -281,8 +277,6 @@ def expand_paths(items):
 
 def estimator_names(text, default):
     """Names from ``--estimators A,B C`` (comma or space separated), checked; ``default`` when empty."""
-    from studyapp.estimators.registry import spec
-
     if not text:
         return list(default)
     names = [n for item in text for n in item.replace(",", " ").split()]

@@ -21,7 +21,9 @@ Every figure is written as PNG and SVG (matplotlib, Agg backend).
 
 import numpy as np
 
+from studyapp.evaluation.labels import place_labels
 from studyapp.evaluation.significance import not_different_from_best
+from studyapp.io.atomic import atomic_path
 
 PANELS = (
     ("objective", "objective per recording"),
@@ -47,8 +49,6 @@ def _pyplot():
 
 def save(fig, stem):
     """Write ``stem``.png and ``stem``.svg atomically; return both paths."""
-    from studyapp.atomic import atomic_path
-
     paths = []
     for suffix in (".png", ".svg"):
         target = stem.with_suffix(suffix)
@@ -100,8 +100,6 @@ def _available(table, rate=None):
 
 def tradeoff_figure(table):
     """Cost (ns/sample, streaming) against the global objective, one panel per rate, Pareto front drawn."""
-    from studyapp.evaluation.labels import place_labels
-
     plt = _pyplot()
     rates = sorted({row["rate"] for row in table})
     fig, axes = plt.subplots(1, len(rates), figsize=(4.4 * len(rates), 4.4), squeeze=False)
@@ -140,7 +138,6 @@ def pareto_figure(table, rate):
     """
     from matplotlib.colors import LogNorm
 
-    from studyapp.evaluation.labels import place_labels
 
     plt = _pyplot()
     rows = [r for r in _available(table, rate)

@@ -13,16 +13,17 @@ lists them).
 
 import numpy as np
 
+from studyapp.estimators.foaw import window_sizes
+from studyapp.estimators.registry import spec
 from studyapp.evaluation.findings import FINDING_COLUMNS, findings
 from studyapp.evaluation.space import PAPER_ESTIMATORS, PAPER_TUNED
+from studyapp.evaluation.tables import write_csv
 
 PARAMETER_COLUMNS = ["estimator", "parameter", "paper", "ours"]
 
 
 def table_1():
     """The paper's Table 1: estimator -> {parameter: value} (the estimators' defaults)."""
-    from studyapp.estimators.registry import spec
-
     return {
         name: {p.name: p.default for p in spec(name).params if p.name in PAPER_TUNED[name]}
         for name in PAPER_ESTIMATORS
@@ -45,8 +46,6 @@ def fraction_at_maximum(positions, window, margin):
 
     ``window`` is FOAW's size (the paper's Size); ``window_sizes`` gives the size chosen at each sample.
     """
-    from studyapp.estimators.foaw import window_sizes
-
     at_maximum = total = 0
     for position in positions:
         sizes = window_sizes(position, window, margin)
@@ -57,8 +56,6 @@ def fraction_at_maximum(positions, window, margin):
 
 def write(output, result, positions, validation=None):
     """Write ``paper_comparison.csv`` and ``findings.csv`` into the folder ``output``."""
-    from studyapp.evaluation.tables import write_csv
-
     write_csv(output / "paper_comparison.csv", parameter_rows(result.params), PARAMETER_COLUMNS)
     fraction = None
     if "FOAW" in result.params:

@@ -14,6 +14,7 @@ caller can report it and go on.
 """
 
 from studyapp.errors import ParameterError, UserError
+from studyapp.estimators.registry import spec
 from studyapp.evaluation import params_file
 from studyapp.evaluation.dataset import estimator_names
 from studyapp.evaluation.space import PAPER_ESTIMATORS
@@ -25,8 +26,6 @@ def parameter_sets(params_path=None, estimators=None, rate=None, unavailable=Non
     ``unavailable``: a dict to receive name -> reason for the estimators whose
     parameters cannot exist at ``rate`` (else those raise like any bad value).
     """
-    from studyapp.estimators.registry import spec
-
     loaded, provenance = ({}, {}) if params_path is None else params_file.read(params_path)
     default = list(loaded) if loaded else PAPER_ESTIMATORS
     names = estimator_names(estimators, default)

@@ -28,7 +28,7 @@ is written for the reader, from the estimator tables, one line per estimator
 that has conventions: the choice parameters (``q_convention``, ``start``) and
 fixed meanings (FOAW's ``window`` is the paper's Size). What runs is what the
 estimator tables say; ``read`` accepts the table and does not use it. ``read`` uses the
-standard library's ``tomllib`` (through ``studyapp.small_files``: a regular
+standard library's ``tomllib`` (through ``studyapp.io.small_files``: a regular
 file of at most 1 MB); ``write`` writes the flat structure by hand
 (strings, numbers, booleans and flat lists of them), atomically.
 """
@@ -37,17 +37,17 @@ import json
 import math
 from pathlib import Path
 
-from studyapp.atomic import atomic_open
 from studyapp.errors import UserError
-from studyapp.small_files import read_toml
+from studyapp.estimators import conventions
+from studyapp.estimators.registry import SPECS
+from studyapp.io.atomic import atomic_open
+from studyapp.io.small_files import read_toml
 
 META_TABLES = ("provenance", "objective", "conventions")
 
 
 def read(path):
     """(params, provenance): params is name -> {parameter: value}; names are checked, values are not."""
-    from studyapp.estimators.registry import SPECS
-
     path = Path(path)
     _, data = read_toml(path, "parameter (PARAMS.toml)")
     params = {}
@@ -99,7 +99,6 @@ def dumps(params, provenance=None, objective=None, comment=None):
     lines = []
     if comment:
         lines += [f"# {line}" for line in comment.splitlines()] + [""]
-    from studyapp.estimators import conventions
 
     tables = []
     if provenance:

@@ -33,9 +33,12 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from scipy.stats import spearmanr
 
 from studyapp.errors import ParameterError, UserError
 from studyapp.evaluation.perceptual import audio_distance, check_rate, frame_length
+from studyapp.model.loop import check_fmax
+from studyapp.model.simulate import simulate
 from studyapp.model.sources import TRUE, is_pseudo
 
 DEFAULT_FMAX = (1.0, 2.2, 4.4, 7.7)
@@ -57,8 +60,6 @@ class Cases:
     gesture: str = GESTURE
 
     def __post_init__(self):
-        from studyapp.model.loop import check_fmax
-
         object.__setattr__(self, "rate", check_rate(self.rate))
         object.__setattr__(self, "fmax", tuple(check_fmax(f) for f in self.fmax))
         object.__setattr__(self, "seeds", tuple(_seed(s) for s in self.seeds))
@@ -83,8 +84,6 @@ class Cases:
         return {**asdict(self), "fmax": list(self.fmax), "seeds": list(self.seeds), "reference": REFERENCE_SOURCE}
 
     def simulate(self, source, fmax, seed, params=None):
-        from studyapp.model import simulate
-
         estimators = {} if is_pseudo(source) else {source: dict(params or {})}
         return simulate(fmax, rate=self.rate, duration=self.duration, source=source, gesture=self.gesture,
                         seed=seed, estimators=estimators)
@@ -155,8 +154,6 @@ def perceptual_objective_task(cases, name, params):
 
 def warm_up(cases, names):
     """Load (or compile) the closed loop and each estimator's kernel in this process, on a few samples."""
-    from studyapp.model import simulate
-
     short = frame_length(cases.rate) / cases.rate
     for name in (REFERENCE_SOURCE, *names):
         estimators = {} if is_pseudo(name) else {name: {}}
@@ -169,8 +166,6 @@ def spearman(distances, values):
 
     Over the names where both are finite: {rho, p, n} (rho and p None below 3 names).
     """
-    from scipy.stats import spearmanr
-
     names = [n for n in distances if np.isfinite(distances[n]) and np.isfinite(values.get(n, np.nan))]
     if len(names) < 3:
         return {"rho": None, "p": None, "n": len(names)}

@@ -8,14 +8,14 @@ the versions of studyapp, Python and the numerical libraries.
 import datetime
 import platform
 
+import numba
+import numpy
+import scipy
+
+from studyapp import __version__
+
 
 def versions():
-    import numba
-    import numpy
-    import scipy
-
-    from studyapp import __version__
-
     return {
         "studyapp_version": __version__,
         "python_version": platform.python_version(),

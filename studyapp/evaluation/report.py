@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from studyapp.estimators import conventions
 from studyapp.evaluation.normalisation import bounds, per_objective, raw_objectives
 
 BASELINE = "LOWPASS"
@@ -109,8 +110,6 @@ class Evaluation:
         ``parameters``: what each estimator ran with; ``conventions``: what
         those numbers mean (``estimators.conventions.record``).
         """
-        from studyapp.estimators import conventions
-
         return {
             "estimators": {
                 name: {

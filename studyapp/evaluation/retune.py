@@ -22,6 +22,7 @@ rate, with the estimators evaluated there, and returns its ``Result``.
   the rate's optimum in a few minutes.
 """
 
+from studyapp.estimators.registry import spec
 from studyapp.evaluation.dataset import RawObjectives
 from studyapp.evaluation.optimiser import Optimiser
 from studyapp.evaluation.space import SEARCH_RANGES, Space
@@ -31,8 +32,6 @@ TABLE1_RATE = 5000.0  # the paper's rate, at which Table 1 and SEARCH_RANGES wer
 
 def search_spaces(names, rate, windows="seconds"):
     """name -> ``Space`` at ``rate`` (narrowed window ranges scaled with the rate when windows keep seconds)."""
-    from studyapp.estimators.registry import spec
-
     spaces = {}
     for name in names:
         s = spec(name)

@@ -15,7 +15,7 @@ import itertools
 
 import numpy as np
 
-from studyapp.evaluation.rank_sum import rank_sum_test
+from studyapp.stats.rank_sum import rank_sum_test
 
 ALPHA = 0.05
 

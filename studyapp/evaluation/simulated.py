@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 from studyapp.evaluation.dataset import DEFAULT_MAX_LAG_S, Dataset, take_from_recording
 from studyapp.evaluation.metric import DEFAULT_METHOD
+from studyapp.model.simulate import simulate
 
 
 def make_dataset(takes, max_lag_s=DEFAULT_MAX_LAG_S, delay_method=DEFAULT_METHOD, fast=True):
@@ -26,8 +27,6 @@ def make_dataset(takes, max_lag_s=DEFAULT_MAX_LAG_S, delay_method=DEFAULT_METHOD
 
 def simulate_takes(rate, fmax_values, duration, seed, reference="lvt"):
     """Short recordings simulated at ``rate``, one per F_max, as takes."""
-    from studyapp.model import simulate
-
     takes = []
     for i, fmax in enumerate(fmax_values):
         recording = simulate(fmax, rate=rate, duration=duration, seed=seed + i)

@@ -3,7 +3,7 @@
 import csv
 import math
 
-from studyapp.atomic import atomic_open
+from studyapp.io.atomic import atomic_open
 
 
 def _cell(v):

@@ -41,10 +41,13 @@ import numpy as np
 
 from studyapp.errors import ParameterError, UserError
 from studyapp.estimators import conventions
+from studyapp.estimators.benchmark import cost as streaming_cost
+from studyapp.estimators.registry import spec
+from studyapp.evaluation.executors import InlineExecutor
+from studyapp.evaluation.metric import DEFAULT_METHOD
 from studyapp.evaluation.pareto import pareto_front
 from studyapp.evaluation.report import evaluate
 from studyapp.evaluation.retune import retune
-from studyapp.evaluation.metric import DEFAULT_METHOD
 from studyapp.evaluation.simulated import SimulatedSet
 
 DEFAULT_RATES = (5000.0, 10000.0, 20000.0, 40000.0)
@@ -64,8 +67,6 @@ def params_at_rate(params, rate, params_rate, windows="seconds"):
     Returns ``(available, not_available)``: name -> validated parameters, and
     name -> why the estimator cannot run at ``rate`` (the validation message).
     """
-    from studyapp.estimators.registry import spec
-
     if windows not in ("seconds", "samples"):
         raise UserError(f"windows = {windows!r}: allowed is 'seconds' or 'samples'")
     available, missing = {}, {}
@@ -108,8 +109,6 @@ def _median(values):
 
 
 def _rows(rate, result, costs, source):
-    from studyapp.estimators.registry import spec
-
     names = result.names
     cost_of = [costs[n]["stream_ns_per_sample"] for n in names]
     errors = [float(np.median(result.errors[n])) for n in names]
@@ -147,13 +146,11 @@ def tradeoff(params, rates=DEFAULT_RATES, fmax_values=DEFAULT_FMAX, duration=2.0
     step; ``tuning_progress(rate)`` gives the optimiser's progress reporter.
     """
     if cost is None:
-        from studyapp.estimators.benchmark import cost
+        cost = streaming_cost
     if duration <= 2 * max_lag_s:
         raise UserError(f"--duration {duration:g}: allowed is more than {2 * max_lag_s:g} s")
     tune = tune_patience is not None
     if tune and executor is None:
-        from studyapp.evaluation.executors import InlineExecutor
-
         executor = InlineExecutor()
     check_available(params, rates, params_rate, windows)
     source_name = source_name or ("tuned" if tune else "table1")

@@ -39,7 +39,7 @@ def apparatus_is_simulated(apparatus):
 
 def enrolled(study_folder):
     """{participant: simulated?} of every participant with a session under ``study_folder``."""
-    from studyapp.experiment.session import read_description, session_folders
+    from studyapp.experiment.session import read_description, session_folders  # session imports this module
 
     folder = Path(study_folder)
     if not folder.is_dir():

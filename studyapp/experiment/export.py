@@ -65,8 +65,9 @@ from studyapp.experiment.log_scan import written_twice
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import TASK_TYPES, task_type
+from studyapp.experiment.trial_health import HEALTH_COLUMNS
+from studyapp.io.atomic import atomic_open
 
-HEALTH_COLUMNS = ["deadline_misses", "underruns", "faults", "events_dropped"]
 SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
            "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS,
@@ -183,17 +184,8 @@ def export_responses(results_dir, problems=None):
     return frame.reset_index(drop=True)
 
 
-def write_responses(results_dir, output, problems=None):
-    """Write ``export_responses(results_dir, problems)`` to the CSV file ``output`` atomically; return the frame."""
-    frame = export_responses(results_dir, problems)
-    save_responses(frame, results_dir, output)
-    return frame
-
-
 def save_responses(frame, results_dir, output):
     """Write the exported ``frame`` to the CSV file ``output`` atomically (refused when it is empty)."""
-    from studyapp.atomic import atomic_open
-
     if frame.empty:
         raise UserError(f"{results_dir}: no responses found (no {SESSION_FILE} with confirmed responses)")
     with atomic_open(output, newline="", encoding="utf-8") as f:

@@ -28,7 +28,7 @@ import re
 import zlib
 from dataclasses import dataclass, field
 
-from studyapp.small_files import read_regular
+from studyapp.io.small_files import read_regular
 
 _CRC = re.compile(rb',"crc":"([0-9a-f]{8})"\}')
 _CRC_END = re.compile(rb',"crc":"([0-9a-f]{8})"\}$')

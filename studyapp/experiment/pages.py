@@ -39,6 +39,7 @@ import textwrap
 from dataclasses import asdict, dataclass, replace
 
 from studyapp.errors import UserError
+from studyapp.experiment.fields import Fields
 
 KINDS = ("welcome", "instructions", "transition", "break", "goodbye", "calibration")
 WHO = ("participant", "experimenter")
@@ -81,8 +82,6 @@ def markdown(text):
 
 def parse_pages(source, document, tasks):
     """The protocol's ``[[pages]]`` as ``Page``s, in file order; ``UserError`` (one line) if one is invalid."""
-    from studyapp.experiment.protocol import _Fields
-
     value = document.get("pages", [])
     if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
         raise UserError(f"{source}: pages = {value!r}: allowed is an array of tables, each [[pages]] "
@@ -91,7 +90,7 @@ def parse_pages(source, document, tasks):
     tasks_allowed = "one of the tasks: " + ", ".join(tasks)
     pages = []
     for i, values in enumerate(value):
-        table = _Fields(source, "pages", values, label=f"[[pages]] #{i + 1}")
+        table = Fields(source, "pages", values, label=f"[[pages]] #{i + 1}")
         kind = table.string("kind", kinds_allowed)
         if kind not in KINDS:
             table.fail("kind", f"= {kind!r}", kinds_allowed)

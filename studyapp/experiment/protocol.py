@@ -35,10 +35,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from studyapp.errors import UserError
-from studyapp.model.device import DeviceLimits
-from studyapp.small_files import parse_toml, read_bytes
+from studyapp.experiment.fields import table_fields
+from studyapp.experiment.pages import parse_pages
+from studyapp.experiment.task_type import Bounds
+from studyapp.experiment.tasks import protocol_task_names as task_names
+from studyapp.experiment.tasks import task_type
+from studyapp.io.small_files import parse_toml, read_bytes
+from studyapp.model.limits import SESSION_GESTURES, SUSTAINED_FORCE
 
-SAFE_CEILING = DeviceLimits().sustained  # N: the motors' sustained limit, the engine's default ceiling
+SAFE_CEILING = SUSTAINED_FORCE  # N: the motors' sustained limit, the engine's default ceiling
 FMAX_FIELDS = ("fmax", "ceiling")  # the task fields that set an F_max level
 
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_-]{1,32}")
@@ -81,7 +86,7 @@ class Protocol:
         that has conventions, with this protocol's parameters
         (``studyapp.estimators.conventions``).
         """
-        from studyapp import estimators
+        from studyapp import estimators  # numba: only when settings are asked for (parse_protocol)
         from studyapp.estimators import conventions
 
         out = {
@@ -105,94 +110,12 @@ class Protocol:
         return out
 
 
-class _Fields:
-    """Reads one TOML table, turning each problem into one line naming file and field."""
-
-    def __init__(self, source, table, values, label=None):
-        self.source = source
-        self.table = table
-        self.label = label or f"[{table}]"  # how messages name it, e.g. "[[pages]] #2"
-        self.values = values
-        self.used = set()
-
-    def fail(self, key, problem, allowed):
-        where = f"{self.label} {key}" if key else self.label
-        raise UserError(f"{self.source}: {where} {problem}: allowed is {allowed}")
-
-    def get(self, key, allowed, default=...):
-        self.used.add(key)
-        if key not in self.values:
-            if default is ...:
-                self.fail(key, "is missing", allowed)
-            return default
-        return self.values[key]
-
-    def string(self, key, allowed="a non-empty string", default=..., pattern=None):
-        value = self.get(key, allowed, default)
-        if not isinstance(value, str) or not value.strip() or (pattern and not pattern.fullmatch(value)):
-            self.fail(key, f"= {value!r}", allowed)
-        return value
-
-    def integer(self, key, low, high, default=...):
-        allowed = f"an integer from {low} to {high}"
-        value = self.get(key, allowed, default)
-        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-            self.fail(key, f"= {value!r}", allowed)
-        return value
-
-    def number(self, key, low, high, unit="", default=..., low_open=False):
-        """A finite number in [low, high] (``low_open``: above ``low``); NaN and infinities fail the test."""
-        lower = f"above {low:g} and up" if low_open else f"from {low:g}"
-        allowed = f"a number {lower} to {high:g} {unit}".strip()
-        value = self.get(key, allowed, default)
-        bad = isinstance(value, bool) or not isinstance(value, (int, float))
-        if not bad:
-            value = float(value)
-            bad = not ((low < value if low_open else low <= value) and value <= high)
-        if bad:
-            self.fail(key, f"= {value!r}", allowed)
-        return value
-
-    def conditions(self, key, known, at_least, at_most):
-        allowed = (f"a list of {at_least} to {at_most} different estimator names from: {', '.join(known)}")
-        value = self.get(key, allowed)
-        if (not isinstance(value, list) or not at_least <= len(value) <= at_most
-                or not all(isinstance(name, str) for name in value)):
-            self.fail(key, f"= {value!r}", allowed)
-        for name in value:
-            if name not in known:
-                self.fail(key, f"has unknown condition {name!r}", allowed)
-        if len(set(value)) != len(value):
-            self.fail(key, "names a condition twice", allowed)
-        return tuple(value)
-
-    def finish(self):
-        unknown = sorted(set(self.values) - self.used)
-        if unknown:
-            self.fail(unknown[0], "is not a known field", "one of " + ", ".join(sorted(self.used)))
-
-
-def _table(source, document, name, required=True):
-    if name not in document:
-        if required:
-            raise UserError(f"{source}: table [{name}] is missing: allowed is a [{name}] table (see docs/experiment.md)")
-        return None
-    value = document[name]
-    if not isinstance(value, dict):
-        raise UserError(f"{source}: [{name}] = {value!r}: allowed is a table")
-    return _Fields(source, name, value)
-
-
 def parse_protocol(text, source="<protocol>"):
     """Validate protocol ``text`` (TOML); ``source`` names the file in error messages."""
+    # the estimators compile with numba: imported when a protocol is parsed, not when this module is
     from studyapp import estimators
     from studyapp.estimators.registry import spec as estimator_spec
     from studyapp.estimators.spec import RATE_MAX, RATE_MIN
-    from studyapp.experiment.pages import parse_pages
-    from studyapp.experiment.task_type import Bounds
-    from studyapp.experiment.tasks import protocol_task_names as task_names
-    from studyapp.experiment.tasks import task_type
-    from studyapp.model.loop import GESTURES
 
     document = parse_toml(text, source)
     known_tables = ("study", "apparatus", "estimators", "pages", *task_names())
@@ -200,7 +123,7 @@ def parse_protocol(text, source="<protocol>"):
         if name not in known_tables:
             raise UserError(f"{source}: [{name}] is not a known table: allowed are {', '.join(known_tables)}")
 
-    study = _table(source, document, "study")
+    study = table_fields(source, document, "study")
     name = study.string("name", NAME_ALLOWED, pattern=NAME_PATTERN)
     title = study.string("title", default=name)
     participant_title = study.string("participant_title", default=PARTICIPANT_TITLE)
@@ -212,14 +135,13 @@ def parse_protocol(text, source="<protocol>"):
     seed = study.integer("seed", 0, 2**32 - 1)
     study.finish()
 
-    apparatus = _table(source, document, "apparatus")
+    apparatus = table_fields(source, document, "apparatus")
     rate = apparatus.number("rate", RATE_MIN, RATE_MAX, "Hz")
     knobs = apparatus.integer("knobs", 1, 64, default=8)
     pads = apparatus.integer("pads", 1, 64, default=8)
-    gestures = [g for g in GESTURES if g != "playback"]  # playback needs a recorded trajectory
-    gesture = apparatus.string("gesture", "one of " + ", ".join(gestures), default="strokes")
-    if gesture not in gestures:
-        apparatus.fail("gesture", f"= {gesture!r}", "one of " + ", ".join(gestures))
+    gesture = apparatus.string("gesture", "one of " + ", ".join(SESSION_GESTURES), default="strokes")
+    if gesture not in SESSION_GESTURES:
+        apparatus.fail("gesture", f"= {gesture!r}", "one of " + ", ".join(SESSION_GESTURES))
     ceiling = None
     if "fmax_ceiling" in apparatus.values:
         ceiling = apparatus.number("fmax_ceiling", 0.0, SAFE_CEILING, "N (the motors' sustained limit)",
@@ -229,7 +151,7 @@ def parse_protocol(text, source="<protocol>"):
 
     known = estimators.names()
     overrides = {}
-    table = _table(source, document, "estimators", required=False)
+    table = table_fields(source, document, "estimators", required=False)
     for est, params in (table.values.items() if table else ()):
         if est not in known:
             table.fail(est, "is not an estimator", "one of " + ", ".join(known))
@@ -244,7 +166,7 @@ def parse_protocol(text, source="<protocol>"):
     specs = {}
     bounds = Bounds(estimators=tuple(known), knobs=knobs, pads=pads)
     for task in tasks:
-        table = _table(source, document, task)
+        table = table_fields(source, document, task)
         specs[task] = task_type(task).parse(table, bounds)
         table.finish()
     for task in task_names():

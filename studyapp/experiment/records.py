@@ -16,7 +16,7 @@ through gave an overflow or a memory error further on (issue 21, item 14).
 
 import math
 
-from studyapp.model.loop import FMAX_LIMIT
+from studyapp.model.limits import FMAX_LIMIT
 
 STEP_MAX = 10**6  # a session's steps: a few hundred
 TRIAL_MAX = 10_000  # trials of one task per condition (the protocol allows 100 plus practice)

@@ -113,7 +113,7 @@ def _recorded_durations(study_folder):
     """{task: median duration (s)} of the real, non-practice responses recorded under ``study_folder``."""
     if not Path(study_folder).is_dir():
         return {}
-    from studyapp.experiment.export import export_responses
+    from studyapp.experiment.export import export_responses  # pandas: only when sessions are counted
 
     try:
         frame = export_responses(study_folder, problems=[])  # unreadable sessions: simply not counted

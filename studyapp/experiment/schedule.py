@@ -38,8 +38,6 @@ from studyapp.experiment.level_check import calibrated
 from studyapp.experiment.pages import Page
 from studyapp.experiment.tasks import task_type
 
-PHASES = ("page", "practice", "trial")
-
 
 @dataclass(frozen=True)
 class Trial:

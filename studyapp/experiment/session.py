@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from studyapp import __version__
-from studyapp.atomic import atomic_open
+from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, make_folders
@@ -70,8 +70,8 @@ from studyapp.experiment.session_info import (
 )
 from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
 from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
-from studyapp.free_names import first_free
-from studyapp.small_files import LIMIT_BYTES, open_regular
+from studyapp.io.free_names import first_free
+from studyapp.io.small_files import LIMIT_BYTES, open_regular
 
 CREATED = records.SESSION_CREATED
 SESSION_END = records.SESSION_END

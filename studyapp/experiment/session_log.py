@@ -34,12 +34,12 @@ import zlib
 from datetime import datetime
 from pathlib import Path
 
-from studyapp.atomic import atomic_open
+from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, open_file
 from studyapp.experiment.log_scan import LOG_LIMIT, read_events, read_log, scan  # noqa: F401 - the log's readers, here too
-from studyapp.small_files import read_regular
+from studyapp.io.small_files import read_regular
 
 DAMAGED_SUFFIX = ".damaged"
 TORN_SUFFIX = ".torn-"

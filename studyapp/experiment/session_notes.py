@@ -30,6 +30,7 @@ import pandas as pd
 
 from studyapp.errors import UserError
 from studyapp.experiment import records
+from studyapp.experiment.export import session_folders_under
 from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description, session_folders
 from studyapp.experiment.session_info import check_notes
 from studyapp.experiment.session_lock import ParticipantLock
@@ -74,8 +75,6 @@ def add_note(folder, text):
 
 def list_notes(results):
     """DataFrame ``NOTE_COLUMNS``: every note of every session at or below ``results``, oldest first per session."""
-    from studyapp.experiment.export import session_folders_under
-
     root = Path(results)
     if root.exists() and not root.is_dir():
         raise UserError(f"{root}: is a file: allowed is a results folder (or any folder inside it)")

@@ -28,7 +28,7 @@ The current trial is the state machine its task type makes
 ``make_loop(estimators, source, seed)`` with the conditions the task type asks
 for (the rating trial gets all its conditions, an adjustment trial only its
 own), so every adjustment trial starts from a string at rest with F_max = 0. Headless,
-the default builds ``studyapp.model.ClosedLoop`` in-process; the GUI passes a
+the default builds ``studyapp.model.loop.ClosedLoop`` in-process; the GUI passes a
 factory for the real-time engine.
 
 An event the log cannot write (a full disk) sets F_max to zero before the
@@ -53,7 +53,7 @@ def closed_loop_factory(protocol, audio=False):
     """``make_loop`` building the model's ClosedLoop in-process for ``protocol``."""
 
     def make_loop(estimators, source, seed):
-        from studyapp.model import ClosedLoop, LoopConfig
+        from studyapp.model.loop import ClosedLoop, LoopConfig  # numba: not in the GUI, which passes its own
 
         config = LoopConfig(rate=protocol.rate, estimators=estimators, source=source, fmax=0.0,
                             gesture=protocol.gesture, seed=seed, audio=audio)

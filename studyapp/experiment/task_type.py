@@ -99,7 +99,7 @@ class TaskType(Protocol):
     measure: Measure | None
 
     def parse(self, table, bounds: Bounds):
-        """The task's spec from its protocol ``table`` (``protocol._Fields``); errors via ``table.fail``."""
+        """The task's spec from its protocol ``table`` (``fields.Fields``); errors via ``table.fail``."""
 
     def schedule(self, spec, square: list, participant_index: int) -> tuple:
         """``(trials, rows_used)``: trials as ``(trial number, conditions, condition or None)``."""

@@ -10,7 +10,7 @@ from PySide6.QtWidgets import QComboBox, QGroupBox, QHBoxLayout, QLabel, QPushBu
 from studyapp.gui.bowing_pad import BowingPad
 from studyapp.gui.knobs import KnobPanel
 from studyapp.gui.scope import Scope
-from studyapp.live.hand import GESTURES
+from studyapp.model.limits import CONSOLE_GESTURES
 
 
 class LiveTab(QWidget):
@@ -26,7 +26,7 @@ class LiveTab(QWidget):
         self.bowing_pad.bow_moved.connect(controller.bow_move)
         self.bowing_pad.bow_released.connect(controller.bow_release)
         self.gesture = QComboBox()
-        self.gesture.addItems(GESTURES)
+        self.gesture.addItems(CONSOLE_GESTURES)
         self.gesture.setToolTip("the virtual hand: scripted strokes, holding the handle still, or the mouse (pad)")
         self.gesture.activated.connect(lambda index: controller.set_gesture(self.gesture.itemText(index)))
         self.bow_button = QPushButton("Bow")

@@ -41,7 +41,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from studyapp.atomic import atomic_path
+from studyapp.io.atomic import atomic_path
 from studyapp.gui.flow_layout import FlowLayout
 from studyapp.gui.frame_rate import FrameRateMeter
 from studyapp.model.device import DeviceLimits

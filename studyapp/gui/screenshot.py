@@ -9,7 +9,7 @@ application exits with 0.
 
 from PySide6.QtWidgets import QApplication
 
-from studyapp.atomic import atomic_path
+from studyapp.io.atomic import atomic_path
 from studyapp.gui.preview_bowing import PreviewBowing
 
 

@@ -30,6 +30,8 @@ from PySide6.QtWidgets import (
 )
 
 from studyapp.errors import UserError
+from studyapp.experiment.run_plan import make_plan, plan_markdown
+from studyapp.io.atomic import atomic_open
 from studyapp.live.master_sound import DB_RANGE
 
 
@@ -54,8 +56,6 @@ class RunSheetDialog(QDialog):
         self.resize(760, 600)
 
     def save(self, path):
-        from studyapp.atomic import atomic_open
-
         with atomic_open(path, encoding="utf-8") as f:
             f.write(self.markdown)
 
@@ -119,8 +119,6 @@ class SessionTools(QGroupBox):
 
     def run_sheet(self):
         """The run sheet's Markdown for the set-up panel's fields (``UserError`` when they do not allow one)."""
-        from studyapp.experiment.run_plan import make_plan, plan_markdown
-
         protocol = self.controller.protocol
         if protocol is None:
             raise UserError("no protocol loaded: choose one first")

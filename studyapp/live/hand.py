@@ -11,8 +11,7 @@ controls do not (paused, emergency stop, no engine).
 
 from studyapp.engine import commands as cmd
 from studyapp.errors import UserError
-
-GESTURES = ("strokes", "hold", "live")  # what the console offers: scripted strokes, a held handle, the mouse
+from studyapp.model.limits import CONSOLE_GESTURES
 
 
 class Hand:
@@ -33,8 +32,8 @@ class Hand:
 
     def set_gesture(self, name):
         """How the virtual hand moves the handle: ``strokes``, ``hold`` or ``live``."""
-        if name not in GESTURES:
-            raise UserError(f"gesture {name!r}: allowed are {', '.join(GESTURES)}")
+        if name not in CONSOLE_GESTURES:
+            raise UserError(f"gesture {name!r}: allowed are {', '.join(CONSOLE_GESTURES)}")
         live = self.live
         if not live.accepting:
             return

@@ -25,11 +25,9 @@ which export carries as columns.
 from studyapp.engine import commands as cmd
 from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode
+from studyapp.experiment.trial_health import HEALTH
 
 AUDIO_FILE = "audio.wav"  # what the participant heard, in the session folder (audio-2.wav, ... per engine run)
-# the engine's fault counters a trial_health record logs, and their names there
-HEALTH = {"deadline_misses": "deadline_misses", "audio_underruns": "underruns", "faults": "faults",
-          "events_dropped": "events_dropped"}
 
 
 class TrialMedia:

@@ -14,6 +14,11 @@ import time
 
 import numpy as np
 
+from studyapp.estimators import lvt, names
+from studyapp.estimators.spec import validate_rate
+from studyapp.model.loop import ClosedLoop, LoopConfig
+from studyapp.model.sources import LVT_SENSOR
+
 BLOCK = 1024
 SECONDS = 1.0
 REPEATS = 5
@@ -21,10 +26,6 @@ REPEATS = 5
 
 def measure(rate, block=BLOCK, seconds=SECONDS, repeats=REPEATS):
     """Samples per second (median over repeats) of the full closed loop at ``rate``."""
-    from studyapp.estimators import lvt, names
-    from studyapp.model.loop import ClosedLoop, LoopConfig
-    from studyapp.model.sources import LVT_SENSOR
-
     estimators = {name: {} for name in names() if name != lvt.NAME}
     loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=LVT_SENSOR, fmax=1.0, gesture="strokes"))
     loop.run(block)
@@ -41,8 +42,6 @@ def measure(rate, block=BLOCK, seconds=SECONDS, repeats=REPEATS):
 
 
 def run_cli(args):
-    from studyapp.estimators.spec import validate_rate
-
     rate = validate_rate(args.rate)
     sps = measure(rate)
     result = {"rate": rate, "samples_per_second": sps, "realtime_factor": sps / rate}

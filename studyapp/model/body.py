@@ -21,7 +21,6 @@ HIGHPASS_HZ = 60.0
 # (centre Hz, Q, gain dB)
 MODES = ((275.0, 8.0, 10.0), (460.0, 10.0, 8.0), (550.0, 12.0, 10.0), (600.0, 12.0, 8.0), (2500.0, 1.5, 6.0))
 OUTPUT_GAIN = 0.25
-MAX_SECTIONS = 1 + len(MODES)
 
 
 def peaking(f0, q, gain_db, rate):

@@ -23,6 +23,8 @@ import math
 
 import numpy as np
 
+from studyapp.model import stability
+
 GRID = tuple(float(f) for f in np.geomspace(0.05, 200.0, 25))
 DURATION = 2.5  # s
 SETTLE = 0.25  # s
@@ -49,8 +51,7 @@ def pitch(x, rate, fmin=100.0):
 
 def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
     """(band level, pitch) of TRUE bowing ``gesture`` at ``fmax`` for ``duration`` s, measured after SETTLE."""
-    from studyapp.model import stability
-    from studyapp.model.loop import ClosedLoop, LoopConfig
+    from studyapp.model.loop import ClosedLoop, LoopConfig  # the loop imports this module
 
     loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
                                  seed=seed, audio=False), judge=False)
@@ -63,8 +64,6 @@ def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
 @functools.lru_cache(maxsize=16)
 def table(rate, f0, gesture):
     """(log F_max, log level) arrays of TRUE's band level over GRID, held after TRUE leaves its pitch."""
-    from studyapp.model import stability
-
     levels = []
     for fmax in GRID:
         level, p = true_run(rate, f0, gesture, fmax)

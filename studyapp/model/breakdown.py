@@ -39,15 +39,18 @@ import math
 import numpy as np
 
 from studyapp.errors import ParameterError
+from studyapp.estimators import names
+from studyapp.estimators.spec import validate_rate
 from studyapp.model import bowing_reference, stability
 from studyapp.model.calibration import F0
+from studyapp.model.limits import BREAKDOWN_GESTURES, FMAX_LIMIT
+from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import is_pseudo, with_pseudo_sources
 
 SETTLE = 0.25  # s before the monitor's verdict counts (its window)
 BLOCK = 0.05  # s
 LOW = 0.05  # N, the search's lowest F_max
-HIGH = 200.0  # N, the search's highest F_max (loop.FMAX_LIMIT)
-GESTURES = ("hold", "strokes")
+HIGH = FMAX_LIMIT  # N, the search's highest F_max
 MAX_SEEDS = 100  # a source's search takes about 0.3 s per seed at 5 kHz; --all with 100 seeds about 10 min
 DURATION_RANGE = (0.5, 60.0)  # s per trial; below about 2 s a late onset is missed (the verdict lags ~1 s)
 DURATION = 5.0  # s per trial by default: about ten strokes
@@ -56,8 +59,6 @@ KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min",
 
 def sources():
     """Every velocity source the loop can run: each estimator name, then the pseudo-sources (model/sources.py)."""
-    from studyapp.estimators import names
-
     return with_pseudo_sources(names())
 
 
@@ -75,8 +76,8 @@ def check_seeds(n, label="seeds"):
 
 
 def check_gesture(name, label="gesture"):
-    if name not in GESTURES:
-        raise ParameterError(f"{label} {name!r}: allowed are {', '.join(GESTURES)}")
+    if name not in BREAKDOWN_GESTURES:
+        raise ParameterError(f"{label} {name!r}: allowed are {', '.join(BREAKDOWN_GESTURES)}")
     return name
 
 
@@ -93,8 +94,6 @@ def check_duration(seconds, label="duration"):
 
 def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, seed=0, estimators=None, f0=None):
     """Whether ``source`` at ``fmax`` N breaks down within ``duration`` s of ``gesture`` (the module's criteria)."""
-    from studyapp.model.loop import ClosedLoop, LoopConfig
-
     estimators = dict(estimators or {})
     if not is_pseudo(source) and source not in estimators:
         estimators[source] = {}
@@ -134,8 +133,6 @@ def _bowing_measures(block, rate, f0):
 
 @functools.lru_cache(maxsize=4096)
 def _true_bowing(rate, f0, gesture, fmax, total, seed):
-    from studyapp.model.loop import ClosedLoop, LoopConfig
-
     loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
                                  seed=seed, audio=False), judge=False)
     return _bowing_measures(loop.run(total), loop.rate, loop.string.f0)
@@ -183,8 +180,6 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
     once per seed with verdict "result", ``fmax`` the seed's breakdown F_max
     and ``trial`` the number of trials it took.
     """
-    from studyapp.estimators.spec import validate_rate
-
     check_source(source)
     rate = validate_rate(rate)
     seeds = check_seeds(seeds)

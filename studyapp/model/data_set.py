@@ -10,11 +10,11 @@ atomically; ``index.json`` last, so a directory with an index is complete.
 import json
 from pathlib import Path
 
-from studyapp.atomic import atomic_open
+from studyapp.io.atomic import atomic_open
 from studyapp.estimators.spec import validate_rate
 from studyapp.model.simulate import simulate
 from studyapp.model.sources import LVT_SENSOR
-from studyapp.recording import save
+from studyapp.io.recording import save
 
 PAPER_FMAX = [0, 0.3, 0.5, 0.8, 1.1, 1.4, 1.6, 1.9, 2.2, 3.3, 4.4, 5.5, 7.7, 9.9, 12.1]
 TRAINING = {"seed": 1, "gesture": "strokes"}

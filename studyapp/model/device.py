@@ -37,12 +37,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from studyapp.model.limits import IMPULSIVE_FORCE, SUSTAINED_FORCE, TRAVEL
+
 
 @dataclass(frozen=True)
 class DeviceLimits:
-    travel: float = 0.011  # m, end stops at +-travel
-    impulsive: float = 200.0  # N
-    sustained: float = 60.0  # N RMS
+    travel: float = TRAVEL  # m, end stops at +-travel
+    impulsive: float = IMPULSIVE_FORCE  # N
+    sustained: float = SUSTAINED_FORCE  # N RMS
     sustained_window: float = 1.0  # s, time constant of the RMS
 
     def params(self, rate):

@@ -58,14 +58,12 @@ from studyapp.model.control import (
 )
 from studyapp.model.device import N_LIMIT_STATE, HapticDevice
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
+from studyapp.model.limits import FMAX_LIMIT, GESTURES
 from studyapp.model.simulated_device import SimulatedDevice
 from studyapp.model.sources import LVT_SENSOR, LVT_SENSOR_INDEX, TRUE, TRUE_INDEX, with_pseudo_sources
 from studyapp.model.stability import StabilityMonitor
 
-FMAX_LIMIT = 200.0  # N: nothing above the motors' impulsive limit makes sense
 F0_RANGE = (20.0, 2000.0)
-
-GESTURES = ("strokes", "strokes-validation", "hold", "live", "playback")
 
 
 @dataclass

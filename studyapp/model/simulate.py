@@ -1,7 +1,7 @@
 """One simulated recording, as the paper recorded its data set (Sec. 6.1).
 
 ``simulate(fmax, ...)`` runs the closed loop (loop.py) with the requested
-velocity source in the loop and returns a ``studyapp.recording.Recording``
+velocity source in the loop and returns a ``studyapp.io.recording.Recording``
 with the columns of the paper's recordings (LVDT position, LVT velocity,
 acceleration) plus the simulation's ground truth (true velocity and
 acceleration), the force command, the string velocity at the bow and the audio.
@@ -11,11 +11,12 @@ run on the recording.
 
 import numpy as np
 
+from studyapp import __version__
 from studyapp.errors import ParameterError
+from studyapp.io.recording import COLUMNS, Recording
 from studyapp.model import calibration
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import LVT_SENSOR, is_pseudo
-from studyapp.recording import COLUMNS, Recording
 
 BLOCK = 4096
 DURATION_MAX = 3600.0
@@ -60,7 +61,6 @@ def simulate(fmax, rate=5000.0, duration=7.0, source=LVT_SENSOR, gesture="stroke
         if progress is not None:
             progress(done, total)
     columns = {name: np.concatenate(parts[name]) if parts[name] else np.zeros(0) for name in COLUMNS}
-    from studyapp import __version__
 
     meta = {
         "version": __version__,

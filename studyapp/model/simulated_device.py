@@ -53,6 +53,7 @@ puts the handle at rest at 0, keeping every output finite, and sets ``fault``.
 
 import numpy as np
 from numba import njit
+from scipy.linalg import expm
 
 from studyapp.estimators.dispatch import step_guarded
 from studyapp.model import calibration, contact_mic, control, hand, sensors, stability
@@ -72,8 +73,6 @@ N_STATE = 7
 
 def discretise(m_e, m_h, k_g, b_g, t):
     """(Phi, Gamma) of the end-effector and hand on the grip over a step of ``t`` s (zero-order hold)."""
-    from scipy.linalg import expm
-
     a = np.array([[0.0, 1.0, 0.0, 0.0],
                   [-k_g / m_e, -b_g / m_e, k_g / m_e, b_g / m_e],
                   [0.0, 0.0, 0.0, 1.0],

@@ -25,6 +25,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from studyapp.model.sources import is_pseudo
+
 WINDOW_S = 0.1  # short-term RMS window
 SETTLE_S = 1.0  # the start of bowing left out (the string building up)
 SECONDS = 6.0  # bowed per condition (several strokes)
@@ -43,8 +45,7 @@ def short_term_rms_dbfs(audio, rate, window_s=WINDOW_S):
 
 @lru_cache(maxsize=16)
 def _typical(rate, gesture, fmax, conditions, seed, seconds):
-    from studyapp.model.loop import ClosedLoop, LoopConfig
-    from studyapp.model.sources import is_pseudo
+    from studyapp.model.loop import ClosedLoop, LoopConfig  # numba: the schedule (level_check) imports this module
 
     levels = []
     for name, params in conditions:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from studyapp.analysis.holm import holm_adjust
+from studyapp.stats.holm import holm_adjust
 from studyapp.analysis.rank_sum import WILCOXON_COLUMNS, pairwise_rank_sum
 
 

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studyapp.analysis.compact_letters import compact_letters
+from studyapp.stats.compact_letters import compact_letters
 from studyapp.analysis.summary import SUMMARY_COLUMNS, summarise
 
 

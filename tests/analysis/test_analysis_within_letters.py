@@ -16,9 +16,9 @@ import pytest
 from scipy import stats
 
 from studyapp.analysis.figures import render
-from studyapp.analysis.friedman import Friedman
+from studyapp.stats.friedman import Friedman
 from studyapp.analysis.responses import check_responses
-from studyapp.analysis.signed_rank import minimum_p, participants_needed
+from studyapp.stats.signed_rank import minimum_p, participants_needed
 from studyapp.analysis.study import analyse
 from studyapp.cli import main
 from tests.analysis.conftest import SYNTHETIC_FMAX, synthetic_responses

@@ -5,7 +5,7 @@ import pytest
 
 from studyapp.engine.safety import Safety, SafetyLimits
 from studyapp.errors import ParameterError
-from studyapp.model import ClosedLoop, LoopConfig
+from studyapp.model.loop import ClosedLoop, LoopConfig
 from tests.engine.nan_device import NanDevice
 
 RATE = 5000.0

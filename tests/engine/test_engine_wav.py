@@ -10,7 +10,7 @@ from scipy.io import wavfile
 from studyapp.engine.audio.recorder import AudioRecorder
 from studyapp.engine.audio.sinks import WavSink
 from studyapp.engine.audio.wav import open_wav, pcm16
-from studyapp.free_names import claim, first_free, numbered_names
+from studyapp.io.free_names import claim, first_free, numbered_names
 
 
 def test_pcm16_is_round_32767_x_clipped_to_full_scale():

@@ -10,8 +10,28 @@ from filterpy.kalman import KalmanFilter
 from studyapp.errors import ParameterError
 from studyapp.estimators import create
 from studyapp.estimators.dispatch import GUARD
-from studyapp.estimators.kalman import P0_ACCELERATION, P0_VELOCITY, unscaled_posterior
+from studyapp.estimators.kalman import KALPOS_STATE, P0_ACCELERATION, P0_VELOCITY
 from studyapp.estimators.spec import Q_CONVENTIONS
+
+
+def unscaled_posterior(state, rate):
+    """(mean, covariance) of the posterior in SI units from a KALPOS or KALMAN state slice.
+
+    ``state`` is the kernel's own state (after the input guard); ``len(state)``
+    tells the order. P = S^-1 U D U^T S^-1 (estimators/kalman.py's factorised form).
+    """
+    t = 1.0 / rate
+    if len(state) == KALPOS_STATE:
+        y = np.array(state[1:3])
+        u = np.array([[1.0, state[3]], [0.0, 1.0]])
+        d = np.array(state[4:6])
+    else:
+        y = np.array(state[1:4])
+        u = np.array([[1.0, state[4], state[5]], [0.0, 1.0, state[6]], [0.0, 0.0, 1.0]])
+        d = np.array(state[7:10])
+    s_inv = np.array([1.0, 1.0 / t, 1.0 / (t * t)])[: len(y)]
+    us = u * s_inv[:, None]
+    return y * s_inv, (us * d) @ us.T
 
 
 def signals(rate, duration, seed=0):

@@ -14,8 +14,8 @@ def stick_slip(rate=5000.0, duration=1.0, f0=110.0, ripple=0.02, seed=0):
 
 
 def synthetic_recording(fmax, rate=5000.0, duration=1.0, seed=0):
-    """A ``studyapp.recording.Recording`` of the synthetic signal; the ripple grows with F_max."""
-    from studyapp.recording import Recording
+    """A ``studyapp.io.recording.Recording`` of the synthetic signal; the ripple grows with F_max."""
+    from studyapp.io.recording import Recording
 
     sig = stick_slip(rate, duration, ripple=0.01 + 0.004 * fmax, seed=seed)
     return Recording(rate, sig, {"fmax": float(fmax), "rate": rate, "source": "synthetic", "seed": seed})
@@ -29,7 +29,7 @@ def synthetic():
 @pytest.fixture(scope="session")
 def short_recording(tmp_path_factory):
     """A 0.3 s synthetic recording at F_max = 1 N, saved as .npz (for command-line tests)."""
-    from studyapp.recording import save
+    from studyapp.io.recording import save
 
     path = tmp_path_factory.mktemp("short_recording") / "fmax_1.npz"
     save(synthetic_recording(1.0, duration=0.3), path)

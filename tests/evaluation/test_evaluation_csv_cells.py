@@ -28,7 +28,7 @@ def test_numpy_scalars_are_written_as_plain_numbers(tmp_path):
 
 
 def test_evaluation_and_validation_tables_hold_plain_numbers(tmp_path, capsys):
-    from studyapp.recording import save
+    from studyapp.io.recording import save
 
     for folder, seed in (("train", 0), ("validation", 1)):
         (tmp_path / folder).mkdir()

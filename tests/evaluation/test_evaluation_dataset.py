@@ -24,7 +24,7 @@ def test_reference_column_is_selectable():
 
 
 def test_directories_expand_in_fmax_order_and_files_are_hashed(tmp_path):
-    from studyapp.recording import save
+    from studyapp.io.recording import save
 
     for fmax in (12.1, 0.5, 2.2):
         save(synthetic_recording(fmax, duration=0.1), tmp_path / f"fmax_{fmax}.npz")

@@ -19,7 +19,7 @@ FMAX = [1.1, 4.4]
 
 @pytest.fixture(scope="module")
 def recordings(tmp_path_factory):
-    from studyapp.recording import save
+    from studyapp.io.recording import save
 
     root = tmp_path_factory.mktemp("delay_option")
     for seed, folder in enumerate(["train", "validation"]):
@@ -37,7 +37,7 @@ def test_the_option_offers_the_metric_methods():
 @pytest.mark.parametrize("delay", ["normalised", "paper"])
 def test_evaluate_measures_with_the_chosen_method_and_records_it(recordings, tmp_path, capsys, delay):
     from studyapp.estimators import create
-    from studyapp.recording import load
+    from studyapp.io.recording import load
 
     out = tmp_path / "ev"
     argv = ["evaluate", str(recordings / "train"), "--estimators", "LOWPASS,KALMAN", "-o", str(out),

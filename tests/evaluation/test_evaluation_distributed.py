@@ -14,7 +14,7 @@ ESTIMATORS = ["LOWPASS", "LEASTSQ"]
 
 
 def test_optimise_on_a_local_cluster_gives_the_local_workers_parameters(tmp_path):
-    from studyapp.recording import save
+    from studyapp.io.recording import save
 
     for i, fmax in enumerate((1.0, 7.7)):
         save(synthetic_recording(fmax, duration=0.3, seed=i), tmp_path / f"fmax_{fmax}.npz")

@@ -94,7 +94,7 @@ def test_evaluate_writes_every_output(recordings, optimised, tmp_path, capsys):
     # The numbers are the metric's own on the recording (independent re-computation).
     from studyapp.estimators import create
     from studyapp.evaluation import delay_and_error
-    from studyapp.recording import load
+    from studyapp.io.recording import load
 
     params = tomllib.loads(optimised.read_text())["KALMAN"]
     rec = load(recordings / "train" / "fmax_2.2.npz")

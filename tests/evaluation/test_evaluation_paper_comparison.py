@@ -41,7 +41,7 @@ def test_fraction_at_maximum_on_straight_lines():
 
 @pytest.fixture(scope="module")
 def recordings(tmp_path_factory):
-    from studyapp.recording import save
+    from studyapp.io.recording import save
 
     root = tmp_path_factory.mktemp("paper_comparison")
     for folder, seed in (("train", 0), ("valid", 50)):
@@ -62,7 +62,7 @@ def test_evaluate_compare_paper_writes_both_tables(recordings, tmp_path, capsys)
     from studyapp.estimators import create
     from studyapp.estimators.dispatch import GUARD
     from studyapp.estimators.foaw import CHOSEN
-    from studyapp.recording import load
+    from studyapp.io.recording import load
 
     out = tmp_path / "eval"
     assert main(["evaluate", str(recordings / "train"), "--params", str(recordings / "PARAMS.toml"), "-o", str(out),

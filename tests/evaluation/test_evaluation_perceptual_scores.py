@@ -6,7 +6,7 @@ import pytest
 from studyapp.errors import ParameterError
 from studyapp.evaluation import perceptual_scores as ps
 from studyapp.evaluation.perceptual import audio_distance
-from studyapp.model import simulate
+from studyapp.model.simulate import simulate
 from tests.figure_checks import text_overlaps, texts_outside
 
 SHORT = ps.Cases(rate=5000.0, fmax=(1.0, 4.4), seeds=(3,), duration=0.5)

@@ -169,7 +169,7 @@ def test_delay_is_reported_in_samples_and_microseconds_and_matches_the_metric(ex
     """The 1 kHz LOWPASS row, recomputed independently: simulate, run the estimator, measure."""
     from studyapp.estimators import create
     from studyapp.evaluation import delay_and_error
-    from studyapp.model import simulate
+    from studyapp.model.simulate import simulate
 
     _, out = extremes
     rows = {(r["rate"], r["estimator"]): r for r in _rows(out)}

@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from studyapp.errors import UserError
-from studyapp.experiment.export import COLUMNS, export_responses, write_responses
+from studyapp.experiment.export import COLUMNS, export_responses, save_responses
 from studyapp.model.fmax_knob import fmax_from_knob
 from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
@@ -176,7 +176,7 @@ def test_export_columns_and_content(tmp_path, protocol):
     assert (frame.protocol_hash == hashlib.sha256(Path(protocol.path).read_bytes()).hexdigest()).all()
     assert pd.to_datetime(frame.time, format="ISO8601").notna().all()
     out = tmp_path / "responses.csv"
-    write_responses(tmp_path, out)
+    save_responses(export_responses(tmp_path), tmp_path, out)
     back = pd.read_csv(out)
     assert list(back.columns) == COLUMNS and len(back) == len(frame)
     assert back.loc[back.task == "adjustment", "rating"].isna().all()
@@ -190,7 +190,7 @@ def test_export_of_nothing(tmp_path):
         export_responses(tmp_path / "absent")
     assert export_responses(tmp_path).empty
     with pytest.raises(UserError, match="no responses found"):
-        write_responses(tmp_path, tmp_path / "r.csv")
+        save_responses(export_responses(tmp_path), tmp_path, tmp_path / "r.csv")
     assert not (tmp_path / "r.csv").exists()
 
 
@@ -213,6 +213,6 @@ def test_export_carries_each_trials_engine_health_and_leaves_it_empty_headless(t
     assert logged.loc[3].to_numpy().tolist() == [[6, 3, 0, 12]]
     assert logged.drop(index=[0, 3], level="step").isna().all().all()
     assert frame.loc[frame.participant == "H02", columns].isna().all().all()
-    write_responses(tmp_path, tmp_path / "r.csv")
+    save_responses(export_responses(tmp_path), tmp_path, tmp_path / "r.csv")
     back = pd.read_csv(tmp_path / "r.csv")
     assert back.loc[(back.participant == "H01") & (back.step == 3), "events_dropped"].tolist() == [12]

@@ -100,7 +100,7 @@ def visible_texts(window):
 def render(size, state):
     from PySide6.QtWidgets import QApplication
 
-    from studyapp.gui.layout_check import layout_problems
+    from tests.gui.layout_check import layout_problems
     from studyapp.gui.participant_window import ParticipantWindow
 
     app = QApplication.instance()

@@ -5,7 +5,7 @@ controls an experimenter needs are in view. Offscreen Qt; the real-X screenshot 
 import pytest
 from PySide6.QtCore import QPoint, QRect
 
-from studyapp.gui.layout_check import layout_problems
+from tests.gui.layout_check import layout_problems
 from tests.gui.conftest import DEMO, ENGINE_START, ROOT, wait_until
 
 pytest.importorskip("pytestqt")

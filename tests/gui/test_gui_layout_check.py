@@ -16,7 +16,7 @@ def _window(qapp):
 def test_a_window_that_shows_everything_has_no_problems(qapp):
     from PySide6.QtWidgets import QLabel, QPushButton
 
-    from studyapp.gui.layout_check import layout_problems
+    from tests.gui.layout_check import layout_problems
 
     window = _window(qapp)
     QLabel("short", window).setGeometry(0, 0, 150, 30)
@@ -29,7 +29,7 @@ def test_a_window_that_shows_everything_has_no_problems(qapp):
 def test_a_widget_past_the_edge_and_a_clipped_label_are_named(qapp):
     from PySide6.QtWidgets import QLabel, QPushButton
 
-    from studyapp.gui.layout_check import layout_problems
+    from tests.gui.layout_check import layout_problems
 
     window = _window(qapp)
     QLabel("a label far too long for the hundred and fifty pixels it has", window).setGeometry(0, 0, 150, 30)
@@ -45,7 +45,7 @@ def test_a_widget_past_the_edge_and_a_clipped_label_are_named(qapp):
 def test_a_wrapped_label_is_checked_by_the_height_it_needs(qapp):
     from PySide6.QtWidgets import QLabel
 
-    from studyapp.gui.layout_check import layout_problems
+    from tests.gui.layout_check import layout_problems
 
     window = _window(qapp)
     label = QLabel("word " * 60, window)

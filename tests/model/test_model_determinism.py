@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from studyapp.model import simulate
+from studyapp.model.simulate import simulate
 from studyapp.model.loop import OUTPUTS, ClosedLoop, LoopConfig
-from studyapp.recording import COLUMNS
+from studyapp.io.recording import COLUMNS
 
 CONFIG = dict(estimators={"LOWPASS": {}, "LEVANT": {}, "KALMAN": {}}, source="LOWPASS", fmax=2.0)
 

@@ -8,8 +8,9 @@ import pytest
 
 from studyapp.cli import main
 from studyapp.errors import InputDataError, UserError
-from studyapp.model import PAPER_FMAX, simulate
-from studyapp.recording import COLUMNS, Recording, load, save
+from studyapp.model.data_set import PAPER_FMAX
+from studyapp.model.simulate import simulate
+from studyapp.io.recording import COLUMNS, Recording, load, save
 
 
 @pytest.fixture(scope="module")

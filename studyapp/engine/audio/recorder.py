@@ -49,7 +49,7 @@ import threading
 import numpy as np
 
 from studyapp.engine.audio.wav import open_wav, pcm16
-from studyapp.free_names import claim, create
+from studyapp.io.free_names import claim, create
 
 QUEUE_SECONDS = 10.0  # of audio the writer may fall behind before blocks are dropped
 CUES_FILE = "audio_cues.csv"

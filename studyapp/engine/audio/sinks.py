@@ -38,13 +38,13 @@ import threading
 
 import numpy as np
 
-from studyapp.atomic import default_mode
+from studyapp.io.atomic import default_mode
 from studyapp.engine.audio.fifo import Fifo
 from studyapp.engine.audio.wav import open_wav, pcm16
 from studyapp.engine.native_stderr import captured_native_stderr
 from studyapp.engine.signal_chain import Gain, SignalChain
 from studyapp.errors import ParameterError
-from studyapp.free_names import claim, first_free
+from studyapp.io.free_names import claim, first_free
 
 DEVICE_RATE = 48_000.0
 WAV_RATE = 48_000.0

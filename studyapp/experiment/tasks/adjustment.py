@@ -48,7 +48,7 @@ from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
 from studyapp.model.controls import KNOB_MAX, FmaxKnob
-from studyapp.model.loop import FMAX_LIMIT
+from studyapp.model.limits import FMAX_LIMIT
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from studyapp.experiment.records import text
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.tasks.confirm_pad import check_knob_value
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
-from studyapp.model.loop import FMAX_LIMIT
+from studyapp.model.limits import FMAX_LIMIT
 
 DURATION_RANGE = (0.1, 600.0)  # s
 

@@ -1,4 +1,4 @@
-"""A recording (``.npz`` or ``.h5``, see ``studyapp.recording``) read a block of samples at a time.
+"""A recording (``.npz`` or ``.h5``, see ``studyapp.io.recording``) read a block of samples at a time.
 
 ``RecordingBlocks(path)`` reads the metadata and the columns' names and
 lengths; ``blocks(size)`` yields ``{name: float64 array}`` for runs of
@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from studyapp.errors import InputDataError
-from studyapp.recording import parse_meta
+from studyapp.io.recording import parse_meta
 
 SUFFIXES = (".npz", ".h5", ".hdf5")
 

@@ -1,4 +1,4 @@
-"""The one rank-sum test (evaluation/rank_sum.py): hand-computed examples, scipy on the same data, exact p."""
+"""The one rank-sum test (stats/rank_sum.py): hand-computed examples, scipy on the same data, exact p by counting."""
 
 import math
 
@@ -7,19 +7,37 @@ import pytest
 from scipy import stats
 
 from studyapp.errors import InputDataError
-from studyapp.evaluation.rank_sum import EXACT_MAX_SMALLER, rank_sum_test, u_distribution
-from studyapp.evaluation.ranks import average_ranks, tie_sizes
+from studyapp.stats.rank_sum import EXACT_MAX_SMALLER, rank_sum_test
+
+
+def u_distribution(n1, n2):
+    """Counts of U = 0 .. n1 n2 over the C(n1 + n2, n1) placements of n1 values among n2 (no ties).
+
+    Going through the pooled order, placing the next value in a when k values of a
+    and j of b are already placed adds j = (position - k) to U.
+    """
+    counts = np.zeros((n1 + 1, n1 * n2 + 1))
+    counts[0, 0] = 1.0
+    for position in range(n1 + n2):
+        for k in range(min(position, n1 - 1), -1, -1):
+            below = position - k
+            if below > n2:
+                continue
+            counts[k + 1, below:] += counts[k, : counts.shape[1] - below]
+    return counts[n1]
+
+
+def exact_p(a, b):
+    """Two-sided exact p of untied samples by counting orderings: 2 P(U' >= max(U, n1 n2 - U)), at most 1."""
+    n1, n2 = len(a), len(b)
+    u = sum(1 for x in a for y in b if x > y)
+    counts = u_distribution(n1, n2)
+    return min(1.0, 2.0 * float(counts[max(u, n1 * n2 - u):].sum()) / math.comb(n1 + n2, n1))
 
 
 def test_average_ranks_with_ties_by_hand():
-    # Sorted: 1, 2, 2, 2, 3, 4, 5 -> the three 2s share ranks 2, 3, 4, i.e. 3.
-    assert average_ranks([2, 5, 1, 2, 4, 2, 3]).tolist() == [3, 7, 1, 3, 6, 3, 5]
-    assert sorted(tie_sizes([2, 5, 1, 2, 4, 2, 3]).tolist()) == [1, 1, 1, 1, 3]
-
-
-def test_average_ranks_equal_scipy_rankdata():
-    x = np.random.default_rng(3).integers(0, 6, 40)
-    assert np.array_equal(average_ranks(x), stats.rankdata(x, method="average"))
+    # Sorted: 1, 2, 2, 2, 3, 4, 5 -> the three 2s share ranks 2, 3, 4, i.e. 3 (the ranks rank_sum_test sums).
+    assert stats.rankdata([2, 5, 1, 2, 4, 2, 3]).tolist() == [3, 7, 1, 3, 6, 3, 5]
 
 
 def test_rank_sum_with_ties_by_hand():
@@ -78,6 +96,15 @@ def test_u_distribution_counts_every_placement():
         counts = u_distribution(n1, n2)
         assert counts.sum() == math.comb(n1 + n2, n1)
         assert np.array_equal(counts, counts[::-1])  # U and n1 n2 - U are equally likely
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_exact_p_equals_the_count_of_orderings(seed):
+    rng = np.random.default_rng(seed)
+    n1, n2 = rng.integers(1, EXACT_MAX_SMALLER + 1), rng.integers(1, 15)
+    a, b = rng.normal(0.0, 1.0, n1), rng.normal(0.5, 1.0, n2)
+    test = rank_sum_test(a, b)
+    assert test.exact and test.p_value == pytest.approx(exact_p(a, b), rel=1e-9)
 
 
 def test_exact_p_for_separated_samples_by_hand():

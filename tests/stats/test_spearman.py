@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from studyapp.analysis.spearman import spearman
+from studyapp.stats.spearman import spearman
 
 
 def test_rho_without_ties_by_hand():
@@ -45,3 +45,11 @@ def test_undefined_cases_are_nan():
     assert all(math.isnan(v) for v in spearman([1, 1, 1], [1, 2, 3]))
     with pytest.raises(ValueError):
         spearman([1, 2, 3], [1, 2])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_equal_or_reversed_rankings_are_exactly_one(seed):
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=int(rng.integers(3, 12)))
+    assert spearman(x, np.exp(x)) == (1.0, 0.0)
+    assert spearman(x, -x**3) == (-1.0, 0.0)

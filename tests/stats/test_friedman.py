@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from studyapp.analysis.friedman import friedman_test, minimum_p
+from studyapp.stats.friedman import friedman_test, minimum_p
 
 
 def test_without_ties_by_hand():

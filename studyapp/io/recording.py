@@ -13,7 +13,7 @@ Units are SI: t (s), position (m), velocity_lvt, velocity_true, string_velocity 
 acceleration, acceleration_true (m/s^2), force (N, the force commanded on the handle),
 audio (arbitrary units, the body filter's output).
 
-Writes are atomic (``studyapp.atomic``): a failure leaves no partial file. ``load``
+Writes are atomic (``studyapp.io.atomic``): a failure leaves no partial file. ``load``
 raises ``InputDataError`` naming the file and what is wrong with it.
 """
 
@@ -23,15 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
-from studyapp.atomic import atomic_open, atomic_path
+from studyapp import __version__
 from studyapp.errors import InputDataError, UserError
+from studyapp.io.atomic import atomic_open, atomic_path
 
 COLUMNS = (
     "t", "position", "velocity_lvt", "acceleration", "velocity_true",
     "acceleration_true", "force", "string_velocity", "audio",
 )
 SUFFIXES = (".h5", ".npz", ".csv")
-META_KEYS = ("fmax", "rate", "source", "gesture", "f0", "seed", "duration", "version")
 FORMAT_VERSION = 1  # stored as meta["format"]; meta["version"] is the app's version
 
 
@@ -70,8 +70,6 @@ def check_path(path):
 
 
 def _meta_json(recording):
-    from studyapp import __version__
-
     meta = {"format": FORMAT_VERSION, "version": __version__, **recording.meta, "rate": recording.rate}
     return json.dumps(meta, sort_keys=True, default=_plain)
 

@@ -11,7 +11,7 @@ A bad file stops with one ``InputDataError`` that names the file, the line and
 the column. The header, the first row and the file's kind (a regular file: a
 device such as ``/dev/zero`` never ends) are checked on opening; a bad cell
 further down is found when its block is read, so a caller writing as it reads
-writes atomically (``studyapp.atomic``).
+writes atomically (``studyapp.io.atomic``).
 """
 
 import csv
@@ -22,7 +22,7 @@ import numpy as np
 
 from studyapp.errors import InputDataError
 from studyapp.number_text import to_float
-from studyapp.small_files import NotARegularFile, open_regular
+from studyapp.io.small_files import NotARegularFile, open_regular
 
 
 class SampleTable:

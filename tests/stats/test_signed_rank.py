@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from studyapp.analysis.signed_rank import (
+from studyapp.stats.signed_rank import (
     ZERO_METHOD,
     exact_tied_p,
     minimum_p,

@@ -1,0 +1,11 @@
+"""Files in and out: written whole or not at all, read with checks, one line naming what is wrong.
+
+    atomic.atomic_open / atomic_path     write a file whole or not at all (temporary file, fsync, rename)
+    small_files.open_regular             read a small text file a person wrote, refusing devices and FIFOs
+    sample_table                         CSV tables of samples, read a block at a time
+    recording.save / recording.load      signal recordings (.h5, .npz, .csv) with their metadata
+    recording_blocks.RecordingBlocks     a recording (.npz or .h5) read a block at a time
+
+The package name shadows the standard library's ``io`` only as ``studyapp.io``:
+every import in studyapp is absolute, so ``import io`` still means the standard library.
+"""
