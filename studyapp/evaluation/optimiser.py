@@ -12,6 +12,10 @@ One iteration:
 4. an estimator stops searching once ``patience`` new sets in a row brought no
    improvement; the run ends when none is left (the paper's rule, 1000).
 
+With ``restarts`` the searches run in lanes (``search.py``); a lane whose best
+is not the estimator's is judged here, against its own best under the same
+memorised scale as the step's decisions.
+
 Work is sent to the executor in few, large tasks: an iteration's sets go out
 together, one task per worker (``executors.parallelism``). An objective that
 can be split by recordings (``shares(k)``, ``dataset.RawObjectives``) gives
