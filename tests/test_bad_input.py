@@ -181,6 +181,7 @@ CASES = {
     "evaluate-out-unwritable": ["evaluate", "{in}/rec.npz", "-o", UNWRITABLE],
     "evaluate-out-under-file": ["evaluate", "{in}/rec.npz", "-o", "{in}/good.csv/ev"],
     # optimise
+    "optimise-restarts-huge": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--restarts", "1000000"],
     "optimise-workers-beyond-the-machine": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--workers", "100000"],
     "tradeoff-workers-beyond-the-machine": [*TRADEOFF, "-o", "{out}/t", "--tune", "--workers", "100000"],
     "optimise-seed-negative": [*OPTIMISE, "{in}/rec.npz", "-o", "{out}/p.toml", "--seed", "-1"],

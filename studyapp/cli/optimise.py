@@ -14,6 +14,10 @@ recordings are read; the default patience is then ``PERCEPTUAL_PATIENCE``.
 from studyapp.cli import delay_option, number_options, output_paths, perceptual_options
 
 PAPER_PATIENCE = 1000  # the paper's stopping rule
+# Lanes of each search that start from drawn points, within the same patience (evaluation/search.py):
+# with 2, seeds 0-2 gave F_g within 2 % of each other for 10 of the 13 estimators (docs/evaluation.md).
+RESTARTS = 2
+RESTARTS_MAX = 50  # lanes share the patience: more only split it thinner
 # Each set costs a closed-loop simulation per case (eight by default): at a tenth of the paper's rule a run
 # of the thirteen took 2549 sets, 170 s of CPU (docs/evaluation.md).
 PERCEPTUAL_PATIENCE = 100
@@ -36,6 +40,9 @@ def register(sub):
                    help=f"stop an estimator after this many new sets without improvement "
                         f"(default {PAPER_PATIENCE}; {PERCEPTUAL_PATIENCE} with --objective perceptual)")
     p.add_argument("--seed", type=number_options.seed, default=0, help="random seed (default 0)")
+    p.add_argument("--restarts", type=int, default=RESTARTS, metavar="N",
+                   help=f"restarts of each estimator's search from drawn points, sharing the patience "
+                        f"(default {RESTARTS}; 0: one search from Table 1, as before restarts)")
     p.add_argument("--reference", choices=("lvt", "true"), default="lvt",
                    help="reference velocity: the LVT tachometer (paper) or the true velocity (default lvt)")
     p.add_argument("--tune", choices=("paper", "all"), default="paper",
@@ -86,6 +93,8 @@ def run(args):
         raise UserError(f"--patience {args.patience}: allowed is an integer of at least 1")
     if args.max_sets is not None and args.max_sets < 1:
         raise UserError(f"--max-sets {args.max_sets}: allowed is an integer of at least 1")
+    if not 0 <= args.restarts <= RESTARTS_MAX:
+        raise UserError(f"--restarts {args.restarts}: allowed is an integer from 0 to {RESTARTS_MAX}")
     check_workers(args.workers)
     names = estimator_names(args.estimators, PAPER_ESTIMATORS)
     cases = perceptual_options.cases(args, 5000.0 if args.rate is None else args.rate, perceptual,
@@ -123,7 +132,7 @@ def run(args):
         }
         initializer, initargs = warm_up, (tuple(names), rate, True)
     optimiser = Optimiser(
-        spaces, objective, None, patience=args.patience, seed=args.seed,
+        spaces, objective, None, patience=args.patience, seed=args.seed, restarts=args.restarts,
         max_sets=args.max_sets, checkpoint=checkpoint, fingerprint=fingerprint,
         progress=None if args.quiet else Progress(sys.stderr),
     )
@@ -149,6 +158,7 @@ def run(args):
         objective_values = result.objectives
     info = provenance(
         command="studyapp optimise", objective=args.objective, seed=args.seed, patience=args.patience,
+        restarts=args.restarts,
         tune=args.tune, rate=rate, **settings, iterations=result.iterations,
         parameter_sets_evaluated=result.evaluated, seconds=round(result.seconds, 3), resumed=result.resumed,
     )

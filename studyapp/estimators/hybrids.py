@@ -173,6 +173,41 @@ def step_kalfoawacc(s, p, x, a, v):
     return kalman_step(s, p, x, z)
 
 
+# The front ends: the acceleration z each hybrid hands K at a sample, on the hybrid's own state and
+# parameters, with K's started flag set as K's first step sets it (the high-pass primes on it). K's
+# other slots are untouched, so a run of a front end followed by KALMAN's step on (x, z) with the
+# hybrid's first KALMAN_PARAMS parameters is the hybrid, bit for bit (the optimiser's use: the
+# front end's parameters are fixed while q and r_acc are tuned, evaluation/kernels.py).
+@njit(cache=True, inline="always")
+def front_kallev(s, p, x, a, v):
+    z = _levant_twice(s[_AFTER:], p[_P:], x)
+    s[0] = 1.0
+    return z
+
+
+@njit(cache=True, inline="always")
+def front_kallevacc(s, p, x, a, v):
+    h = _highpass(s, p[_P + LEVANT_PARAMS:_P + LEVANT_PARAMS + SECTION], a)
+    z = _levant_twice(s[_AFTER + STATE:], p[_P:], x) + h
+    s[0] = 1.0
+    return z
+
+
+@njit(cache=True, inline="always")
+def front_kalfoaw(s, p, x, a, v):
+    z = _foaw_twice(s, _AFTER, p[_P:], x)
+    s[0] = 1.0
+    return z
+
+
+@njit(cache=True, inline="always")
+def front_kalfoawacc(s, p, x, a, v):
+    h = _highpass(s, p[_P + 4:_P + 4 + SECTION], a)
+    z = _foaw_twice(s, _AFTER + STATE, p[_P:], x) + h
+    s[0] = 1.0
+    return z
+
+
 SPEC_KALLEV = EstimatorSpec(
     name="KALLEV", kind=kinds.KALLEV, description="KALMAN with acceleration from LEVANT twice: K(x, L(L(x))).",
     inputs=("position",),

@@ -28,6 +28,7 @@ class Batch:
         self.references = list(references)
         self.rate = self.takes[0].rate
         self.side_by_side = all(t.finite for t in self.takes)
+        self.fronts = {}  # the hybrids' front-end outputs on these takes (kernels.run_many)
         if self.side_by_side:
             self.x, self.a, self.v = (
                 np.ascontiguousarray(np.stack([getattr(t, column) for t in self.takes], axis=1))
@@ -38,7 +39,7 @@ class Batch:
         from studyapp.estimators import create
 
         if self.side_by_side:
-            return kernels.run_many(create(name, self.rate, **params), self.x, self.a, self.v)
+            return kernels.run_many(create(name, self.rate, **params), self.x, self.a, self.v, self.fronts)
         return [kernels.run(create(name, self.rate, **params), t.position, t.acceleration, t.velocity, t.finite)
                 for t in self.takes]
 

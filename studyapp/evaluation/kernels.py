@@ -29,22 +29,29 @@ same order for a block of outputs at once (the additions of different
 outputs are independent, so the loop over outputs vectorises); measured at
 M = 257: 234 -> 27 ns per sample.
 
-The loops are compiled once per process and kernel (numba cannot cache a
-function compiled for another compiled function as argument), so they pay
-off in long runs: the optimiser's worker processes warm them up at start.
+Compiled once, kept on disk. numba cannot cache a loop compiled for a
+function passed as its argument, but it caches a function that names each
+kernel in its source: ``side_by_side`` switches on the estimator's kind and
+calls the loop with that kernel, as ``estimators.dispatch.run_block`` does,
+so the loops load from numba's cache instead of compiling in every process
+(7.5 s of CPU each run before, 2026-11-25).
+
+Front ends. The hybrids K(x, z) feed KALMAN an acceleration z from a front
+end (LEVANT or FOAW twice, plus the high-passed accelerometer) whose
+parameters the paper's Table 2 never tunes: only q and r_acc are. So
+``run_many(..., fronts=CACHE)`` runs a hybrid's front end once per setting
+(``hybrids.front_*``, the same code as the hybrid's step), keeps z in CACHE
+and runs KALMAN's step on (x, z) with the hybrid's parameters, the hybrid's
+output bit for bit (tests check it): the FOAW hybrids' runs fall from about
+67 to 16 ms per set on 15 recordings, KALMAN's cost.
 """
 
 import numpy as np
 from numba import njit
 
+from studyapp.estimators import bdiff, complementary, foaw, hybrids, kalman, kinds, leastsq, levant, lowpass, lvt
 from studyapp.estimators.bounds import all_good
 from studyapp.estimators.dispatch import GUARD
-
-
-@njit
-def run_kernel(step, s, p, xs, acc, vel, out):
-    for i in range(xs.shape[0]):
-        out[i] = step(s, p, xs[i], acc[i], vel[i])
 
 
 @njit
@@ -55,7 +62,56 @@ def run_side_by_side(step, states, p, xs, acc, vel, out):
             out[r, i] = step(states[r], p, xs[i, r], acc[i, r], vel[i, r])
 
 
-@njit(error_model="numpy")
+# Kinds of the hybrids' front ends in ``side_by_side`` (after the estimators' own kinds).
+FRONT = {"KALLEV": 100, "KALLEVACC": 101, "KALFOAW": 102, "KALFOAWACC": 103}
+
+
+@njit(cache=True)
+def side_by_side(kind, states, p, xs, acc, vel, out):
+    """``run_side_by_side`` with the step of estimator ``kind`` (or of a hybrid's front end, ``FRONT``).
+
+    Returns False for a kind without a branch here (LEASTSQ has its block form).
+    """
+    if kind == kinds.BDIFF:
+        run_side_by_side(bdiff.step, states, p, xs, acc, vel, out)
+    elif kind == kinds.LOWPASS:
+        run_side_by_side(lowpass.step, states, p, xs, acc, vel, out)
+    elif kind == kinds.FOAW:
+        run_side_by_side(foaw.step, states, p, xs, acc, vel, out)
+    elif kind == kinds.LEVANT:
+        run_side_by_side(levant.step_levant, states, p, xs, acc, vel, out)
+    elif kind == kinds.LEVANTLP:
+        run_side_by_side(levant.step_levantlp, states, p, xs, acc, vel, out)
+    elif kind == kinds.KALPOS:
+        run_side_by_side(kalman.step_kalpos, states, p, xs, acc, vel, out)
+    elif kind == kinds.KALMAN:
+        run_side_by_side(kalman.step_kalman, states, p, xs, acc, vel, out)
+    elif kind == kinds.KALLEV:
+        run_side_by_side(hybrids.step_kallev, states, p, xs, acc, vel, out)
+    elif kind == kinds.KALLEVACC:
+        run_side_by_side(hybrids.step_kallevacc, states, p, xs, acc, vel, out)
+    elif kind == kinds.KALFOAW:
+        run_side_by_side(hybrids.step_kalfoaw, states, p, xs, acc, vel, out)
+    elif kind == kinds.KALFOAWACC:
+        run_side_by_side(hybrids.step_kalfoawacc, states, p, xs, acc, vel, out)
+    elif kind == kinds.COMP1 or kind == kinds.COMP2:
+        run_side_by_side(complementary.step, states, p, xs, acc, vel, out)
+    elif kind == kinds.LVT:
+        run_side_by_side(lvt.step, states, p, xs, acc, vel, out)
+    elif kind == 100:
+        run_side_by_side(hybrids.front_kallev, states, p, xs, acc, vel, out)
+    elif kind == 101:
+        run_side_by_side(hybrids.front_kallevacc, states, p, xs, acc, vel, out)
+    elif kind == 102:
+        run_side_by_side(hybrids.front_kalfoaw, states, p, xs, acc, vel, out)
+    elif kind == 103:
+        run_side_by_side(hybrids.front_kalfoawacc, states, p, xs, acc, vel, out)
+    else:
+        return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
 def fir_side_by_side(taps, xs, out):
     """``out[r, k] = sum_i taps[i] * xs[k - i, r]`` summed in increasing i, from 0.0, with
     ``xs[j, r] = xs[0, r]`` for j < 0 (history at rest): LEASTSQ's step at every sample.
@@ -89,35 +145,26 @@ def _leastsq(p, xs, acc, vel, out):
 BLOCK_FORMS = {"LEASTSQ": _leastsq}
 
 
-def kernels():
-    """Estimator name -> its compiled step (the registry's, the same functions the dispatch calls)."""
-    from studyapp.estimators.registry import KERNELS
-
-    return KERNELS
-
-
 def run(estimator, position, acceleration, velocity, finite=None):
     """The estimate of a fresh ``estimator`` over whole arrays (float64, C-contiguous, equal length).
 
     ``finite`` says whether every sample of the three inputs is known to be good (finite and
     within ``estimators.bounds``; checked here when None).
     """
-    step = kernels().get(estimator.name)
     if finite is None:
         finite = all_good(position, acceleration, velocity)
-    if step is None or not finite:
+    if not finite:
         return estimator.process(position, acceleration, velocity)
-    out = np.empty(position.shape[0])
-    run_kernel(step, estimator.state[GUARD:], estimator.p, position, acceleration, velocity, out)
-    return out
+    return run_many(estimator, position[:, None], acceleration[:, None], velocity[:, None])[0]
 
 
-def run_many(estimator, positions, accelerations, velocities):
+def run_many(estimator, positions, accelerations, velocities, fronts=None):
     """The estimates of a fresh ``estimator`` (as ``create`` makes it) on each column of the inputs.
 
     The inputs are (samples x recordings), float64, C-contiguous, every sample good
     (``estimators.bounds``). Row r of the result (recordings x samples) is
-    ``run(estimator, positions[:, r], ...)``; the estimator itself is left untouched.
+    ``Estimator.process`` on column r; the estimator itself is left untouched. ``fronts``: a
+    dict kept with these inputs, where a hybrid's front-end output is kept per setting.
     """
     from studyapp.estimators import create
 
@@ -127,12 +174,31 @@ def run_many(estimator, positions, accelerations, velocities):
     if block_form is not None:
         block_form(estimator.p, positions, accelerations, velocities, out)
         return out
-    step = kernels().get(estimator.name)
-    if step is None:
+    states = np.repeat(estimator.state[None, GUARD:], count, axis=0)
+    if fronts is not None and estimator.name in FRONT:
+        k = states[:, :kalman.KALMAN_STATE].copy()  # K's fresh state (the front end changes its flag)
+        z = _front(estimator, states, positions, accelerations, velocities, fronts)
+        side_by_side(kinds.KALMAN, k, estimator.p[:kalman.KALMAN_PARAMS], positions, z, velocities, out)
+        return out
+    if not side_by_side(estimator.spec.kind, states, estimator.p, positions, accelerations, velocities, out):
         for r in range(count):
             fresh = create(estimator.name, estimator.rate, **estimator.params)
             out[r] = fresh.process(positions[:, r], accelerations[:, r], velocities[:, r])
-        return out
-    states = np.repeat(estimator.state[None, GUARD:], count, axis=0)
-    run_side_by_side(step, states, estimator.p, positions, accelerations, velocities, out)
     return out
+
+
+def _front(estimator, states, positions, accelerations, velocities, fronts):
+    """The front end's z (samples x recordings) of a hybrid, from ``fronts`` or run and kept there.
+
+    Keyed by the hybrid and the parameters after KALMAN's (those of the front end), one setting per
+    hybrid (a search that tunes the front end replaces it at every set).
+    """
+    key = estimator.p[kalman.KALMAN_PARAMS:].tobytes()
+    kept = fronts.get(estimator.name)
+    if kept is not None and kept[0] == key:
+        return kept[1]
+    z = np.empty((positions.shape[1], positions.shape[0]))
+    side_by_side(FRONT[estimator.name], states, estimator.p, positions, accelerations, velocities, z)
+    z = np.ascontiguousarray(z.T)
+    fronts[estimator.name] = (key, z)
+    return z

@@ -12,6 +12,10 @@ One iteration:
 4. an estimator stops searching once ``patience`` new sets in a row brought no
    improvement; the run ends when none is left (the paper's rule, 1000).
 
+With ``restarts`` the searches run in lanes (``search.py``); a lane whose best
+is not the estimator's is judged here, against its own best under the same
+memorised scale as the step's decisions.
+
 Work is sent to the executor in few, large tasks: an iteration's sets go out
 together, one task per worker (``executors.parallelism``). An objective that
 can be split by recordings (``shares(k)``, ``dataset.RawObjectives``) gives
@@ -104,11 +108,13 @@ class Optimiser:
     ``starts``: name -> the first parameter set of that estimator (default its
     space's start, Table 1); ``studyapp tradeoff`` starts from Table 1 made
     for the rate (windows kept in seconds).
+    ``restarts``: lanes of each search that start from drawn points (``search.py``; 0: none,
+    the search as it was before restarts, draw for draw).
     """
 
     def __init__(self, spaces, objective, executor, patience=1000, seed=0, tolerance=None,
                  max_sets=None, checkpoint=None, checkpoint_interval=30.0, progress=None, fingerprint=None,
-                 starts=None):
+                 starts=None, restarts=0):
         if not spaces:
             raise UserError("no estimators to optimise")
         self.spaces = dict(spaces)
@@ -118,6 +124,9 @@ class Optimiser:
         if self.patience < 1:
             raise UserError(f"--patience {patience}: allowed is an integer of at least 1")
         self.seed = int(seed)
+        self.restarts = int(restarts)
+        if self.restarts < 0:
+            raise UserError(f"--restarts {restarts}: allowed is an integer of at least 0")
         self.tolerance = tolerance
         self.max_sets = None if max_sets is None else int(max_sets)
         if self.max_sets is not None and self.max_sets < 1:
@@ -127,13 +136,14 @@ class Optimiser:
         self.progress = progress
         starts = dict(starts or {})
         self.fingerprint = {
-            "seed": self.seed, "patience": self.patience, "max_sets": self.max_sets,
+            "seed": self.seed, "patience": self.patience, "max_sets": self.max_sets, "restarts": self.restarts,
             "spaces": {name: space.describe() for name, space in self.spaces.items()},
             **({"starts": starts} if starts else {}),
             **(fingerprint or {}),
         }
         self.searches = {
-            name: AdaptiveSearch(space, estimator_seed(self.seed, name), self.patience, starts.get(name))
+            name: AdaptiveSearch(space, estimator_seed(self.seed, name), self.patience, starts.get(name),
+                                 self.restarts)
             for name, space in self.spaces.items()
         }
         self.sum = None
@@ -176,6 +186,16 @@ class Optimiser:
             raws[name] = raw
             self.evaluated += 1
         return {name: raws[name] for name in proposals}
+
+    def _lanes_improved(self, raws):
+        """name -> whether its candidate beats the best of its search's lane, where that is not the
+        estimator's best (``search.py``: restarts); False otherwise (the objective sum decides)."""
+        lanes = {}
+        for name, raw in raws.items():
+            lane_raw = self.searches[name].lane_raw
+            lanes[name] = lane_raw is not None and bool(
+                self.sum.objective(raw) < self.sum.objective(lane_raw) - self.sum.tolerance)
+        return lanes
 
     def _active(self):
         return [name for name, s in self.searches.items()
@@ -235,9 +255,11 @@ class Optimiser:
                 # Steps 5-8.
                 proposals = {name: self.searches[name].propose() for name in active}
                 raws = self._evaluate(proposals)
+                lanes = self._lanes_improved(raws)  # under the scale in force, as the decisions are
                 decisions = self.sum.step(raws)
                 for name in active:
-                    self.searches[name].report(proposals[name], decisions[name].accepted)
+                    accepted = decisions[name].accepted
+                    self.searches[name].report(proposals[name], accepted, accepted or lanes[name], raws[name])
                 self.seconds = time.monotonic() - started
                 self._snapshot = self.state()
                 self._report(final=False)

@@ -52,6 +52,7 @@ def test_optimise_writes_params_with_provenance(recordings, optimised):
     assert prov["recordings"] == [str(p) for p in files]
     assert prov["recording_sha256"] == [hashlib.sha256(p.read_bytes()).hexdigest() for p in files]
     assert prov["seed"] == 1 and prov["patience"] == 6 and prov["reference"] == "lvt"
+    assert prov["restarts"] == 2  # the default
     assert prov["studyapp_version"] and prov["numpy_version"] and prov["iterations"] >= 6
     assert 1.0 <= data["LOWPASS"]["cutoff_hz"] <= 2450.0
     assert data["KALMAN"]["q_convention"] == "scaled" and data["KALMAN"]["r_pos"] == 2e-10  # Table 1's convention

@@ -61,3 +61,21 @@ def test_leastsq_block_form_equals_its_step(order, window, signals):
         expected = create("LEASTSQ", 5000.0, order=order, window=window).process(cols[0][:, r], cols[1][:, r],
                                                                                  cols[2][:, r])
         assert np.array_equal(out[r], expected)
+
+
+@pytest.mark.parametrize("name", ["KALLEV", "KALLEVACC", "KALFOAW", "KALFOAWACC"])
+def test_hybrid_from_a_kept_front_end_equals_process(name):
+    """A hybrid run as its front end's kept output then KALMAN's step is the hybrid, bit for bit,
+    for every q and r_acc on the kept front end and after a change of the front end's setting."""
+    sigs = [stick_slip(5000.0, 0.1, seed=s) for s in (5, 6)]
+    cols = [np.ascontiguousarray(np.stack([s[c] for s in sigs], axis=1))
+            for c in ("position", "acceleration", "velocity_lvt")]
+    front = {"margin": 3e-5} if "FOAW" in name else {"c": 40.0}
+    fronts = {}
+    settings = [{}, {"q": 3.0, "r_acc": 0.2}, {"q": 1e6, "r_acc": 1e4}, {"q": 50.0, **front}, {"q": 2.0, **front}]
+    for params in settings:
+        out = kernels.run_many(create(name, 5000.0, **params), *cols, fronts=fronts)
+        for r, s in enumerate(sigs):
+            expected = create(name, 5000.0, **params).process(s["position"], s["acceleration"], s["velocity_lvt"])
+            assert np.array_equal(out[r], expected)
+    assert list(fronts) == [name]
