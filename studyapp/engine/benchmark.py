@@ -30,10 +30,13 @@ test.
 
 import json
 import sys
+import time
 
 from studyapp import estimators
+from studyapp.engine.config import BLOCK_PERIOD, EngineConfig, block_samples
+from studyapp.engine.engine import Engine
+from studyapp.errors import ParameterError
 from studyapp.estimators import lvt
-from studyapp.engine.config import BLOCK_PERIOD, block_samples
 
 LADDER = (5000.0, 10000.0, 20000.0, 40000.0, 48000.0, 96000.0)
 PROBE_SECONDS = 3.0
@@ -47,10 +50,7 @@ def all_fourteen():
 
 def probe(rate, seconds, progress=print, block_period=BLOCK_PERIOD):
     """Run the engine for ``seconds`` at ``rate`` in blocks of ``block_period`` s; the worker's summary plus ``passed``."""
-    import time
 
-    from studyapp.engine.config import EngineConfig
-    from studyapp.engine.engine import Engine
 
     config = EngineConfig(rate=rate, estimators=all_fourteen(), source="KALLEV", fmax=1.0,
                           audio="discard", midi="none", block=block_samples(rate, block_period))
@@ -140,7 +140,6 @@ def search(confirm_seconds=30.0, probe_seconds=PROBE_SECONDS, progress=print, bl
 
 
 def run_cli(args):
-    from studyapp.errors import ParameterError
 
     seconds = float(getattr(args, "seconds", 30.0))
     if not seconds > 0:

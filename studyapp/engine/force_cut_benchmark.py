@@ -20,6 +20,7 @@ maximum per mode; it is a measurement on this machine under its load, never a
 test.
 """
 
+import ctypes
 import json
 import multiprocessing
 import os
@@ -28,12 +29,16 @@ import statistics
 import sys
 import time
 
+from studyapp.engine.config import EngineConfig
+from studyapp.engine.engine import Engine
+from studyapp.engine.status import StatusBlock
+from studyapp.errors import ParameterError
+
 MODES = ("python", "gil")
 
 
 def _observe(status_name, ready, out, limit):
     """In its own process: report time.monotonic() when ``force_enable`` falls (or None after ``limit`` s)."""
-    from studyapp.engine.status import StatusBlock
 
     status = StatusBlock.attach(status_name)
     try:
@@ -57,7 +62,6 @@ def _busy_python(seconds):
 
 def _busy_gil(seconds):
     """Sleep in C with the interpreter's lock held: ``PyDLL`` calls keep the GIL, unlike ``CDLL``'s."""
-    import ctypes
 
     ctypes.PyDLL(None).usleep(int(seconds * 1e6))
 
@@ -65,8 +69,6 @@ def _busy_gil(seconds):
 def one_try(mode, busy=2.0):
     """One SIGSTOP while the parent is busy; returns the force-cut time in s (None if the force stayed on,
     "void" if it was cut before the stop: the worker starved by a loaded machine, retried by ``measure``)."""
-    from studyapp.engine.config import EngineConfig
-    from studyapp.engine.engine import Engine
 
     ctx = multiprocessing.get_context("spawn")
     engine = Engine(EngineConfig(rate=5000.0, source="LVT", fmax=1.0, audio="null", midi="none")).start()
@@ -120,7 +122,6 @@ def measure(tries=20, busy=2.0, modes=MODES, progress=print):
 
 
 def run_cli(args):
-    from studyapp.errors import ParameterError
 
     if not 1 <= args.tries <= 1000:
         raise ParameterError(f"--tries {args.tries}: allowed is an integer from 1 to 1000")

@@ -32,13 +32,20 @@ import contextlib
 import json
 import os
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
 import textwrap
 import time
 
+import numpy as np
+
+from studyapp.engine.config import EngineConfig
+from studyapp.engine.engine import Engine
 from studyapp.engine.events import Applied
+from studyapp.errors import ParameterError, UserError
+from studyapp.model.controls import LIVE_RANGE, FmaxKnob, knob_value
 from studyapp.model.sources import LVT_SENSOR
 
 KNOBS = 8
@@ -79,7 +86,6 @@ SENDER = textwrap.dedent("""
 @contextlib.contextmanager
 def dummy_jack():
     """A private JACK server with the dummy driver; ``JACK_DEFAULT_SERVER`` names it meanwhile."""
-    from studyapp.errors import UserError
 
     jackd, wait = shutil.which("jackd"), shutil.which("jack_wait")
     if jackd is None or wait is None:
@@ -134,8 +140,6 @@ def _ready(wait, name, server, timeout=15.0):
 
 
 def _engine():
-    from studyapp.engine.config import EngineConfig
-    from studyapp.engine.engine import Engine
 
     return Engine(EngineConfig(rate=5000.0, source=LVT_SENSOR, fmax=0.5, audio="null", midi="virtual")).start()
 
@@ -152,9 +156,7 @@ def quiet(seconds):
 
 def flood(rate, seconds, progress=print):
     """One run: the engine under ``rate`` control changes per second for ``seconds``; the figures."""
-    import numpy as np
 
-    from studyapp.model.controls import LIVE_RANGE, FmaxKnob, knob_value
 
     background = quiet(seconds)
     engine = _engine()
@@ -198,9 +200,7 @@ def flood(rate, seconds, progress=print):
 
 
 def run_cli(args):
-    import statistics
 
-    from studyapp.errors import ParameterError
 
     if not 1 <= args.rate <= 100_000:
         raise ParameterError(f"--rate {args.rate:g}: allowed is 1 to 100000 messages per second")
