@@ -63,7 +63,10 @@ def run_side_by_side(step, states, p, xs, acc, vel, out):
 
 
 # Kinds of the hybrids' front ends in ``side_by_side`` (after the estimators' own kinds).
-FRONT = {"KALLEV": 100, "KALLEVACC": 101, "KALFOAW": 102, "KALFOAWACC": 103}
+FRONT_KALLEV, FRONT_KALLEVACC, FRONT_KALFOAW, FRONT_KALFOAWACC = 100, 101, 102, 103
+FRONT = {"KALLEV": FRONT_KALLEV, "KALLEVACC": FRONT_KALLEVACC, "KALFOAW": FRONT_KALFOAW,
+         "KALFOAWACC": FRONT_KALFOAWACC}
+
 
 
 @njit(cache=True)
@@ -98,13 +101,13 @@ def side_by_side(kind, states, p, xs, acc, vel, out):
         run_side_by_side(complementary.step, states, p, xs, acc, vel, out)
     elif kind == kinds.LVT:
         run_side_by_side(lvt.step, states, p, xs, acc, vel, out)
-    elif kind == 100:
+    elif kind == FRONT_KALLEV:
         run_side_by_side(hybrids.front_kallev, states, p, xs, acc, vel, out)
-    elif kind == 101:
+    elif kind == FRONT_KALLEVACC:
         run_side_by_side(hybrids.front_kallevacc, states, p, xs, acc, vel, out)
-    elif kind == 102:
+    elif kind == FRONT_KALFOAW:
         run_side_by_side(hybrids.front_kalfoaw, states, p, xs, acc, vel, out)
-    elif kind == 103:
+    elif kind == FRONT_KALFOAWACC:
         run_side_by_side(hybrids.front_kalfoawacc, states, p, xs, acc, vel, out)
     else:
         return False
