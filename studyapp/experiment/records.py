@@ -4,10 +4,10 @@ A record is a JSON object with a ``type``; ``SessionLog.append`` stamps it
 (``seq``, ``mono``, ``wall``) and ``SessionRunner.log`` puts the trial's
 ``step``, ``task`` (and ``practice``) in front. The constructors below fix
 each kind's keys and their order, which is what the file holds byte for byte
-(tests/live/test_event_records_golden.py). The task types make their own
-``knob``, ``pad``, ``acknowledge`` and ``response`` records (their fields are
-the task's: ``studyapp.experiment.tasks``); ``response_problem`` checks the
-fields every response shares before export reads it.
+(tests/live/test_event_records_golden.py). The task types fill the
+``knob`` and ``response`` records with their own fields (after the keys made
+here: ``studyapp.experiment.tasks``); ``response_problem`` checks the fields
+every response shares before export reads it.
 
 Checks. Every number has an upper bound as well: a value such as step 10^30
 or F_max 10^308 is valid JSON but no session writes it, and letting it
@@ -136,6 +136,26 @@ def press_too_soon(control: str, since: float) -> dict:
     """The participant's press on a page shown ``since`` s ago, taken as the second press of a double press."""
     return {"type": "acknowledge", "by": "participant", "control": control, "accepted": False,
             "reason": f"pressed {since:.2f} s after the page appeared: taken as a double press"}
+
+
+# what a participant did, as a task type logs it ----------------------------------------------------
+
+def knob(index: int, value: int, **task_fields) -> dict:
+    """Knob ``index`` turned to ``value`` (0..127), with the task's reading of it (its F_max, its condition)."""
+    return {"type": "knob", "index": index, "value": value, **task_fields}
+
+
+def pad(index: int) -> dict:
+    return {"type": "pad", "index": index}
+
+
+def acknowledge(by: str) -> dict:
+    return {"type": "acknowledge", "by": by}
+
+
+def response(task: str, **answer) -> dict:
+    """A trial's answer: the task's fields after the ``task`` (``response_problem`` checks the shared ones)."""
+    return {"type": "response", "task": task, **answer}
 
 
 def knob_latency(controls: int, midi: int, median: float, largest: float) -> dict:

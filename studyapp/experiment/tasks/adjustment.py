@@ -42,8 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from studyapp.experiment.records import integer, text
+from studyapp.experiment import records
 from studyapp.experiment.latin_square import participant_row
+from studyapp.experiment.records import integer, text
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
@@ -89,7 +90,7 @@ class AdjustmentTrial(ConfirmPadTrial):
             return []
         self.value = value
         self.peak_value = max(self.peak_value, value)
-        return [{"type": "knob", "index": index, "value": value, "fmax": self.fmax}]
+        return [records.knob(index, value, fmax=self.fmax)]
 
     def refusal(self):
         return "F_max is 0: turn the knob up first" if self.value == 0 else None

@@ -22,6 +22,7 @@ condition as ``listen_short``. Knob values are 7-bit MIDI positions
 
 import math
 
+from studyapp.experiment import records
 from studyapp.model.controls import KNOB_MAX
 
 LISTEN_SLACK = 1e-9  # s: what float sums of block times may fall short of a whole second
@@ -78,7 +79,7 @@ class ConfirmPadTrial:
         return "listen longer with the bow on: " + ", ".join(parts), short
 
     def pad(self, index):
-        record = {"type": "pad", "index": index}
+        record = records.pad(index)
         if self.done or index != self.confirm_pad:
             return [record]
         reason, short = self.refusal(), {}
@@ -86,7 +87,7 @@ class ConfirmPadTrial:
             reason, short = self._listen_refusal()
         if reason is not None:
             return [{**record, "accepted": False, "reason": reason, **({"listen_short": short} if short else {})}]
-        self.response = {"type": "response", "task": self.task, **self.answer()}
+        self.response = records.response(self.task, **self.answer())
         return [{**record, "accepted": True}, self.response]
 
     def tick(self, dt, bowing=False):

@@ -15,8 +15,9 @@ The simulated participant bows through the whole trial.
 
 from dataclasses import dataclass
 
-from studyapp.experiment.records import text
+from studyapp.experiment import records
 from studyapp.experiment.latin_square import participant_row
+from studyapp.experiment.records import text
 from studyapp.experiment.tasks.confirm_pad import check_knob_value
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
 from studyapp.model.limits import FMAX_LIMIT
@@ -64,7 +65,7 @@ class ListenTrial:
         return []
 
     def pad(self, index):
-        return [{"type": "pad", "index": index}]
+        return [records.pad(index)]
 
     def tick(self, dt, bowing=False):
         if self.done:
@@ -72,8 +73,8 @@ class ListenTrial:
         self.elapsed += dt
         if self.elapsed < self.duration_s:
             return []
-        self.response = {"type": "response", "task": self.task, "condition": self.condition, "trial": self.trial,
-                         "fmax": self.listen_fmax, "listened": True, "duration": self.elapsed}
+        self.response = records.response(self.task, condition=self.condition, trial=self.trial, fmax=self.listen_fmax,
+                                         listened=True, duration=self.elapsed)
         return [self.response]
 
     def restore(self, earlier):

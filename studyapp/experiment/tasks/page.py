@@ -18,8 +18,9 @@ acknowledged page again; how long it was read is the time between its
 and ``measure`` None (the log keeps when each page was acknowledged).
 """
 
-from studyapp.experiment.records import text
+from studyapp.experiment import records
 from studyapp.experiment.pages import KINDS, WHO
+from studyapp.experiment.records import text
 from studyapp.experiment.tasks.confirm_pad import check_knob_value
 
 REFUSED = "the experimenter confirms this page"
@@ -51,7 +52,7 @@ class PageTrial:
         return []
 
     def pad(self, index):
-        record = {"type": "pad", "index": index}
+        record = records.pad(index)
         if self.done or index != self.page.pad:
             return [record]
         if self.page.by != "participant":
@@ -64,15 +65,14 @@ class PageTrial:
             raise ValueError(f"by = {by!r}: allowed is one of {', '.join(WHO)}")
         if self.done:
             return []
-        record = {"type": "acknowledge", "by": by}
+        record = records.acknowledge(by)
         if by == "participant" and self.page.by != "participant":
             return [{**record, "accepted": False, "reason": REFUSED}]
         return [{**record, "accepted": True}, self._acknowledged(by)]
 
     def _acknowledged(self, by):
         p = self.page
-        self.response = {"type": "response", "task": self.task, "trial": self.trial, "fmax": 0.0, "kind": p.kind,
-                         "title": p.title, "by": by}
+        self.response = records.response(self.task, trial=self.trial, fmax=0.0, kind=p.kind, title=p.title, by=by)
         if p.kind == "calibration":
             self.response.update(tone_hz=p.tone_hz, level_dbfs=p.level_dbfs)
         return self.response

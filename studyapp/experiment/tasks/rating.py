@@ -38,8 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from studyapp.experiment.records import integer, number, text
+from studyapp.experiment import records
 from studyapp.experiment.latin_square import participant_row
+from studyapp.experiment.records import integer, number, text
 from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
@@ -89,7 +90,7 @@ class RatingTrial(ConfirmPadTrial):
         condition = self.conditions[index]
         self.values[condition] = value
         self.selected = condition
-        return [{"type": "knob", "index": index, "value": value, "condition": condition}]
+        return [records.knob(index, value, condition=condition)]
 
     def refusal(self):
         unrated = [self.listen_label(c) for c, v in self.values.items() if v is None]
