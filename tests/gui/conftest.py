@@ -35,6 +35,21 @@ def wait_until(app, predicate, timeout, step=0.01):
         time.sleep(step)
 
 
+def line_within(proc, timeout):
+    """The next line ``proc`` writes on stdout; fail (killing it) when none comes within ``timeout`` s.
+
+    A bare ``readline`` waits forever on a child that hangs (a full run once did: the probe stayed
+    blocked after its console failed), so the suite would never end."""
+    import selectors
+
+    with selectors.DefaultSelector() as sel:
+        sel.register(proc.stdout, selectors.EVENT_READ)
+        if not sel.select(timeout):
+            proc.kill()
+            raise AssertionError(f"no line from {proc.args[:4]} within {timeout:g} s: {proc.stderr.read()[-3000:]}")
+    return proc.stdout.readline()
+
+
 def answer_question(console, qtbot, button):
     """Click ``button`` (a ``QMessageBox.StandardButton``) of the console's next question once it is open.
 

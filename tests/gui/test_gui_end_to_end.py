@@ -23,7 +23,7 @@ from PySide6.QtCore import Qt
 from studyapp.experiment.export import export_responses
 from studyapp.model.fmax_knob import fmax_from_knob
 from studyapp.live.controller import PAGE_SETTLE_S
-from tests.gui.conftest import ENGINE_START, wait_until
+from tests.gui.conftest import ENGINE_START, line_within, wait_until
 
 pytest.importorskip("pytestqt")
 
@@ -123,14 +123,14 @@ class Lpd8:
         before = self.controller.engine.status()["midi_messages"]
         self.proc.stdin.write(line + "\n")
         self.proc.stdin.flush()
-        assert self.proc.stdout.readline().strip() == "ok", self.proc.stderr.read()[-2000:]
+        assert line_within(self.proc, 60).strip() == "ok", self.proc.stderr.read()[-2000:]
         self.sent += messages
         wait_until(self.app, lambda: self.controller.engine.status()["midi_messages"] >= before + messages, 10)
 
     def connect(self):
         self.proc.stdin.write("connect\n")
         self.proc.stdin.flush()
-        assert self.proc.stdout.readline().strip() == "ok", self.proc.stderr.read()[-2000:]
+        assert line_within(self.proc, 60).strip() == "ok", self.proc.stderr.read()[-2000:]
 
     def turn(self, knob, value):
         self._command(f"cc {knob + 1} {value}", 1)

@@ -13,7 +13,7 @@ import sys
 
 import pytest
 
-from tests.gui.conftest import DEMO, ROOT
+from tests.gui.conftest import DEMO, ROOT, line_within
 
 pytestmark = pytest.mark.gui
 
@@ -51,7 +51,7 @@ def probe(display, tmp_path, then, *args):
 
 
 def first_report(proc):
-    line = proc.stdout.readline()
+    line = line_within(proc, TIMEOUT)
     assert line, proc.stderr.read()[-3000:]
     return json.loads(line)
 
