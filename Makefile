@@ -20,13 +20,10 @@ setup: $(STAMP)
 run: $(STAMP)
 	$(VENV)/bin/studyapp gui
 
-# the suite in two workers per core (at most 4), each with its own JACK server, Xvfb display and
-# temporary directory; a worker that runs out of tests takes some of another's (worksteal). Two per
-# core because many tests wait on real time (an engine, a GUI session): at one per core the two
-# workers of a 2-core machine kept 0.9 of its cores busy (clean clone, 2026-11-25).
-WORKERS ?= $(shell n=$$(nproc); echo $$(( 2 * n < 4 ? 2 * n : 4 )))
+# the suite on every core (at most 4), each worker with its own JACK server, Xvfb display and
+# temporary directory; a worker that runs out of tests takes some of another's (worksteal)
 test: $(STAMP)
-	$(PY) -m pytest -q -n $(WORKERS) --dist worksteal
+	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 
 clean:
 	rm -rf $(VENV) build *.egg-info
