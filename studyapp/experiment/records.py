@@ -132,6 +132,13 @@ def pickup(control: str, trial: int, when: float | None, ignored: int) -> dict:
     return {"type": "pickup", "control": control, "trial": trial, "when": when, "ignored": ignored}
 
 
+def late_control(control: str, value: int) -> dict:
+    """A control the worker applied in an attempt that had ended (an emergency stop, a restart) before its
+    report came back: ``value`` the knob's step (0..127) or 1 for a pad. Logged so that no force the worker
+    set goes unrecorded, and given to no task (a resumed rating restores only ``knob`` records)."""
+    return {"type": "late_control", "control": control, "value": value}
+
+
 def press_too_soon(control: str, since: float) -> dict:
     """The participant's press on a page shown ``since`` s ago, taken as the second press of a double press."""
     return {"type": "acknowledge", "by": "participant", "control": control, "accepted": False,

@@ -8,7 +8,10 @@ tagged with the trial's number); ``take`` hands those of the current trial to
 the runner, which logs them and keeps the task's state, after telling the
 trial's loop what the worker applied (engine_loop.py: the worker is the one
 writer of what its knobs set). A held trial's, a stale trial's, or the
-preview's while a session starts reach no task. The knob positions shown are
+preview's while a session starts reach no task; an ended attempt's control
+that the worker applied (its report came back after an emergency stop or a
+restart began the next attempt) is logged as ``late_control`` and reaches no
+task. The knob positions shown are
 the worker's (``Applied.value``).
 
 Pickup. A physical knob that sets a level acts only once it has passed
@@ -103,6 +106,7 @@ class Controls:
         ours = runner is not None and runner.task is not None and record.trial == live.trial_serial
         preview = record.trial == 0 and live.at_rest
         if not (ours or preview):
+            self._log_late(record, knob)
             return
         if self._picked_up(record, knob, ours):
             return
@@ -110,6 +114,9 @@ class Controls:
             self.latency.add(record.latency, record.origin)
         if knob is not None:
             live.events.knob.emit(index=knob, value=knob_step(record.value))
+        for command in record.commands:
+            if isinstance(command, cmd.SetVolume):  # the preview's volume knob: the one volume record follows
+                live.volume_applied(command.gain)
         if not ours:
             return
         if runner.loop is not None:
@@ -120,6 +127,16 @@ class Controls:
             if runner.trial.page is not None and self.settling(record.control):
                 return
             live.take_records(runner.pad(pad))
+
+    def _log_late(self, record, knob):
+        """An ended attempt's control that the worker applied: logged, given to no task."""
+        runner = self.live.runner
+        if runner is None or not 0 < record.trial < self.live.trial_serial or record.pending_pickup:
+            return
+        if knob is not None and record.commands:
+            runner.log(records.late_control(record.control, knob_step(record.value)))
+        elif knob is None and record.value > 0:
+            runner.log(records.late_control(record.control, 1))
 
     def _picked_up(self, record, knob, ours):
         """Follow a knob's pickup; True while it waits for it (the task must not see it)."""

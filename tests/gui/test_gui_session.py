@@ -160,6 +160,8 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     dial = console.knobs.dials[0]
     assert dial.value() == 0 and console.knobs.captions[0].text() == "F_max"
     dial.setValue(60)
+    # the experimenter stops once the turn took effect (a turn reported after the stop is a late_control)
+    wait_until(qapp, lambda: c.controls_taken >= c.controls_sent, 10)
     qtbot.mouseClick(console.stop_button, Qt.MouseButton.LeftButton)
     assert c.state == "emergency" and c.emergency
     qtbot.mouseClick(console.pause_button, Qt.MouseButton.LeftButton)

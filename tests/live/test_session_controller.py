@@ -420,3 +420,25 @@ def test_each_session_engine_records_the_audio_with_a_cue_at_each_trial_start_an
     assert [x for x in second.sent if isinstance(x, (cmd.RecordAudio, cmd.AudioCue))] == [
         cmd.RecordAudio(str(folder / "audio.wav")), cmd.AudioCue(1, "adjustment", 1, "start"),
         cmd.AudioCue(1, "adjustment", 1, "end"), cmd.RecordAudio(None)]
+
+
+def test_a_turn_the_worker_applied_before_an_emergency_stop_is_logged_but_not_given_to_the_new_attempt(controller):
+    c = controller
+    start(c)
+    up(c)
+    play_rating(c)
+    engine = c.host.engine
+    c.knob(0, 60)  # the worker applies it at once ...
+    report = engine.controls()  # ... and its report is late (a loaded machine)
+    c.emergency_stop()
+    c.clear_emergency()
+    c.poll()
+    assert c.state == S.RUNNING and c.trial_serial == report[0].trial + 1
+    engine._controls.extend(report)  # it arrives while the next attempt runs
+    c.poll()
+    assert c.runner.task.value == 0
+    events = log(c)
+    late = [e for e in events if e["type"] == "late_control"]
+    assert late == [{"step": 1, "task": "adjustment", "type": "late_control", "control": "knob1", "value": 60}]
+    assert not any(e["type"] == "knob" and e["task"] == "adjustment" for e in events)
+    assert engine.fmax == 0.0
