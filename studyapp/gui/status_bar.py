@@ -29,12 +29,23 @@ ELIDED = ("engine", "faults", "knob")
 MESSAGE_CHARACTERS = 40
 
 
+def message_width(label):
+    """Room for ``MESSAGE_CHARACTERS`` characters of a warning, the "…" and the label's margins.
+
+    Measured on "n", wider than most lower-case letters: ``averageCharWidth`` is an integer and
+    held 39 characters of an ordinary warning.
+    """
+    margins = label.contentsMargins()
+    sample = "n" * MESSAGE_CHARACTERS + "…"
+    return label.fontMetrics().horizontalAdvance(sample) + margins.left() + margins.right() + 2
+
+
 class StatusBar(QStatusBar):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.labels = {}
         self.message = ElidedLabel("")
-        self.message.setMinimumWidth(self.message.fontMetrics().averageCharWidth() * MESSAGE_CHARACTERS)
+        self.message.setMinimumWidth(message_width(self.message))
         self.addWidget(self.message, 1)
         self._message_timer = QTimer(self)
         self._message_timer.setSingleShot(True)

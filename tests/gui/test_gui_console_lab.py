@@ -174,9 +174,18 @@ def test_during_a_session_at_1366x768_the_blinding_tick_and_the_warnings_fit(idl
         for _ in range(10):
             qapp.processEvents()
         assert in_view(console.blind, console)
-        message = console.status.message  # the latest warning (the null sink's come too)
+        # the readouts at their widest (a loaded machine's counts), then the warning again: it is the latest
+        console.status.show_status({"achieved_rate": 4998.0, "rate": 5000.0, "load_mean": 0.99, "load_max": 1.25,
+                                    "deadline_misses": 12345, "audio_underruns": 678, "faults": 9,
+                                    "fault_latched": False, "fault": "", "events_dropped": 4321}, lost=98765,
+                                   knob_latency=(0.0123, 0.0456))
+        warning = "the emergency stop was cleared by the experimenter, and so on"
+        console.status.show_message(warning, 5000)
+        for _ in range(10):
+            qapp.processEvents()
+        message = console.status.message
         shown = message.shown_text()
-        assert len(message.text()) >= 40 and len(shown.rstrip("…")) >= 40, shown
+        assert message.text() == warning and len(shown.rstrip("…")) >= 40, (message.text(), shown)
     finally:
         if c.in_session:
             console.abort_session()
