@@ -168,8 +168,8 @@ def action_commands(action, value, sent):
             return (SetFmax(knob.fmax(knob_step(value)), sent=sent),)
         case FmaxLinear() as linear:
             return (SetFmax(linear.fmax(value), sent=sent),)
-        case Volume():
-            return (SetVolume(value, sent=sent),)
+        case Volume() as volume:
+            return (SetVolume(volume.gain(value), sent=sent),)
         case Source(name):
             return (SetSource(name, sent=sent),) if value > 0 else ()  # a pad: pressed, not released
         case Select(condition, fmax):

@@ -25,6 +25,8 @@ an on-screen knob) must first be turned through the new level. Positions are
 knob steps (0..127). On-screen knobs show the level itself and need no pickup.
 """
 
+import math
+
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine.midi import coalesce
@@ -51,8 +53,8 @@ def level_position(action, fmax, volume, rating=None):
             return knob.step(fmax)
         case FmaxLinear(low, high):
             return _step((fmax - low) / (high - low))
-        case Volume():
-            return _step(volume)
+        case Volume() as law:
+            return _step(law.value(20.0 * math.log10(volume)) if volume > 0 else 0.0)
         case Select():
             return rating
     return None

@@ -9,8 +9,9 @@
   (``SessionController.add_note``): in the running session, or after it in
   the latest session's log.
 - **Sound**: Mute and a master volume slider (-40 to 0 dB) send the engine's
-  own volume and mute commands (``session/master_sound.py``), logged during
-  a session. The slider reports only when released, so a drag is one change.
+  own volume and mute commands (``live/master_sound.py``), logged during
+  a session. The slider reports only when released, so a drag is one change;
+  it follows the preview's volume knob (knob 2), which has the same law.
 """
 
 from PySide6.QtCore import Qt, Signal
@@ -98,6 +99,7 @@ class SessionTools(QGroupBox):
         self.volume.setValue(int(high))
         self.volume.setTracking(False)  # one change per release, not one per pixel dragged
         self.volume.valueChanged.connect(self._volume)
+        controller.events.volume.connect(self._volume_applied)
         self.volume.sliderMoved.connect(lambda db: self.volume_label.setText(f"{db} dB"))
         self.volume_label = QLabel(f"{int(high)} dB")
         self.message = QLabel("")
@@ -149,6 +151,13 @@ class SessionTools(QGroupBox):
         self.message.setText(f"Note logged at {record['wall'][11:19]}.")
         self.note_added.emit(text)
         return record
+
+    def _volume_applied(self, db):
+        """A volume knob set the master volume: show it, without sending it again."""
+        self.volume.blockSignals(True)
+        self.volume.setValue(round(db))
+        self.volume.blockSignals(False)
+        self.volume_label.setText(f"{db:.0f} dB")
 
     def _volume(self, db):
         self.volume_label.setText(f"{db} dB")

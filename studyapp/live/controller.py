@@ -34,7 +34,8 @@ ignores the participant's controls; resume gives the settings back.
 
 Notes and sound: ``add_note`` (experiment/session_notes.py: in the running
 session, or after it in the latest session's log), ``set_volume`` (dB) and
-``set_mute`` (master_sound.py: sent again to every engine that comes up),
+``set_mute`` (master_sound.py: sent again to every engine that comes up;
+``volume_applied`` when the preview's volume knob set it),
 each logged during a session.
 """
 
@@ -70,7 +71,8 @@ class SessionController:
         self.apparatus = Apparatus(audio, midi, device, realtime, hang_timeout, make_host)
         self.clock = clock
         self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing", "gesture",
-                                 "telemetry", "status", "message", "response", "pickup", "page", "refused")
+                                 "telemetry", "status", "message", "response", "pickup", "page", "refused",
+                                 "volume")
         self.controls = Controls(self)
         self.media = TrialMedia(self)
         self.hand = Hand(self)
@@ -280,6 +282,14 @@ class SessionController:
     def set_volume(self, db):
         """The master volume, in dB (master_sound.py); logged during a session."""
         self._sound_event(self.sound.set_db(db))
+
+    def volume_applied(self, gain):
+        """The worker applied a volume knob's ``gain``: the master volume now (logged during a session), and
+        the console's slider follows (``events.volume``); nothing is sent back."""
+        record = self.sound.adopt(gain)
+        if self.session is not None:
+            self._log_session(record)
+        self.events.volume.emit(db=self.sound.db)
 
     def set_mute(self, on):
         self._sound_event(self.sound.set_muted(on))

@@ -4,7 +4,11 @@ They send the engine's existing commands (``SetVolume`` with a linear gain,
 ``SetMute``; engine/audio/sinks.py applies them, ramped, before the rest of the
 audio chain), so this adds no second volume stage. The console sets the
 volume in decibels, -40 to 0 dB (gain 10^(dB/20), 0.01 to 1): an
-attenuator, never louder than the chain's own full level. The setting
+attenuator, never louder than the chain's own full level. The preview's
+volume knob (knob 2) has the same law (model/controls.py ``Volume``); the
+worker applies it, and what it applied becomes this setting (``adopt``), so
+the console shows it and every engine that comes up gets it: the volume has
+one record, whichever control set it last. The setting
 belongs to the console, not to an engine: every engine that comes up (a
 session's, a restarted one, the preview after it) gets it again
 (``commands``). During a session every change is logged as an event,
@@ -16,8 +20,9 @@ import math
 from studyapp.engine import commands as cmd
 from studyapp.errors import UserError
 from studyapp.experiment import records
+from studyapp.model.controls import VOLUME_DB
 
-DB_RANGE = (-40.0, 0.0)
+DB_RANGE = VOLUME_DB
 
 
 class MasterSound:
@@ -35,6 +40,12 @@ class MasterSound:
         if not (isinstance(db, (int, float)) and math.isfinite(db) and low <= db <= high):
             raise UserError(f"volume {db!r} dB: allowed is {low:g} to {high:g} dB")
         self.db = float(db)
+        return records.volume(self.db, self.gain)
+
+    def adopt(self, gain):
+        """The worker applied a volume knob's ``gain``: it is the setting now; returns the event to log."""
+        low, high = DB_RANGE
+        self.db = min(max(20.0 * math.log10(gain), low), high) if gain > 0 else low
         return records.volume(self.db, self.gain)
 
     def set_muted(self, on):

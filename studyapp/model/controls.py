@@ -14,7 +14,8 @@ k = round(127 v) (``knob_step``), its value again v = k / 127
                                  logarithmic map, Sec. 8.2): F_max = 0 at step 0, else
                                  ceiling * 10^(-decades (127 - k) / 126); applied here only (``fmax``)
     FmaxLinear(low, high)        F_max = low + v (high - low)
-    Volume()                     the linear gain v
+    Volume()                     the master volume on the console's law: v dB-linear over VOLUME_DB
+                                 (-40 dB at 0, 0 dB at 1), gain 10^(dB/20); applied here only
     Source(name)                 a pad: selects the velocity source ``name`` when pressed
     Select(condition, fmax)      a rating knob: any movement selects ``condition``, at ``fmax`` if given
     Bowing()                     the bow on the string while v > 0
@@ -30,7 +31,9 @@ from dataclasses import dataclass, fields
 from studyapp.errors import ParameterError
 from studyapp.model.fmax_knob import KNOB_MAX, LIVE_RANGE, fmax_from_knob, knob_from_fmax
 
-__all__ = ["KNOB_MAX", "LIVE_RANGE", "FmaxKnob", "FmaxLinear", "Volume", "Source", "Select", "Bowing",
+VOLUME_DB = (-40.0, 0.0)  # the master volume's range: an attenuator, never above the chain's full level
+
+__all__ = ["KNOB_MAX", "LIVE_RANGE", "VOLUME_DB", "FmaxKnob", "FmaxLinear", "Volume", "Source", "Select", "Bowing",
            "HandTarget", "as_action", "as_actions", "knob_step", "knob_value"]
 
 
@@ -73,7 +76,24 @@ class FmaxLinear:
 
 @dataclass(frozen=True)
 class Volume:
-    """The sink's linear gain: the control's value."""
+    """The master volume: the console's slider and a volume knob share this law, so one level has one
+    knob position (pickup) and the console shows what a knob set."""
+
+    @staticmethod
+    def db(value):
+        low, high = VOLUME_DB
+        return low + min(max(value, 0.0), 1.0) * (high - low)
+
+    @staticmethod
+    def gain(value):
+        """The linear gain the sink applies at control value ``value`` (0..1)."""
+        return 10.0 ** (Volume.db(value) / 20.0)
+
+    @staticmethod
+    def value(db):
+        """The control value (0..1) of the volume ``db`` (dB, clipped to VOLUME_DB)."""
+        low, high = VOLUME_DB
+        return (min(max(db, low), high) - low) / (high - low)
 
 
 @dataclass(frozen=True)

@@ -97,7 +97,8 @@ def test_default_actions_drive_the_engine_commands():
         commands.SetFmax(pytest.approx(fmax_from_knob(100, *LIVE_RANGE)), sent=1.0),)
     assert made(actions["pad2"], 1.0, 2.0) == (commands.SetSource("LOWPASS", sent=2.0),)
     assert made(actions["pad2"], 0.0, 2.0) == ()  # releasing a pad does nothing
-    assert made(actions["knob2"], 0.5, 2.0) == (commands.SetVolume(0.5, sent=2.0),)
+    # the volume knob on the console's law, dB-linear from -40 dB to 0 dB: halfway is -20 dB
+    assert made(actions["knob2"], 0.5, 2.0) == (commands.SetVolume(pytest.approx(0.1), sent=2.0),)
     # a rating knob selects its condition whatever its position, even at the bottom, at the task's F_max
     assert made(("select", "LVT", 1.0), 0.0, 3.0) == (commands.SetSource("LVT", sent=3.0),
                                                       commands.SetFmax(1.0, sent=3.0))

@@ -29,7 +29,8 @@ def test_the_level_position_of_each_action():
     assert level_position(ADJUST["knob1"], 0.0, None) == 0
     assert level_position(ADJUST["knob1"], fmax_from_knob(77, 40.0, 2.0), None) == 77
     assert level_position(("fmax_linear", 0.0, 10.0), 5.0, None) == 64  # 63.5 steps: the nearer even step
-    assert level_position(("volume",), 0.0, 0.5) == 64
+    assert level_position(("volume",), 0.0, 0.1) == 64  # -20 dB: halfway on the console's -40..0 dB law
+    assert level_position(("volume",), 0.0, 0.0) == 0  # silent: the knob's bottom
     assert level_position(("volume",), 0.0, 3.0) == 127  # above the knob's range: its top
     assert level_position(("select", "KALLEV", 1.0), 1.0, None, rating=None) is None  # unrated: free
     assert level_position(("select", "KALLEV", 1.0), 1.0, None, rating=90) == 90

@@ -6,7 +6,7 @@ from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.run_plan import make_plan, plan_markdown
 from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import read_events
-from tests.gui.conftest import DEMO
+from tests.gui.conftest import DEMO, ENGINE_START, wait_until
 
 pytest.importorskip("pytestqt")
 
@@ -62,3 +62,15 @@ def test_notes_and_sound_reach_the_controller(tools, idle_console, tmp_path):
     tools.mute.setChecked(False)
     tools.volume.setValue(0)
     assert c.sound.db == 0.0 and not c.sound.muted
+
+
+def test_the_preview_volume_knob_moves_the_consoles_slider_without_a_second_record(tools, idle_console, qapp):
+    c = idle_console.controller
+    wait_until(qapp, lambda: c.engine is not None and c.at_rest, ENGINE_START)
+    try:
+        c.knob(1, 64)  # knob 2 in the preview: the worker applies the volume and reports it
+        wait_until(qapp, lambda: tools.volume.value() == -20, 10)
+        assert c.sound.db == pytest.approx(-40.0 + 40.0 * 64 / 127) and tools.volume_label.text() == "-20 dB"
+    finally:
+        tools.volume.setValue(0)
+    assert c.sound.db == 0.0

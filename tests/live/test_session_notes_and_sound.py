@@ -43,3 +43,23 @@ def test_volume_and_mute_send_the_engines_commands_are_logged_and_survive_a_new_
     for bad in (3.0, -41.0, float("nan")):
         with pytest.raises(UserError, match="allowed is -40 to 0 dB"):
             c.set_volume(bad)
+
+
+def test_the_preview_volume_knob_sets_the_one_master_volume_the_console_shows_and_a_new_engine_gets(controller):
+    c = controller
+    shown = []
+    c.events.volume.connect(lambda db: shown.append(db))
+    c.set_volume(-6.0)
+    engine = c.host.engine
+    before = len(engine.sent_of(cmd.SetVolume))
+    engine.control("knob2", 64 / 127)  # the preview's volume knob, on MIDI: the worker applies it
+    c.poll()
+    db = -40.0 + 40.0 * 64 / 127  # the console's law: dB-linear from -40 to 0 dB
+    assert c.sound.db == pytest.approx(db) and shown == [pytest.approx(db)]
+    assert len(engine.sent_of(cmd.SetVolume)) == before + 1  # the worker's own; the parent sends nothing back
+    engine.control("knob2", 0.0)
+    c.poll()
+    assert c.sound.db == -40.0 and c.sound.gain == pytest.approx(0.01)  # the bottom: -40 dB, not silence
+    start(c)  # a new engine for the session gets the volume the knob set last
+    up(c)
+    assert c.host.engine.sent_of(cmd.SetVolume)[0] == cmd.SetVolume(pytest.approx(0.01))

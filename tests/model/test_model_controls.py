@@ -61,3 +61,14 @@ def test_a_bad_spelling_is_one_line_naming_it(spelling, says):
     with pytest.raises(ParameterError) as info:
         as_action(spelling)
     assert says in str(info.value) and "\n" not in str(info.value)
+
+
+def test_the_volume_law_is_the_consoles_decibel_scale_and_inverts():
+    from studyapp.model.controls import VOLUME_DB
+
+    assert VOLUME_DB == (-40.0, 0.0)
+    assert Volume.gain(0.0) == pytest.approx(0.01) and Volume.gain(1.0) == 1.0
+    assert Volume.gain(0.5) == pytest.approx(0.1) and Volume.gain(2.0) == 1.0  # never above full level
+    for db in (-40.0, -27.5, -6.0, 0.0):
+        assert Volume.db(Volume.value(db)) == pytest.approx(db)
+    assert Volume.value(-90.0) == 0.0 and Volume.value(6.0) == 1.0
