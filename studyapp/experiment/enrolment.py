@@ -20,6 +20,7 @@ ever given twice.
 from pathlib import Path
 
 from studyapp.errors import UserError
+from studyapp.experiment.session_description import read_description, session_folders
 
 
 def is_simulated(info):
@@ -39,8 +40,6 @@ def apparatus_is_simulated(apparatus):
 
 def enrolled(study_folder):
     """{participant: simulated?} of every participant with a session under ``study_folder``."""
-    from studyapp.experiment.session import read_description, session_folders  # session imports this module
-
     folder = Path(study_folder)
     if not folder.is_dir():
         return {}

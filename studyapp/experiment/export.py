@@ -62,7 +62,8 @@ from studyapp.errors import InputDataError, UserError
 from studyapp.experiment import records
 from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.log_scan import written_twice
-from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description
+from studyapp.experiment.session_description import read_description
+from studyapp.experiment.session_files import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import TASK_TYPES, task_type
 from studyapp.experiment.trial_health import HEALTH_COLUMNS

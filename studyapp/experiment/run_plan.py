@@ -32,7 +32,9 @@ from pathlib import Path
 from studyapp.errors import UserError
 from studyapp.experiment.enrolment import enrolment_index, is_simulated
 from studyapp.experiment.schedule import Trial, build_schedule
-from studyapp.experiment.session import EVENTS_FILE, check_participant, read_description, session_folders
+from studyapp.experiment.session import check_participant
+from studyapp.experiment.session_description import read_description, session_folders
+from studyapp.experiment.session_files import EVENTS_FILE
 from studyapp.experiment.session_info import check_order_row, order_rows
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type

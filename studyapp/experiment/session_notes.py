@@ -31,7 +31,8 @@ import pandas as pd
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.export import session_folders_under
-from studyapp.experiment.session import EVENTS_FILE, SESSION_FILE, read_description, session_folders
+from studyapp.experiment.session_description import read_description, session_folders
+from studyapp.experiment.session_files import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_info import check_notes
 from studyapp.experiment.session_lock import ParticipantLock
 from studyapp.experiment.session_log import SessionLog, read_log
