@@ -24,5 +24,7 @@ def test_compile_runs_every_part_and_names_its_cache():
     assert proc.returncode == 0, proc.stderr
     lines = proc.stderr.splitlines()
     assert lines[0] == f"compile: {len(PARTS)} parts into {os.environ['NUMBA_CACHE_DIR']}"  # conftest set it
-    assert {line.split(" ", 1)[1].rsplit(" ", 2)[0] for line in lines[1:-1]} == set(PARTS)
+    assert {line.split(" ", 1)[1].rsplit(" ", 5)[0] for line in lines[1:-1]} == set(PARTS)
+    counts = [line.rsplit("(", 1)[1] for line in lines[1:-1]]
+    assert counts == [f"{k} of {len(PARTS)})" for k in range(1, len(PARTS) + 1)]
     assert lines[-1].startswith("compile: done in ")

@@ -23,7 +23,7 @@ callees the parts share.)
 import os
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 JOBS_MAX = 8
 
@@ -126,7 +126,9 @@ def run(args):
     start = time.monotonic()
     print(f"compile: {len(PARTS)} parts into {os.environ.get('NUMBA_CACHE_DIR')}", file=sys.stderr, flush=True)
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-        for name, seconds in zip(PARTS, pool.map(_timed, PARTS)):
-            print(f"compile: {name} {seconds:.1f} s", file=sys.stderr, flush=True)
+        parts = {pool.submit(_timed, name): name for name in PARTS}
+        for done, part in enumerate(as_completed(parts), start=1):
+            print(f"compile: {parts[part]} {part.result():.1f} s ({done} of {len(PARTS)})", file=sys.stderr,
+                  flush=True)
     print(f"compile: done in {time.monotonic() - start:.1f} s", file=sys.stderr)
     return 0

@@ -283,10 +283,13 @@ class SessionController:
         """The master volume, in dB (master_sound.py); logged during a session."""
         self._sound_event(self.sound.set_db(db))
 
-    def volume_applied(self, gain):
+    def volume_applied(self, gain, arrived):
         """The worker applied a volume knob's ``gain``: the master volume now (logged during a session), and
-        the console's slider follows (``events.volume``); nothing is sent back."""
-        record = self.sound.adopt(gain)
+        the console's slider follows (``events.volume``); nothing is sent back. Stale reports are dropped
+        (master_sound.py)."""
+        record = self.sound.adopt(gain, arrived)
+        if record is None:
+            return
         if self.session is not None:
             self._log_session(record)
         self.events.volume.emit(db=self.sound.db)

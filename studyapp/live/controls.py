@@ -116,7 +116,7 @@ class Controls:
             live.events.knob.emit(index=knob, value=knob_step(record.value))
         for command in record.commands:
             if isinstance(command, cmd.SetVolume):  # the preview's volume knob: the one volume record follows
-                live.volume_applied(command.gain)
+                live.volume_applied(command.gain, record.arrived)
         if not ours:
             return
         if runner.loop is not None:

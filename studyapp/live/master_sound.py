@@ -8,7 +8,10 @@ attenuator, never louder than the chain's own full level. The preview's
 volume knob (knob 2) has the same law (model/controls.py ``Volume``); the
 worker applies it, and what it applied becomes this setting (``adopt``), so
 the console shows it and every engine that comes up gets it: the volume has
-one record, whichever control set it last. The setting
+one record, whichever control set it last. "Last" is the worker's order: a
+knob's report that comes back after the console sent its own volume, for a
+message that arrived before, is stale (the worker applied the console's
+after it) and is not adopted. The setting
 belongs to the console, not to an engine: every engine that comes up (a
 session's, a restarted one, the preview after it) gets it again
 (``commands``). During a session every change is logged as an event,
@@ -29,6 +32,7 @@ class MasterSound:
     def __init__(self):
         self.db = 0.0
         self.muted = False
+        self.sent = -math.inf  # when the console's volume last went to an engine (time.monotonic)
 
     @property
     def gain(self):
@@ -42,8 +46,12 @@ class MasterSound:
         self.db = float(db)
         return records.volume(self.db, self.gain)
 
-    def adopt(self, gain):
-        """The worker applied a volume knob's ``gain``: it is the setting now; returns the event to log."""
+    def adopt(self, gain, arrived):
+        """The worker applied a volume knob's ``gain``, the knob's message having ``arrived`` (monotonic s):
+        the setting now, and the event to log; None when the console's own setting went out after that
+        message (the worker applied it later, so it holds)."""
+        if arrived < self.sent:
+            return None
         low, high = DB_RANGE
         self.db = min(max(20.0 * math.log10(gain), low), high) if gain > 0 else low
         return records.volume(self.db, self.gain)
@@ -53,5 +61,7 @@ class MasterSound:
         return records.mute(self.muted)
 
     def commands(self):
-        """The commands that give an engine this setting."""
-        return cmd.SetVolume(self.gain), cmd.SetMute(self.muted)
+        """The commands that give an engine this setting (``sent``: when the volume went out)."""
+        volume = cmd.SetVolume(self.gain)
+        self.sent = volume.sent
+        return volume, cmd.SetMute(self.muted)

@@ -56,6 +56,7 @@ def test_notes_and_sound_reach_the_controller(tools, idle_console, tmp_path):
         assert tools.add_note() is None and "Note not logged" in tools.message.text()
     finally:
         c.last_session = saved
+    tools.volume.setValue(0)  # an earlier test's knob 2 may have left the slider at -12 (adopted, not sent)
     tools.volume.setValue(-12)
     tools.mute.setChecked(True)
     assert c.sound.db == -12.0 and c.sound.muted and tools.volume_label.text() == "-12 dB"
@@ -68,9 +69,12 @@ def test_the_preview_volume_knob_moves_the_consoles_slider_without_a_second_reco
     c = idle_console.controller
     wait_until(qapp, lambda: c.engine is not None and c.at_rest, ENGINE_START)
     try:
+        tools.volume.setValue(-5)
+        assert c.sound.db == -5.0
         c.knob(1, 64)  # knob 2 in the preview: the worker applies the volume and reports it
-        wait_until(qapp, lambda: tools.volume.value() == -20, 10)
-        assert c.sound.db == pytest.approx(-40.0 + 40.0 * 64 / 127) and tools.volume_label.text() == "-20 dB"
+        db = -40.0 + 40.0 * 64 / 127
+        wait_until(qapp, lambda: c.sound.db == pytest.approx(db), 10)
+        assert tools.volume.value() == -20 and tools.volume_label.text() == "-20 dB"
     finally:
         tools.volume.setValue(0)
     assert c.sound.db == 0.0

@@ -7,6 +7,8 @@ telemetry block of n samples tagged likewise, which the host's ``read``
 returns once.
 """
 
+import time
+
 import numpy as np
 
 from studyapp.engine import commands as cmd
@@ -62,16 +64,18 @@ class FakeEngine:
         elif isinstance(command, cmd.ClearFault):
             self.latched = False
         elif isinstance(command, cmd.Control):
-            self.control(command.control, command.value, "screen")
+            self.control(command.control, command.value, "screen", arrived=command.sent)
 
-    def control(self, name, value, origin="midi"):
+    def control(self, name, value, origin="midi", arrived=None):
+        """A control reaches the worker (a MIDI message now; an on-screen one when its command was sent)."""
+        arrived = time.monotonic() if arrived is None else arrived
         action = self.actions.get(name)
-        commands = cmd.action_commands(action, value, 0.0) if action else ()
+        commands = cmd.action_commands(action, value, arrived) if action else ()
         for command in commands:
             self.sent.append(command)
             if isinstance(command, cmd.SetFmax):
                 self.fmax = command.newtons
-        self._controls.append(Applied(name, value, 0.0, LATENCY if commands else None, 0, 0, self.trial,
+        self._controls.append(Applied(name, value, arrived, LATENCY if commands else None, 0, 0, self.trial,
                                       commands, origin))
 
     def pending(self, name, value, target):

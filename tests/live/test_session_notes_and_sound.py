@@ -63,3 +63,16 @@ def test_the_preview_volume_knob_sets_the_one_master_volume_the_console_shows_an
     start(c)  # a new engine for the session gets the volume the knob set last
     up(c)
     assert c.host.engine.sent_of(cmd.SetVolume)[0] == cmd.SetVolume(pytest.approx(0.01))
+
+
+def test_a_volume_knobs_late_report_does_not_undo_the_consoles_later_volume(controller):
+    """The worker applied knob 2, then the console's -12 dB: the knob's report, read after, is stale."""
+    c = controller
+    engine = c.host.engine
+    engine.control("knob2", 90 / 127)  # applied by the worker; its report waits ...
+    c.set_volume(-12.0)  # ... while the console's volume goes out, and is applied after it
+    c.poll()
+    assert c.sound.db == -12.0 and engine.sent_of(cmd.SetVolume)[-1] == cmd.SetVolume(pytest.approx(10 ** -0.6))
+    engine.control("knob2", 90 / 127)  # a turn after it: the knob's level holds now
+    c.poll()
+    assert c.sound.db == pytest.approx(-40.0 + 40.0 * 90 / 127)
