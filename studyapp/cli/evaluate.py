@@ -120,7 +120,10 @@ def run(args):
                 cells = "  ".join(f"{k[4:]} {v:.4g}" if v is not None else f"{k[4:]} inf"
                                   for k, v in row.items() if k.startswith("F_g "))
                 pct = "-" if row["spread_pct"] is None else f"{row['spread_pct']:.2f} %"
-                print(f"  {row['estimator']:<11} {cells}  spread {pct}")
+                apart = "" if row["delays_apart"] is None else (
+                    f"  |D| apart on {row['delays_apart']} recordings (at most {row['max_delay_apart']}),"
+                    f" E apart {row['error_spread_pct']:.1f} %")
+                print(f"  {row['estimator']:<11} {cells}  spread {pct}{apart}")
     return 0
 
 

@@ -13,7 +13,14 @@ the relative loss of the worst file against the best (issue 23 asks for at
 most 2 % over seeds 0-2), and ``spread`` = max - min in units of F_g. Under
 the common scale the best (file, estimator) pair on every objective scores
 0, so ``spread_pct`` is empty (None) where the best F_g is 0 and the files
-differ; a diverged estimator (F_g infinite) leaves both empty. (A file's own ``[objective]`` table cannot be
+differ; a diverged estimator (F_g infinite) leaves both empty.
+
+Where F_g differs, what differs: ``delays_apart``, the recordings on which the
+files' |D_r| (eq. 22, whole samples) are not all equal, ``max_delay_apart``,
+the largest such difference (samples), and ``error_spread_pct``, the largest
+100 (max - min) / min of E_r (eq. 24) over the recordings. Under a common
+scale whose delay spread S_i is one sample, one sample on one recording
+moves F_g by a whole unit (docs/evaluation.md). (A file's own ``[objective]`` table cannot be
 compared across files: each run's final scale is its own.) Only estimators
 present in every file are compared.
 """
@@ -37,8 +44,21 @@ def seed_spread(dataset, sets):
         pct = 0.0 if high == low else 100.0 * (high - low) / abs(low) if finite and low != 0 else None
         rows.append({"estimator": name, **{f"F_g {label}": v if np.isfinite(v) else None
                                            for label, v in zip(labels, values)},
-                     "spread": high - low if finite else None, "spread_pct": pct})
+                     "spread": high - low if finite else None, "spread_pct": pct,
+                     **apart(np.array([raws[label, name] for label in labels]))})
     return rows
+
+
+def apart(raws):
+    """What differs between the files' raw objectives (rows: files; eq. 28's [E_0, |D_0|, E_1, ...])."""
+    errors, delays = raws[:, 0::2], raws[:, 1::2]
+    if not np.all(np.isfinite(raws)):
+        return {"delays_apart": None, "max_delay_apart": None, "error_spread_pct": None}
+    gaps = delays.max(axis=0) - delays.min(axis=0)
+    low = errors.min(axis=0)
+    spread = np.divide(errors.max(axis=0) - low, low, out=np.zeros_like(low), where=low > 0)
+    return {"delays_apart": int(np.count_nonzero(gaps)), "max_delay_apart": int(gaps.max()),
+            "error_spread_pct": float(100.0 * spread.max())}
 
 
 def labels(paths, provenances):

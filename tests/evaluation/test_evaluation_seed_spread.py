@@ -35,6 +35,14 @@ def test_seed_spread_scores_every_file_under_one_scale(tmp_path, short_recording
     f = [global_objective(raws[i], offsets, scales) for i in (0, 2, 4)]
     assert np.allclose([float(rows["LOWPASS"][f"F_g seed {s}"]) for s in (0, 1, 2)], f, rtol=1e-12)
     assert np.isclose(float(rows["LOWPASS"]["spread"]), max(f) - min(f), rtol=1e-12)
+    lowpass = np.array([raws[i] for i in (0, 2, 4)])
+    gaps = lowpass[:, 1::2].max(axis=0) - lowpass[:, 1::2].min(axis=0)
+    assert int(rows["LOWPASS"]["delays_apart"]) == np.count_nonzero(gaps)
+    assert int(rows["LOWPASS"]["max_delay_apart"]) == gaps.max()
+    errors = lowpass[:, 0::2]
+    assert np.isclose(float(rows["LOWPASS"]["error_spread_pct"]),
+                      100 * np.max((errors.max(axis=0) - errors.min(axis=0)) / errors.min(axis=0)), rtol=1e-12)
+    assert rows["LEVANT"]["delays_apart"] == "0" and float(rows["LEVANT"]["error_spread_pct"]) == 0.0
     if min(f) != 0:
         assert np.isclose(float(rows["LOWPASS"]["spread_pct"]), 100 * (max(f) - min(f)) / abs(min(f)), rtol=1e-12)
     else:  # the best pair on every objective scores 0: no relative spread
