@@ -25,8 +25,6 @@ an on-screen knob) must first be turned through the new level. Positions are
 knob steps (0..127). On-screen knobs show the level itself and need no pickup.
 """
 
-import math
-
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine.midi import coalesce
@@ -54,7 +52,7 @@ def level_position(action, fmax, volume, rating=None):
         case FmaxLinear(low, high):
             return _step((fmax - low) / (high - low))
         case Volume() as law:
-            return _step(law.value(20.0 * math.log10(volume)) if volume > 0 else 0.0)
+            return _step(law.value_of_gain(volume))
         case Select():
             return rating
     return None

@@ -13,16 +13,16 @@ the relative loss of the worst file against the best (issue 23 asks for at
 most 2 % over seeds 0-2), and ``spread`` = max - min in units of F_g. Under
 the common scale the best (file, estimator) pair on every objective scores
 0, so ``spread_pct`` is empty (None) where the best F_g is 0 and the files
-differ; a diverged estimator (F_g infinite) leaves both empty.
+differ; a diverged estimator (F_g infinite) leaves both empty. (A file's own
+``[objective]`` table cannot be compared across files: each run's final scale
+is its own.) Only estimators present in every file are compared.
 
 Where F_g differs, what differs: ``delays_apart``, the recordings on which the
 files' |D_r| (eq. 22, whole samples) are not all equal, ``max_delay_apart``,
 the largest such difference (samples), and ``error_spread_pct``, the largest
 100 (max - min) / min of E_r (eq. 24) over the recordings. Under a common
 scale whose delay spread S_i is one sample, one sample on one recording
-moves F_g by a whole unit (docs/evaluation.md). (A file's own ``[objective]`` table cannot be
-compared across files: each run's final scale is its own.) Only estimators
-present in every file are compared.
+moves F_g by a whole unit (docs/evaluation.md).
 """
 
 import numpy as np

@@ -24,7 +24,7 @@ def session_folders(participant_folder):
     return sorted({p.parent for name in (SESSION_FILE, EVENTS_FILE) for p in folder.glob(f"*/{name}")})
 
 
-def check_description(info, where):
+def _check_description(info, where):
     if not isinstance(info, dict) or info.get("format") != FORMAT:
         got = info.get("format") if isinstance(info, dict) else type(info).__name__
         raise ValueError(f"format {got!r}, allowed is {FORMAT!r}")
@@ -44,12 +44,12 @@ def read_description(folder):
     path = folder / SESSION_FILE
     try:
         with open_regular(path, "session description", "r", encoding="utf-8") as f:  # a FIFO is damaged, not waited on
-            return check_description(json.loads(f.read(LIMIT_BYTES)), path), []
+            return _check_description(json.loads(f.read(LIMIT_BYTES)), path), []
     except (OSError, ValueError, UnicodeDecodeError) as exc:
         problem = "missing" if isinstance(exc, FileNotFoundError) else f"damaged ({exc})"
     created = next((e for e in read_log(folder / EVENTS_FILE).events if e.get("type") == CREATED), None)
     try:
-        info = check_description(created.get("description") if created else None, path)
+        info = _check_description(created.get("description") if created else None, path)
     except ValueError:
         raise UserError(f"{path}: {problem}, and {folder / EVENTS_FILE} holds no session description to rebuild "
                         "it from: allowed is to restore session.json from a backup") from None

@@ -33,7 +33,7 @@ from PySide6.QtWidgets import (
 from studyapp.errors import UserError
 from studyapp.experiment.run_plan import make_plan, plan_markdown
 from studyapp.io.atomic import atomic_open
-from studyapp.live.master_sound import DB_RANGE
+from studyapp.model.controls import VOLUME_DB
 
 
 class RunSheetDialog(QDialog):
@@ -93,7 +93,7 @@ class SessionTools(QGroupBox):
         self.note_button.clicked.connect(self.add_note)
         self.mute = QCheckBox("Mute")
         self.mute.toggled.connect(controller.set_mute)
-        low, high = DB_RANGE
+        low, high = VOLUME_DB
         self.volume = QSlider(Qt.Orientation.Horizontal)
         self.volume.setRange(int(low), int(high))
         self.volume.setValue(int(high))

@@ -23,9 +23,7 @@ import math
 from studyapp.engine import commands as cmd
 from studyapp.errors import UserError
 from studyapp.experiment import records
-from studyapp.model.controls import VOLUME_DB
-
-DB_RANGE = VOLUME_DB
+from studyapp.model.controls import VOLUME_DB, Volume
 
 
 class MasterSound:
@@ -39,8 +37,8 @@ class MasterSound:
         return 10.0 ** (self.db / 20.0)
 
     def set_db(self, db):
-        """Set the volume (dB, in ``DB_RANGE``); returns the event to log."""
-        low, high = DB_RANGE
+        """Set the volume (dB, in ``VOLUME_DB``); returns the event to log."""
+        low, high = VOLUME_DB
         if not (isinstance(db, (int, float)) and math.isfinite(db) and low <= db <= high):
             raise UserError(f"volume {db!r} dB: allowed is {low:g} to {high:g} dB")
         self.db = float(db)
@@ -52,8 +50,7 @@ class MasterSound:
         message (the worker applied it later, so it holds)."""
         if arrived < self.sent:
             return None
-        low, high = DB_RANGE
-        self.db = min(max(20.0 * math.log10(gain), low), high) if gain > 0 else low
+        self.db = Volume.db(Volume.value_of_gain(gain))
         return records.volume(self.db, self.gain)
 
     def set_muted(self, on):

@@ -26,6 +26,7 @@ kinds of ``KINDS`` (e.g. ``("fmax_log", 40.0, 2.0)``, ``("select", "KALLEV",
 1.0)``); ``as_action`` reads it.
 """
 
+import math
 from dataclasses import dataclass, fields
 
 from studyapp.errors import ParameterError
@@ -94,6 +95,11 @@ class Volume:
         """The control value (0..1) of the volume ``db`` (dB, clipped to VOLUME_DB)."""
         low, high = VOLUME_DB
         return (min(max(db, low), high) - low) / (high - low)
+
+    @staticmethod
+    def value_of_gain(gain):
+        """The control value (0..1) of a linear ``gain`` (0, silence, is the bottom)."""
+        return Volume.value(20.0 * math.log10(gain)) if gain > 0 else 0.0
 
 
 @dataclass(frozen=True)
