@@ -18,6 +18,7 @@ PAPER_PATIENCE = 1000  # the paper's stopping rule
 # with 2, seeds 0-2 gave F_g within 2 % of each other for 10 of the 13 estimators (docs/evaluation.md).
 RESTARTS = 2
 RESTARTS_MAX = 50  # lanes share the patience: more only split it thinner
+RIDGE = 0.5  # share of proposals drawn along the lane's elite (search.py); measured in docs/evaluation.md
 # Each set costs a closed-loop simulation per case (eight by default): at a tenth of the paper's rule a run
 # of the thirteen took 2549 sets, 170 s of CPU (docs/evaluation.md).
 PERCEPTUAL_PATIENCE = 100
@@ -43,6 +44,9 @@ def register(sub):
     p.add_argument("--restarts", type=int, default=RESTARTS, metavar="N",
                    help=f"restarts of each estimator's search from drawn points, sharing the patience "
                         f"(default {RESTARTS}; 0: one search from Table 1, as before restarts)")
+    p.add_argument("--ridge", type=number_options.finite_float, default=RIDGE, metavar="FRACTION",
+                   help=f"share of draws made along the ridge of the best sets found "
+                        f"(default {RIDGE}; 0: none, as before ridge draws)")
     p.add_argument("--reference", choices=("lvt", "true"), default="lvt",
                    help="reference velocity: the LVT tachometer (paper) or the true velocity (default lvt)")
     p.add_argument("--tune", choices=("paper", "all"), default="paper",
@@ -95,6 +99,8 @@ def run(args):
         raise UserError(f"--max-sets {args.max_sets}: allowed is an integer of at least 1")
     if not 0 <= args.restarts <= RESTARTS_MAX:
         raise UserError(f"--restarts {args.restarts}: allowed is an integer from 0 to {RESTARTS_MAX}")
+    if not 0.0 <= args.ridge <= 1.0:
+        raise UserError(f"--ridge {args.ridge:g}: allowed is a fraction from 0 to 1")
     check_workers(args.workers)
     names = estimator_names(args.estimators, PAPER_ESTIMATORS)
     cases = perceptual_options.cases(args, 5000.0 if args.rate is None else args.rate, perceptual,
@@ -133,7 +139,7 @@ def run(args):
         initializer, initargs = warm_up, (tuple(names), rate, True)
     optimiser = Optimiser(
         spaces, objective, None, patience=args.patience, seed=args.seed, restarts=args.restarts,
-        max_sets=args.max_sets, checkpoint=checkpoint, fingerprint=fingerprint,
+        ridge=args.ridge, max_sets=args.max_sets, checkpoint=checkpoint, fingerprint=fingerprint,
         progress=None if args.quiet else Progress(sys.stderr),
     )
     if perceptual and not args.quiet:
@@ -158,7 +164,7 @@ def run(args):
         objective_values = result.objectives
     info = provenance(
         command="studyapp optimise", objective=args.objective, seed=args.seed, patience=args.patience,
-        restarts=args.restarts,
+        restarts=args.restarts, ridge=args.ridge,
         tune=args.tune, rate=rate, **settings, iterations=result.iterations,
         parameter_sets_evaluated=result.evaluated, seconds=round(result.seconds, 3), resumed=result.resumed,
     )

@@ -14,7 +14,8 @@ One iteration:
 
 With ``restarts`` the searches run in lanes (``search.py``); a lane whose best
 is not the estimator's is judged here, against its own best under the same
-memorised scale as the step's decisions.
+memorised scale as the step's decisions. Each search is also told the F_g of
+its candidate and of its lane's best under that scale, for its ridge draws.
 
 Work is sent to the executor in few, large tasks: an iteration's sets go out
 together, one task per worker (``executors.parallelism``). An objective that
@@ -110,11 +111,13 @@ class Optimiser:
     for the rate (windows kept in seconds).
     ``restarts``: lanes of each search that start from drawn points (``search.py``; 0: none,
     the search as it was before restarts, draw for draw).
+    ``ridge``: the share of proposals drawn along the lane's elite (``search.py``; 0: none, the
+    search as it was before ridge draws, draw for draw).
     """
 
     def __init__(self, spaces, objective, executor, patience=1000, seed=0, tolerance=None,
                  max_sets=None, checkpoint=None, checkpoint_interval=30.0, progress=None, fingerprint=None,
-                 starts=None, restarts=0):
+                 starts=None, restarts=0, ridge=0.0):
         if not spaces:
             raise UserError("no estimators to optimise")
         self.spaces = dict(spaces)
@@ -127,6 +130,9 @@ class Optimiser:
         self.restarts = int(restarts)
         if self.restarts < 0:
             raise UserError(f"--restarts {restarts}: allowed is an integer of at least 0")
+        self.ridge = float(ridge)
+        if not 0.0 <= self.ridge <= 1.0:
+            raise UserError(f"--ridge {ridge}: allowed is a fraction from 0 to 1")
         self.tolerance = tolerance
         self.max_sets = None if max_sets is None else int(max_sets)
         if self.max_sets is not None and self.max_sets < 1:
@@ -137,13 +143,14 @@ class Optimiser:
         starts = dict(starts or {})
         self.fingerprint = {
             "seed": self.seed, "patience": self.patience, "max_sets": self.max_sets, "restarts": self.restarts,
+            **({"ridge": self.ridge} if self.ridge else {}),
             "spaces": {name: space.describe() for name, space in self.spaces.items()},
             **({"starts": starts} if starts else {}),
             **(fingerprint or {}),
         }
         self.searches = {
             name: AdaptiveSearch(space, estimator_seed(self.seed, name), self.patience, starts.get(name),
-                                 self.restarts)
+                                 self.restarts, self.ridge)
             for name, space in self.spaces.items()
         }
         self.sum = None
@@ -187,15 +194,15 @@ class Optimiser:
             self.evaluated += 1
         return {name: raws[name] for name in proposals}
 
-    def _lanes_improved(self, raws):
-        """name -> whether its candidate beats the best of its search's lane, where that is not the
-        estimator's best (``search.py``: restarts); False otherwise (the objective sum decides)."""
-        lanes = {}
+    def _judged(self, raws):
+        """name -> (F_g of its candidate, F_g of its search's lane best) under the scale in force, as
+        the step's decisions are; the lane's best is the estimator's unless a restart lane has its own."""
+        judged = {}
         for name, raw in raws.items():
             lane_raw = self.searches[name].lane_raw
-            lanes[name] = lane_raw is not None and bool(
-                self.sum.objective(raw) < self.sum.objective(lane_raw) - self.sum.tolerance)
-        return lanes
+            judged[name] = (self.sum.objective(raw),
+                            self.sum.objective(self.sum.best[name] if lane_raw is None else lane_raw))
+        return judged
 
     def _active(self):
         return [name for name, s in self.searches.items()
@@ -255,11 +262,15 @@ class Optimiser:
                 # Steps 5-8.
                 proposals = {name: self.searches[name].propose() for name in active}
                 raws = self._evaluate(proposals)
-                lanes = self._lanes_improved(raws)  # under the scale in force, as the decisions are
+                judged = self._judged(raws)
                 decisions = self.sum.step(raws)
                 for name in active:
                     accepted = decisions[name].accepted
-                    self.searches[name].report(proposals[name], accepted, accepted or lanes[name], raws[name])
+                    value, lane_value = judged[name]
+                    own_lane = self.searches[name].lane_raw is not None
+                    lane_improved = accepted or (own_lane and bool(value < lane_value - self.sum.tolerance))
+                    self.searches[name].report(proposals[name], accepted, lane_improved, raws[name],
+                                               value, lane_value)
                 self.seconds = time.monotonic() - started
                 self._snapshot = self.state()
                 self._report(final=False)

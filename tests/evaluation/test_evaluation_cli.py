@@ -43,6 +43,8 @@ def test_bad_settings(short_recording, tmp_path, capsys):
     fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(out), "--patience", "0"], "--patience")
     fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(out), "--max-sets", "0"], "--max-sets")
     fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(out), "--restarts", "-1"], "--restarts")
+    for ridge in ("1.5", "-0.1", "nan"):
+        fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(out), "--ridge", ridge], "--ridge")
     fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(tmp_path / "P.txt")], ".toml")
     fails_with_one_line(capsys, ["optimise", str(short_recording), "-o", str(out), "--resume"], "checkpoint")
     fails_with_one_line(capsys, ["tradeoff", "--rates", "500", "-o", str(tmp_path / "t")], "rate")
