@@ -232,7 +232,7 @@ def test_tune_gives_the_parameters_of_optimise_on_the_same_recordings(tmp_path):
     params = tmp_path / "P.toml"
     assert main(["optimise", str(tmp_path / "fmax_0.5.npz"), str(tmp_path / "fmax_2.2.npz"), "-o", str(params),
                  "--estimators", names, "--patience", "3", "--seed", "0", "--workers", "1", "--restarts", "0",
-                 "--quiet"]) == 0  # tradeoff --tune searches without restarts (patience 20: lanes of 5 sets)
+                 "--ridge", "0", "--quiet"]) == 0  # tradeoff --tune: no restarts (patience 20: lanes of 5 sets), no ridge
     tuned = tomllib.loads(params.read_text())
     rows = {r["estimator"]: r for r in _rows(out)}
     assert {n: rows[n]["parameters"] for n in ("LOWPASS", "COMP1")} == {n: tuned[n] for n in ("LOWPASS", "COMP1")}
