@@ -25,6 +25,7 @@ import time
 
 import numpy as np
 
+from studyapp.cli.optimise import RESTARTS, RIDGE
 from studyapp.evaluation import params_file
 from studyapp.evaluation.dataset import Dataset, expand_paths, load_takes, warm_up
 from studyapp.evaluation.normalisation import bounds, global_objective
@@ -39,8 +40,8 @@ def main():
     parser.add_argument("--params", nargs="+", required=True, help="parameter files giving the common scale")
     parser.add_argument("--estimator", required=True)
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
-    parser.add_argument("--restarts", type=int, default=2)
-    parser.add_argument("--ridge", type=float, default=0.5)
+    parser.add_argument("--restarts", type=int, default=RESTARTS)
+    parser.add_argument("--ridge", type=float, default=RIDGE)
     parser.add_argument("--patience", type=int, default=1000)
     args = parser.parse_args()
 
