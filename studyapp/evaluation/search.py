@@ -109,8 +109,8 @@ class AdaptiveSearch:
             return dict(self.best)
         if self.lane_best is None:  # a restart lane's first set: a point drawn over the whole space
             return self._draw(lambda: self.rng.random(d))
-        axis = self._axis()
-        if axis is not None and self.rng.random() < self.ridge:
+        if self.ridge > 0.0 and len(self.elite) >= MIN_ELITE and self.rng.random() < self.ridge:
+            axis = self._axis()  # only for a ridge draw: an eigendecomposition per proposal otherwise
             return self._draw(lambda: self._along(*axis))
         steps = np.array([dim.step for dim in self.space.dims])
         radius = np.maximum(self.radius, steps)
