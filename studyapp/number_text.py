@@ -14,6 +14,12 @@ def to_float(text):
     return float(text)
 
 
+def shown(value):
+    """``value`` as short text that reads back as the same float: ``{:g}`` unless it rounds (96000.0001)."""
+    short = f"{value:g}"
+    return short if float(short) == value else repr(float(value))
+
+
 def to_int(text):
     """``int(text)`` for a str (``ValueError`` if it holds an underscore)."""
     if isinstance(text, str) and "_" in text:

@@ -3,7 +3,9 @@
 Warnings are errors here. Recordings are short (0.5 s; simulate-set 0.2 s each)
 and estimators few where a command lets us choose, so the whole file stays fast.
 At 1 kHz Table 1's COMP2 (a 2,254 Hz high-pass) cannot exist: the commands
-that run it by default report it as not available and go on.
+that run it by default report it as not available and go on. At 1 kHz the
+string plays only f0 <= rate / 6 (model/playable.py): the recording is made
+with --f0 150, and simulate-set, which plays the model's 440 Hz, refuses.
 """
 
 import csv
@@ -30,13 +32,21 @@ def _run(capsys, argv):
 def recording(request, tmp_path_factory):
     rate = request.param
     path = tmp_path_factory.mktemp(f"rate{rate:g}") / "fmax_1.npz"
-    assert main(["simulate", "--rate", f"{rate:g}", "--duration", "0.5", "--fmax", "1", "-o", str(path)]) == 0
+    f0 = ["--f0", "150"] if rate < 2640 else []
+    assert main(["simulate", "--rate", f"{rate:g}", *f0, "--duration", "0.5", "--fmax", "1", "-o", str(path)]) == 0
     return rate, path
 
 
 def test_simulate_set(recording, tmp_path, capsys):
     rate, _ = recording
-    _run(capsys, ["simulate-set", "--rate", f"{rate:g}", "--duration", "0.2", "-o", str(tmp_path / "set")])
+    argv = ["simulate-set", "--rate", f"{rate:g}", "--duration", "0.2", "-o", str(tmp_path / "set")]
+    if rate < 2640:  # the model's 440 Hz string needs 2.64 kHz
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and "rate 1000 Hz with f0 440 Hz" in err
+        assert not (tmp_path / "set").exists()
+        return
+    _run(capsys, argv)
     assert len(list((tmp_path / "set").glob("fmax_*.npz"))) == 15
 
 

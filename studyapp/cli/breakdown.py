@@ -65,10 +65,11 @@ def run(args):
     import sys
 
     from studyapp.estimators.spec import validate_rate
-    from studyapp.model import breakdown
+    from studyapp.model import breakdown, calibration
+    from studyapp.model.playable import check_playable
 
     names = breakdown.sources() if args.all else [breakdown.check_source(args.source, "--source")]
-    validate_rate(args.rate)
+    check_playable(validate_rate(args.rate), calibration.F0)
     breakdown.check_seeds(args.seeds, "--seeds")
     breakdown.check_gesture(args.gesture, "--gesture")
     breakdown.check_duration(args.duration, "--duration")

@@ -41,14 +41,37 @@ def check_gesture(name):
         raise ParameterError(f"--gesture {name!r}: allowed are {', '.join(allowed)}")
 
 
+def check_disk(path, suffix, samples, columns):
+    """One-line ``UserError`` when the output's folder has not the room the recording needs (before any work)."""
+    import shutil
+    from pathlib import Path
+
+    from studyapp.errors import UserError
+    from studyapp.io.recording_writer import bytes_needed
+
+    need = bytes_needed(suffix, samples, columns)
+    folder = Path(path).resolve().parent
+    free = shutil.disk_usage(folder).free
+    if need > free:
+        raise UserError(f"-o {path}: the recording needs about {need / 1e6:,.0f} MB and {folder} has "
+                        f"{free / 1e6:,.0f} MB free: allowed is a shorter --duration, a lower --rate or "
+                        f"another folder")
+
+
 def run(args):
     import sys
+    import time
+    from pathlib import Path
 
-    from studyapp.io import recording
     from studyapp.cli import output_paths
+    from studyapp.errors import ParameterError
     from studyapp.estimators.spec import validate_rate
-    from studyapp.model.simulate import simulate
-    from studyapp.model.loop import check_fmax
+    from studyapp.io import recording
+    from studyapp.io.recording_writer import RecordingWriter
+    from studyapp.model import calibration
+    from studyapp.model.loop import check_f0, check_fmax
+    from studyapp.model.playable import check_playable
+    from studyapp.model.simulate import DURATION_MAX, Simulation
     from studyapp.model.sources import LVT_SENSOR
 
     if args.source is None:
@@ -56,22 +79,34 @@ def run(args):
     recording.check_path(args.output)
     output_paths.check_file(args.output)
     rate = validate_rate(args.rate)
-    if 0 < args.duration and round(args.duration * rate) < 1:  # would write a recording with no samples
-        from studyapp.errors import ParameterError
-
+    if not 0 < args.duration <= DURATION_MAX:
+        raise ParameterError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
+                             f"{DURATION_MAX:g}")
+    if round(args.duration * rate) < 1:  # would write a recording with no samples
         raise ParameterError(f"--duration {args.duration:g}: allowed is at least one sample, {1 / rate:g} s at "
                              f"{rate:g} Hz")
-    check_fmax(args.fmax)
+    fmax = check_fmax(args.fmax)
+    check_playable(rate, check_f0(calibration.F0 if args.f0 is None else args.f0))
     check_source(args.source)
     check_gesture(args.gesture)
+    samples = int(round(args.duration * rate))
+    check_disk(args.output, Path(args.output).suffix.lower(), samples, len(recording.COLUMNS))
+
+    sim = Simulation(fmax, rate=rate, duration=args.duration, source=args.source, gesture=args.gesture,
+                     f0=args.f0, seed=args.seed)
+    started = time.monotonic()
 
     def progress(done, total):
-        print(f"\rsimulate: {100 * done // total:3d}%", end="", file=sys.stderr, flush=True)
+        elapsed = time.monotonic() - started
+        left = elapsed * (total - done) / done if done else 0.0
+        print(f"\rsimulate: {100 * done // total:3d}% ({done / rate:,.1f} of {total / rate:,.1f} s, "
+              f"about {left:,.0f} s left)", end="", file=sys.stderr, flush=True)
 
-    rec = simulate(args.fmax, rate=args.rate, duration=args.duration, source=args.source,
-                   gesture=args.gesture, f0=args.f0, seed=args.seed, progress=progress)
+    with RecordingWriter(args.output, recording.COLUMNS) as writer:
+        for block in sim.blocks(progress):
+            writer.write(block)
+        writer.finish(sim.rate, sim.meta())
     print("", file=sys.stderr)
-    recording.save(rec, args.output)
-    print(f"wrote {args.output} ({len(rec)} samples at {rec.rate:g} Hz, F_max {args.fmax:g} N, source {args.source})",
+    print(f"wrote {args.output} ({sim.total} samples at {sim.rate:g} Hz, F_max {fmax:g} N, source {args.source})",
           file=sys.stderr)
     return 0

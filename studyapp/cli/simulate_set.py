@@ -21,11 +21,13 @@ def run(args):
     from studyapp.cli import output_paths
     from studyapp.errors import ParameterError
     from studyapp.estimators.spec import validate_rate
+    from studyapp.model import calibration
     from studyapp.model.data_set import write_set
+    from studyapp.model.playable import check_playable
     from studyapp.model.simulate import DURATION_MAX
 
     # checked before write_set makes the folder, so a bad value leaves nothing behind
-    validate_rate(args.rate)
+    check_playable(validate_rate(args.rate), calibration.F0)
     if not 0 < args.duration <= DURATION_MAX:
         raise ParameterError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
                              f"{DURATION_MAX:g}")

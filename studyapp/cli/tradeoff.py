@@ -58,6 +58,8 @@ def run(args):
     from studyapp.cli import output_paths
     from studyapp.errors import UserError
     from studyapp.estimators.spec import RATE_MAX, validate_rate
+    from studyapp.model import calibration
+    from studyapp.model.playable import check_playable
     from studyapp.model.simulate import DURATION_MAX
     from studyapp.evaluation.dataset import file_sha256, warm_up
     from studyapp.evaluation.executors import check_workers, make_executor
@@ -73,6 +75,8 @@ def run(args):
         raise UserError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
                         f"{DURATION_MAX:g}")
     rates = [validate_rate(r) for r in (args.rates or DEFAULT_RATES)]
+    for rate in rates:  # the recordings are simulated: the string must play at each rate
+        check_playable(rate, calibration.F0)
     fmax = list(args.fmax or DEFAULT_FMAX)
     for f in fmax:
         if not 0 <= f <= 1000:

@@ -80,9 +80,12 @@ class Engine(Watchdog):
         """Cheap checks in the parent, so a bad setting is a one-line error before any process starts."""
         from studyapp.estimators import Bank
         from studyapp.estimators.spec import validate_rate
+        from studyapp.model import calibration
+        from studyapp.model.playable import check_playable
 
         c = self.config
         c.rate = validate_rate(c.rate)
+        check_playable(c.rate, calibration.F0 if c.f0 is None else c.f0)
         estimators = c.estimators if isinstance(c.estimators, dict) else {n: {} for n in c.estimators}
         names = Bank(c.rate, estimators).names
         c.estimators = dict(zip(names, estimators.values()))

@@ -4,9 +4,12 @@ Three layers keep a fault from leaving the device pushing:
 
 1. Clamps. F_max is clamped to the protocol's ceiling (``SafetyLimits.fmax_ceiling``,
    from ``Protocol.fmax_ceiling`` for a session, the console's preview and
-   ``live --protocol``; the motors' sustained limit otherwise) before the loop sees it; inside the loop the force is clamped to the motor
-   limits (model/device.py). After each block ``check`` verifies that no
-   sample exceeded either bound.
+   ``live --protocol``; the motors' sustained limit otherwise) before the loop sees it, and the
+   friction force is at most F_max by construction (the bow table caps |rho(v) v| at its peak,
+   model/bow_table.py: the string and the handle feel that one capped force), so no force command
+   exceeds the ceiling on any path; inside the loop the force is also clamped to the motor limits
+   (model/device.py). After each block ``check`` verifies that no sample exceeded either bound
+   (to 1e-9 relative: the bound is exact, not found numerically).
 2. Latched faults. A non-finite value anywhere in a block (the loop latches
    its own fault the moment one appears and zeroes the force from that sample
    on), a clamp found violated, or the ``force_enable`` word cleared (the
@@ -29,8 +32,8 @@ Three layers keep a fault from leaving the device pushing:
 
    Why these numbers (measured on the simulated loop, 4 s of strokes, 0.25 s
    windows; issue 20's world of a 0.1 kg end-effector on a grip, 2026-11-25):
-   the friction force peaks at F_max by design (eq. 20), so saturation is
-   measured against the motor, not against F_max. Bowing at the default
+   the friction force is at most F_max by construction (eq. 20 and the bow
+   table's cap), so saturation is measured against the motor, not against F_max. Bowing at the default
    ceiling F_max = 60 N leaves at most 20 % of a window suspect with TRUE,
    17 % with LVT, 21 % with LOWPASS and 32 % with LEVANT; a loop driven at
    F_max = 200 N, where the sustained limit (60 N RMS) chops the force, leaves
@@ -109,7 +112,7 @@ class Safety:
             value = float("nan")
         if not np.isfinite(value) or value < 0:
             raise ParameterError(f"fmax = {fmax!r}: allowed is a number from 0 to {self.limits.fmax_ceiling:g} N")
-        return min(value, self.limits.fmax_ceiling)
+        return min(value, self.limits.fmax_ceiling) + 0.0  # -0 is 0 N
 
     # faults -----------------------------------------------------------------
     def latch(self, text):
@@ -156,8 +159,8 @@ class Safety:
         if self.latched is None and force.size:
             bound = min(self.loop.fmax, self.motor_limit) * self._previous_force_scale
             peak = float(np.max(np.abs(force)))
-            # 1% slack: the peak of the friction curve is found numerically (model/bow_table.py)
-            if peak > bound * 1.01 + 1e-9:
+            # the cap is exact (model/bow_table.py): rounding only
+            if peak > bound * (1.0 + 1e-9) + 1e-12:
                 self.latch(f"force {peak:.4g} N exceeded its clamp {bound:.4g} N")
         self._runaway(block)
         self._previous_force_scale = self.scale

@@ -15,7 +15,7 @@ from typing import Callable
 import numpy as np
 
 from studyapp.errors import ParameterError
-from studyapp.number_text import to_float
+from studyapp.number_text import shown, to_float
 
 RATE_MIN = 1_000.0
 RATE_MAX = 96_000.0
@@ -167,7 +167,7 @@ def validate_rate(rate):
     except (TypeError, ValueError):
         raise ParameterError(f"rate = {rate!r}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz") from None
     if not (RATE_MIN <= rate <= RATE_MAX):
-        raise ParameterError(f"rate = {rate:g}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz")
+        raise ParameterError(f"rate = {shown(rate)}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz")
     return rate
 
 

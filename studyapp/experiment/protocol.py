@@ -41,7 +41,9 @@ from studyapp.experiment.task_type import Bounds
 from studyapp.experiment.tasks import protocol_task_names as task_names
 from studyapp.experiment.tasks import task_type
 from studyapp.io.small_files import parse_toml, read_bytes
-from studyapp.model.limits import SESSION_GESTURES, SUSTAINED_FORCE
+from studyapp.model.calibration import F0
+from studyapp.model.limits import RATE_PER_F0_MIN, SESSION_GESTURES, SUSTAINED_FORCE
+from studyapp.model.playable import min_rate
 
 SAFE_CEILING = SUSTAINED_FORCE  # N: the motors' sustained limit, the engine's default ceiling
 FMAX_FIELDS = ("fmax", "ceiling")  # the task fields that set an F_max level
@@ -137,6 +139,9 @@ def parse_protocol(text, source="<protocol>"):
 
     apparatus = table_fields(source, document, "apparatus")
     rate = apparatus.number("rate", RATE_MIN, RATE_MAX, "Hz")
+    if rate < min_rate(F0):
+        apparatus.fail("rate", f"= {rate:g}", f"at least {min_rate(F0):g} Hz: the string at f0 = {F0:g} Hz sounds "
+                       f"at f0 only at rate >= {RATE_PER_F0_MIN:g} x f0 (docs/model.md)")
     knobs = apparatus.integer("knobs", 1, 64, default=8)
     pads = apparatus.integer("pads", 1, 64, default=8)
     gesture = apparatus.string("gesture", "one of " + ", ".join(SESSION_GESTURES), default="strokes")

@@ -16,7 +16,9 @@ import numpy as np
 
 from studyapp.estimators import lvt, names
 from studyapp.estimators.spec import validate_rate
+from studyapp.model import calibration
 from studyapp.model.loop import ClosedLoop, LoopConfig
+from studyapp.model.playable import check_playable
 from studyapp.model.sources import LVT_SENSOR
 
 BLOCK = 1024
@@ -43,6 +45,7 @@ def measure(rate, block=BLOCK, seconds=SECONDS, repeats=REPEATS):
 
 def run_cli(args):
     rate = validate_rate(args.rate)
+    check_playable(rate, calibration.F0)
     sps = measure(rate)
     result = {"rate": rate, "samples_per_second": sps, "realtime_factor": sps / rate}
     if getattr(args, "json", False):

@@ -27,6 +27,15 @@ edge, |slope (v + offset)| = c with c = 0.98^(-1/4) - 0.75 = 0.255076:
 = 0.0833 for slope 3 and offset 0 (0.0843 with STK's offset 0.001, whose two
 signs differ: 0.0823 and 0.0843). So G = F_max / max|rho v|. Our default offset is 0:
 the handle bows both ways and F_max must hold in both directions.
+
+The tail. STK's lower clip rho >= RHO_MIN = 0.01 (reached at slope |v| = 2.41,
+|v| = 0.80 string units at slope 3) makes |rho v| = 0.01 |v| grow again
+without limit: it passes the edge's maximum at |v| = 8.33 (at slope 3), which a
+noisy or unstable velocity source reaches (BDIFF at 96 kHz drove 2x F_max,
+LEVANT with C = 1e5 7.5x). ``friction`` therefore caps |rho v| at the maximum
+above: the junction's wave u and the force -G u are one number, so the string
+and the handle feel the same force, and |F| <= F_max holds by construction.
+Below |v| = 8.33 nothing changes (the cap only flattens the clipped tail).
 """
 
 import numpy as np
@@ -50,6 +59,17 @@ def rho(v, slope, offset):
     return r
 
 
+@njit(cache=True, inline="always")
+def friction(v, slope, offset, peak):
+    """u = rho(v) v, with |u| capped at ``peak`` = ``peak_friction(slope, offset)`` (the tail; docstring)."""
+    u = rho(v, slope, offset) * v
+    if u > peak:
+        return peak
+    if u < -peak:
+        return -peak
+    return u
+
+
 def peak_friction(slope, offset=0.0):
     """max over v of |rho(v) v| (closed form; see the module docstring)."""
     return RHO_MAX * (EDGE / slope + abs(offset))
@@ -61,6 +81,12 @@ def breakaway(slope, offset=0.0):
 
 
 def table(v, slope=3.0, offset=0.0):
-    """rho over an array (for plots and tests)."""
+    """rho over an array (for plots and tests), STK's clipped table without the cap."""
     v = np.asarray(v, dtype=np.float64)
     return np.clip((np.abs(slope * (v + offset)) + 0.75) ** -4.0, RHO_MIN, RHO_MAX)
+
+
+def friction_table(v, slope=3.0, offset=0.0):
+    """u = rho(v) v over an array with the cap at peak_friction: what the string and the force use."""
+    peak = peak_friction(slope, offset)
+    return np.clip(table(v, slope, offset) * np.asarray(v, dtype=np.float64), -peak, peak)

@@ -5,7 +5,7 @@ loop) and the nut side (``1 - beta``). Each sample
 
     v_h      = -L(bridge line out) - (nut line out)   incoming waves at the bow
     v_delta  = v_bow - v_h
-    u        = rho(v_delta) * v_delta                  (bow_table.py; 0 when the bow is lifted)
+    u        = rho(v_delta) * v_delta, |u| <= max|rho v| (bow_table.py; 0 when the bow is lifted)
     nut line   <- -L(bridge line out) + u
     bridge line <- -(nut line out) + u
 
@@ -43,8 +43,8 @@ from numba import njit
 from studyapp.model import bow_table, calibration
 
 # parameter vector layout
-P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET = range(6)
-N_PARAMS = 6
+P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET, P_PEAK = range(7)
+N_PARAMS = 7
 # state vector layout
 S_WRITE, S_LOSS_Y = range(2)
 N_STATE = 2
@@ -97,6 +97,7 @@ class StringDesign:
         out[P_LOSS_B0] = self.loss * (1.0 - p)
         out[P_LOSS_A1] = p
         out[P_SLOPE], out[P_OFFSET] = self.slope, self.offset
+        out[P_PEAK] = self.peak_friction()
         return out
 
     def peak_friction(self):
@@ -143,7 +144,7 @@ def step(p, s, bridge, nut, v_bow, bowing):
     v_delta = v_bow - v_h
     u = 0.0
     if bowing:
-        u = bow_table.rho(v_delta, p[P_SLOPE], p[P_OFFSET]) * v_delta
+        u = bow_table.friction(v_delta, p[P_SLOPE], p[P_OFFSET], p[P_PEAK])
     nut[write] = bridge_refl + u
     bridge[write] = nut_refl + u
     write += 1

@@ -12,6 +12,11 @@ the impulsive limit makes sense, so FMAX_LIMIT is the largest any simulation,
 protocol or logged event accepts; a study's own ceiling (protocol
 ``fmax_ceiling``) is at most SUSTAINED_FORCE.
 
+The string's lowest rate (``RATE_PER_F0_MIN``): the waveguide sounds within 1 %
+of its pitch f0 only when the rate is at least 6 f0 (model/playable.py says
+why and what was measured); below, every command and a protocol's validation
+refuse the pair rather than compute with a string that does not play f0.
+
 The gestures, the ways the virtual hand moves the handle (model/gestures.py),
 are four sets, each for its own use:
 
@@ -25,6 +30,7 @@ TRAVEL = 0.011  # m: the handle's end stops at +-TRAVEL
 IMPULSIVE_FORCE = 200.0  # N
 SUSTAINED_FORCE = 60.0  # N RMS
 FMAX_LIMIT = IMPULSIVE_FORCE  # N: nothing above the motors' impulsive limit makes sense
+RATE_PER_F0_MIN = 6.0  # the lowest rate / f0 at which the string sounds at f0 (model/playable.py)
 
 GESTURES = ("strokes", "strokes-validation", "hold", "live", "playback")
 SESSION_GESTURES = tuple(g for g in GESTURES if g != "playback")

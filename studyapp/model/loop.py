@@ -59,6 +59,7 @@ from studyapp.model.control import (
 from studyapp.model.device import N_LIMIT_STATE, HapticDevice
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
 from studyapp.model.limits import FMAX_LIMIT, GESTURES
+from studyapp.model.playable import check_playable
 from studyapp.model.simulated_device import SimulatedDevice
 from studyapp.model.sources import LVT_SENSOR, LVT_SENSOR_INDEX, TRUE, TRUE_INDEX, with_pseudo_sources
 from studyapp.model.stability import StabilityMonitor
@@ -106,7 +107,7 @@ def check_fmax(fmax):
         value = float("nan")
     if not (0.0 <= value <= FMAX_LIMIT):
         raise ParameterError(f"fmax = {fmax!r}: allowed is a number from 0 to {FMAX_LIMIT:g} N")
-    return value
+    return value + 0.0  # -0 is 0 N (recorded and shown as 0)
 
 
 def check_f0(f0):
@@ -134,6 +135,7 @@ class ClosedLoop:
         self.config = config
         self.rate = validate_rate(config.rate)
         f0 = check_f0(calibration.F0 if config.f0 is None else config.f0)
+        check_playable(self.rate, f0)
         estimators = config.estimators
         if not isinstance(estimators, dict):
             estimators = {name: {} for name in estimators}

@@ -133,9 +133,9 @@ def test_make_dataset_passes_the_delay_method():
 
 @pytest.fixture(scope="module")
 def extremes(tmp_path_factory):
-    """A tuned run at 1 kHz and 96 kHz, with warnings turned into errors."""
+    """A tuned run at 3 kHz (the lowest the 440 Hz string plays, playable.py) and 96 kHz, with warnings turned into errors."""
     out = tmp_path_factory.mktemp("tradeoff_extremes") / "trade"
-    argv = ["tradeoff", "--tune", "--patience", "2", "--rates", "1000", "96000", "--fmax", "2.2",
+    argv = ["tradeoff", "--tune", "--patience", "2", "--rates", "3000", "96000", "--fmax", "2.2",
             "--duration", "0.1", "--estimators", "LOWPASS,COMP2,LEASTSQ", "--cost-samples", "1000",
             "--workers", "1", "-o", str(out)]
     with warnings.catch_warnings():
@@ -144,29 +144,29 @@ def extremes(tmp_path_factory):
     return code, out
 
 
-def test_1khz_and_96khz_run_and_report_what_is_not_available(extremes, capsys):
+def test_3khz_and_96khz_run_and_report_what_is_not_available(extremes, capsys):
     code, out = extremes
     assert code == 0
     document = json.loads((out / "tradeoff.json").read_text())
     assert document["not_available"] == [{
-        "rate": 1000.0, "estimator": "COMP2",
-        "reason": "COMP2 parameter 'hpf_hz' = 2254.0: allowed is a number from 1 to 490 Hz"}]
+        "rate": 3000.0, "estimator": "COMP2",
+        "reason": "COMP2 parameter 'hpf_hz' = 2254.0: allowed is a number from 1 to 1470 Hz"}]
     rows = _csv(out / "tradeoff.csv")
     assert [(r["rate"], r["estimator"], r["available"]) for r in rows] == [
-        ("1000.0", "LOWPASS", "True"), ("1000.0", "COMP2", "False"), ("1000.0", "LEASTSQ", "True"),
+        ("3000.0", "LOWPASS", "True"), ("3000.0", "COMP2", "False"), ("3000.0", "LEASTSQ", "True"),
         ("96000.0", "LOWPASS", "True"), ("96000.0", "COMP2", "True"), ("96000.0", "LEASTSQ", "True")]
     missing = rows[1]
-    assert "490 Hz" in missing["reason"] and missing["cost_ns_per_sample"] == "" and missing["parameters"] == ""
-    assert set(document["tuning"]) == {"1000", "96000"}
+    assert "1470 Hz" in missing["reason"] and missing["cost_ns_per_sample"] == "" and missing["parameters"] == ""
+    assert set(document["tuning"]) == {"3000", "96000"}
     assert all(run["iterations"] >= 2 for run in document["tuning"].values())
     prov = document["provenance"]
     assert prov["tune"] is True and prov["patience"] == 2 and prov["parameters"] == "tuned at each rate"
-    for stem in ("tradeoff", "tradeoff_rates", "pareto_1000Hz", "pareto_96000Hz"):
+    for stem in ("tradeoff", "tradeoff_rates", "pareto_3000Hz", "pareto_96000Hz"):
         assert (out / f"{stem}.png").stat().st_size > 1000 and "<svg" in (out / f"{stem}.svg").read_text()
 
 
 def test_delay_is_reported_in_samples_and_microseconds_and_matches_the_metric(extremes):
-    """The 1 kHz LOWPASS row, recomputed independently: simulate, run the estimator, measure."""
+    """The 3 kHz LOWPASS row, recomputed independently: simulate, run the estimator, measure."""
     from studyapp.estimators import create
     from studyapp.evaluation import delay_and_error
     from studyapp.model.simulate import simulate
@@ -177,27 +177,27 @@ def test_delay_is_reported_in_samples_and_microseconds_and_matches_the_metric(ex
         if r["available"]:
             assert r["delay_median_us"] == pytest.approx(r["delay_median"] / r["rate"] * 1e6)
             assert r["parameters_source"] == "tuned"
-    row = rows[(1000.0, "LOWPASS")]
+    row = rows[(3000.0, "LOWPASS")]
     assert row["parameters"] != {"cutoff_hz": 256.0}  # moved off Table 1
-    rec = simulate(2.2, rate=1000.0, duration=0.1, seed=0)
-    est = create("LOWPASS", 1000.0, **row["parameters"]).process(
+    rec = simulate(2.2, rate=3000.0, duration=0.1, seed=0)
+    est = create("LOWPASS", 3000.0, **row["parameters"]).process(
         rec["position"], rec["acceleration"], rec["velocity_lvt"])
     method = json.loads((out / "tradeoff.json").read_text())["provenance"]["delay_method"]
     assert method == "normalised"
 
-    d, e = delay_and_error(rec["velocity_lvt"], est, 20, method=method)  # max_lag: 0.02 s at 1 kHz
+    d, e = delay_and_error(rec["velocity_lvt"], est, 60, method=method)  # max_lag: 0.02 s at 3 kHz
     assert row["delay_median"] == d and row["error_median"] == pytest.approx(e, rel=1e-12)
 
 
 def test_progress_and_unavailable_estimators_on_screen(tmp_path, capsys):
-    code = main(["tradeoff", "--tune", "--patience", "1", "--rates", "1000", "--fmax", "2.2", "--duration", "0.05",
+    code = main(["tradeoff", "--tune", "--patience", "1", "--rates", "3000", "--fmax", "2.2", "--duration", "0.05",
                  "--estimators", "LOWPASS,COMP2", "--cost-samples", "1000", "--workers", "1",
                  "-o", str(tmp_path / "t")])
     captured = capsys.readouterr()
     assert code == 0
-    assert "1000 Hz: COMP2 not available: COMP2 parameter 'hpf_hz' = 2254.0" in captured.out
-    assert "tradeoff: 1000 Hz (1/1): tuning 1 estimators (patience 1)" in captured.err
-    assert "tradeoff: 1000 Hz: tuning: iter" in captured.err
+    assert "3000 Hz: COMP2 not available: COMP2 parameter 'hpf_hz' = 2254.0" in captured.out
+    assert "tradeoff: 3000 Hz (1/1): tuning 1 estimators (patience 1)" in captured.err
+    assert "tradeoff: 3000 Hz: tuning: iter" in captured.err
     assert "Traceback" not in captured.err
 
 
@@ -208,11 +208,11 @@ def test_a_rate_where_no_estimator_is_available_still_gets_its_outputs(tmp_path,
     made = {}
     monkeypatch.setattr(figures, "written", lambda fig, stem: made.setdefault(stem.name, fig))
     out = tmp_path / "t"
-    assert main(["tradeoff", "--rates", "1000", "5000", "--estimators", "COMP2", "--fmax", "1", "--duration", "0.1",
+    assert main(["tradeoff", "--rates", "3000", "5000", "--estimators", "COMP2", "--fmax", "1", "--duration", "0.1",
                  "--cost-samples", "1000", "-o", str(out)]) == 0
     rows = _csv(out / "tradeoff.csv")
-    assert [(r["rate"], r["available"]) for r in rows] == [("1000.0", "False"), ("5000.0", "True")]
-    assert sorted(made) == ["pareto_1000Hz", "pareto_5000Hz", "tradeoff", "tradeoff_rates"]
+    assert [(r["rate"], r["available"]) for r in rows] == [("3000.0", "False"), ("5000.0", "True")]
+    assert sorted(made) == ["pareto_3000Hz", "pareto_5000Hz", "tradeoff", "tradeoff_rates"]
     for fig in made.values():
         assert text_overlaps(fig) == [] and texts_outside(fig) == []
 
@@ -272,6 +272,7 @@ def test_bad_options(tmp_path, capsys):
     fails_with_one_line(capsys, ["tradeoff", "--patience", "5", "-o", str(out)], "only with --tune")
     fails_with_one_line(capsys, ["tradeoff", "--workers", "2", "-o", str(out)], "only with --tune")
     fails_with_one_line(capsys, ["tradeoff", "--delay", "late", "-o", str(out)], "--delay")
-    fails_with_one_line(capsys, ["tradeoff", "--rates", "1000", "2000", "--estimators", "COMP2", "-o", str(out)],
-           "no estimator is available at 1000, 2000 Hz: COMP2 parameter 'hpf_hz'")
+    fails_with_one_line(capsys, ["tradeoff", "--rates", "3000", "4000", "--estimators", "COMP2", "-o", str(out)],
+           "no estimator is available at 3000, 4000 Hz: COMP2 parameter 'hpf_hz'")
+    fails_with_one_line(capsys, ["tradeoff", "--rates", "1000", "-o", str(out)], "rate 1000 Hz with f0 440 Hz")
     assert not out.exists()

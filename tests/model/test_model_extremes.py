@@ -22,7 +22,8 @@ def finite(block):
 @pytest.mark.parametrize("fmax", [0.0, 50.0])
 @pytest.mark.parametrize("source", ["TRUE", "LEVANT"])
 def test_extreme_rates_and_gains_stay_finite_and_clamped(rate, fmax, source):
-    loop = ClosedLoop(LoopConfig(rate=rate, fmax=fmax, source=source, estimators={"LEVANT": {}}))
+    f0 = 150.0 if rate < 2640.0 else None  # the string plays f0 <= rate / 6 (playable.py)
+    loop = ClosedLoop(LoopConfig(rate=rate, fmax=fmax, source=source, estimators={"LEVANT": {}}, f0=f0))
     block = loop.run(int(0.3 * rate))
     finite(block)
     assert np.abs(block["force"]).max() <= min(fmax, 200.0) + 1e-12
@@ -42,7 +43,8 @@ def test_every_estimator_at_the_extremes():
                 continue
             usable.append(name)
         assert len(usable) >= 13
-        loop = ClosedLoop(LoopConfig(rate=rate, fmax=50.0, source="KALMAN", estimators=usable))
+        loop = ClosedLoop(LoopConfig(rate=rate, fmax=50.0, source="KALMAN", estimators=usable,
+                                     f0=150.0 if rate < 2640.0 else None))
         block = loop.run(int(0.05 * rate))
         finite(block)
         assert np.abs(block["force"]).max() <= 50.0 + 1e-12
