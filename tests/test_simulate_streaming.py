@@ -94,8 +94,8 @@ def _peak_rss(argv):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("suffix", [".npz", ".h5"])
-def test_memory_does_not_grow_with_the_duration(suffix, tmp_path):
+def test_memory_does_not_grow_with_the_duration(tmp_path):
+    suffix = ".npz"  # the format whose columns cannot grow side by side in one archive
     # 1 s and 6 s at 96 kHz: holding the recording cost 18 MB per second (90 MB between the two)
     peaks = []
     for seconds in (1, 6):

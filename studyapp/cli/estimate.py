@@ -126,12 +126,12 @@ class _StartWatch:
     FAR = 1e-3  # m from 0 at the first sample
     SPAN = 0.1  # s: the spike's window
 
-    def __init__(self, est, rate):
+    def __init__(self, est):
         self.watch = est.params.get("start") == "zero"
         self.first = None
         self.peak = 0.0
         self.seen = 0
-        self.window = int(self.SPAN * rate)
+        self.window = int(self.SPAN * est.rate)
 
     def see(self, position, estimate):
         import numpy as np
@@ -177,7 +177,7 @@ def run(args):
         source.check(est.spec.inputs)
         with (atomic_open(args.output, "w", newline="") if args.output else contextlib.nullcontext(sys.stdout)) as f:
             write_header(f, source.header, "velocity_estimate")
-            start = _StartWatch(est, source.rate)
+            start = _StartWatch(est)
             for rows, cols in source.blocks(args.block):
                 estimate = est.process(cols["position"], cols["acceleration"], cols["velocity"])
                 start.see(cols["position"], estimate)

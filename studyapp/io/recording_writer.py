@@ -17,8 +17,8 @@ so a failure or a kill leaves no partial recording. The files are those
   than the archive during ``finish`` at worst: ``bytes_needed`` counts it.
 
 ``bytes_needed(suffix, samples, columns)`` is the disk space a recording takes
-(an upper bound): 8 bytes per value for ``.h5`` and ``.npz`` (``.npz`` twice,
-for its temporaries), ``CSV_BYTES_PER_VALUE`` = 25 for ``.csv`` (``%.17g``
+(an upper bound): 8 bytes per value for ``.h5`` (and one chunk per column),
+16 for ``.npz`` (the temporaries and the archive), ``CSV_BYTES_PER_VALUE`` = 25 for ``.csv`` (``%.17g``
 writes at most 24 characters and a separator).
 """
 
@@ -35,7 +35,7 @@ from studyapp.io.atomic import atomic_open, atomic_path
 from studyapp.io.recording import _meta_json, _suffix
 
 CSV_BYTES_PER_VALUE = 25
-H5_CHUNK = 1 << 16  # samples per HDF5 chunk
+H5_CHUNK = 1 << 12  # samples per HDF5 chunk (32 KB): a chunk is stored whole, so a short file stays short
 _COPY = 1 << 20  # bytes per copy step into the archive
 
 
@@ -44,8 +44,9 @@ def bytes_needed(suffix, samples, columns):
     values = int(samples) * int(columns)
     if suffix == ".csv":
         return values * CSV_BYTES_PER_VALUE + 4096
-    factor = 2 if suffix == ".npz" else 1
-    return factor * values * 8 + 65536
+    if suffix == ".h5":  # the last chunk of each column is stored whole
+        return (values + int(columns) * H5_CHUNK) * 8 + 65536
+    return 2 * values * 8 + 65536
 
 
 class _Meta:
