@@ -24,7 +24,7 @@ def register(subparsers):
     which = p.add_mutually_exclusive_group(required=True)
     which.add_argument("--source", metavar="NAME", help="an estimator name, LVT (the tachometer) or TRUE")
     which.add_argument("--all", action="store_true", help="every estimator, LVT and TRUE")
-    p.add_argument("--rate", type=float, default=5000.0, metavar="HZ", help="sample rate in Hz, 1000..96000 (default 5000)")
+    p.add_argument("--rate", type=float, default=5000.0, metavar="HZ", help="sample rate in Hz, 1000..96000 and at least 6 x f0 (default 5000)")
     p.add_argument("--seeds", type=int, default=5, metavar="N", help="seeds 0..N-1, N at most 100 (default 5)")
     p.add_argument("--gesture", default="strokes", metavar="strokes|hold",
                    help="strokes (bowing, judged against TRUE's sound and feel) or hold (the hand at rest, with "

@@ -13,7 +13,7 @@ def register(subparsers):
                     "(.h5, .npz or .csv).",
     )
     p.add_argument("--fmax", type=float, default=1.0, help="peak friction force F_max in N (default 1)")
-    p.add_argument("--rate", type=float, default=5000.0, help="sample rate in Hz, 1000..96000 (default 5000)")
+    p.add_argument("--rate", type=float, default=5000.0, help="sample rate in Hz, 1000..96000 and at least 6 x f0 (default 5000)")
     p.add_argument("--duration", type=float, default=7.0, help="seconds (default 7)")
     p.add_argument("--source", default=None, help=SOURCES_HELP)
     p.add_argument("--gesture", default="strokes", help="strokes, strokes-validation or hold (default strokes)")
