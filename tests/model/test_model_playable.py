@@ -105,3 +105,14 @@ def test_plan_refuses_a_protocol_at_a_rate_the_string_cannot_play(tmp_path, caps
     assert code == 2
     assert len(err.splitlines()) == 1
     assert "rate = 1000" in err and "2640 Hz" in err and "440 Hz" in err
+
+
+def test_the_engine_refuses_before_any_process_starts():
+    from studyapp.engine.config import EngineConfig
+    from studyapp.engine.engine import Engine
+
+    with pytest.raises(ParameterError, match="rate 1000 Hz with f0 440 Hz"):
+        Engine(EngineConfig(rate=1000.0))
+    with pytest.raises(ParameterError, match="rate 5000 Hz with f0 1000 Hz"):
+        Engine(EngineConfig(rate=5000.0, f0=1000.0))
+    assert Engine(EngineConfig(rate=1000.0, f0=150.0)).process is None  # accepted, nothing started
