@@ -32,6 +32,7 @@ def samples(tmp_path_factory):
 @pytest.mark.parametrize("argv, output", [
     (["estimate", "{in}", "--estimator", "BDIFF", "--rate", "5000", "-o", "{out}/e.csv"], "e.csv"),
     (["simulate", "--duration", "0.2", "-o", "{out}/s.npz"], "s.npz"),
+    (["simulate", "--duration", "0.2", "-o", "{out}/s.csv"], "s.csv"),
 ])
 def test_full_disk_is_one_line_and_leaves_nothing(argv, output, samples, tmp_path):
     argv = [a.replace("{in}", str(samples)).replace("{out}", str(tmp_path)) for a in argv]

@@ -102,11 +102,13 @@ def run(args):
         print(f"\rsimulate: {100 * done // total:3d}% ({done / rate:,.1f} of {total / rate:,.1f} s, "
               f"about {left:,.0f} s left)", end="", file=sys.stderr, flush=True)
 
-    with RecordingWriter(args.output, recording.COLUMNS) as writer:
-        for block in sim.blocks(progress):
-            writer.write(block)
-        writer.finish(sim.rate, sim.meta())
-    print("", file=sys.stderr)
+    try:
+        with RecordingWriter(args.output, recording.COLUMNS) as writer:
+            for block in sim.blocks(progress):
+                writer.write(block)
+            writer.finish(sim.rate, sim.meta())
+    finally:
+        print("", file=sys.stderr)  # ends the progress line, before a success's or an error's line
     print(f"wrote {args.output} ({sim.total} samples at {sim.rate:g} Hz, F_max {fmax:g} N, source {args.source})",
           file=sys.stderr)
     return 0
