@@ -30,7 +30,7 @@ def test_the_streamed_file_is_the_whole_recording(suffix, tmp_path, capsys):
     argv = ["simulate", "--fmax", "2.2", "--rate", "5000", "--duration", "2.1", "--source", "LOWPASS", "--seed", "3"]
     assert main([*argv, "-o", str(path)]) == 0  # 2.1 s: two full blocks and a part
     err = capsys.readouterr().err
-    assert "simulate: 100% (2.1 of 2.1 s" in err and "wrote" in err
+    assert "simulate: 100% (2.10 of 2.10 s" in err and "wrote" in err
     whole = simulate(2.2, rate=5000.0, duration=2.1, source="LOWPASS", seed=3)
     got = recording.load(path)
     assert got.rate == whole.rate

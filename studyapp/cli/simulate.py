@@ -99,7 +99,7 @@ def run(args):
     def progress(done, total):
         elapsed = time.monotonic() - started
         left = elapsed * (total - done) / done if done else 0.0
-        print(f"\rsimulate: {100 * done // total:3d}% ({done / rate:,.1f} of {total / rate:,.1f} s, "
+        print(f"\rsimulate: {100 * done // total:3d}% ({done / rate:,.2f} of {total / rate:,.2f} s, "
               f"about {left:,.0f} s left)", end="", file=sys.stderr, flush=True)
 
     try:
