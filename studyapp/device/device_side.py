@@ -22,7 +22,8 @@ Force over [j, j + 1], in this order:
    latched until ARM. Streaming, only FORCE frames feed it: deadline =
    t_last + W, t_last the latest sample tagged so far, W = watchdog_ms *
    rate / 1000 samples (START feeds it to now + latency + W); not streaming,
-   any valid host frame feeds it to now + W. So from the host's last frame
+   any valid host frame feeds it to now + W; ARM sets it to now + W (+ latency
+   while streaming). So from the host's last frame
    (tagged now + latency) the force is 0 within latency + W + D - 1 samples.
 4. The motor limits, as the host's loop applies them (model/device.py
    clamp_force): |F| <= impulsive, and <= sustained while the exponential
@@ -119,6 +120,8 @@ class DeviceSide:
     # host messages, arriving before the actuation of sample ``now``
 
     def _feed(self, until):
+        if self.down:  # the watchdog has fired: nothing feeds it until ARM
+            return
         if ahead(until, self.deadline) > 0 or not self.armed:
             self.deadline = until & MASK
         self.last_feed = self.now
@@ -144,7 +147,8 @@ class DeviceSide:
         self.ramp = ms_samples(max(ramp_ms, self.c.ramp_ms_min), self.c.rate_hz)
         self.got = False
         self.hold = 0.0
-        self.deadline = (self.now + self.c.watchdog_samples) & MASK
+        # streaming, the first forces answer sensor frames sent from now on: latency + W, as at START
+        self.deadline = (self.now + self.c.watchdog_samples + (self.latency if self.streaming else 0)) & MASK
         self.last_feed = self.now
 
     def _disarm(self, fault=0):

@@ -130,3 +130,15 @@ class Firmware:
         out = bytes(self._out)
         self._out.clear()
         return out
+
+    def streaming(self):
+        return self.side.streaming
+
+    def busy(self):
+        """Armed or streaming: the emulator paces such samples closely."""
+        return self.side.streaming or self.side.armed
+
+    def counters(self):
+        s = self.side
+        return {"now": s.now, "armed": int(s.armed), "streaming": int(s.streaming), "fault": s.fault,
+                "late": s.late, "lost": self.lost, "corrupt": s.corrupt, "missing": s.missing}
