@@ -54,10 +54,11 @@ class Firmware:
             payloads = self._reader.feed(data[start:end])
             if self._reader.corrupt > before:
                 self.side.corrupt_frame()
+                self._reports()
             for payload in payloads:
                 self._payload(payload)
+                self._reports()
             start = end
-        self._reports()
 
     def _payload(self, payload):
         try:
