@@ -244,3 +244,37 @@ def test_replaces_its_own_stale_link(tmp_path):
     assert os.readlink(link) != "/dev/pts/999999"
     stop_emulator(proc)
     assert not os.path.lexists(link)
+
+
+def test_counts_format_and_disconnect(tmp_path):
+    """--format counts: INFO announces i32 channels with their gains and SENSORS carries integers;
+    --disconnect-after closes the pty (the host reads end-of-file or EIO), removes the link, exits 0."""
+    from studyapp.device.emulator import COUNT_CHANNELS
+    link = tmp_path / "dev"
+    proc = start_emulator(link, "--format", "counts", "--disconnect-after", "3", "--core", "python")
+    host = Host(link)
+    try:
+        info = handshake(host)
+        assert info.channels == COUNT_CHANNELS
+        host.send(messages.Start(4, 40))
+        frame = host.wait(messages.Sensors)
+        assert len(frame.values) == 4 and all(isinstance(v, int) for r in frame.values for v in r)
+        assert all(abs(x) <= 0.011 for x, _, _ in frame.si(info.channels))
+        proc.wait(timeout=60)
+        assert proc.returncode == 0 and not os.path.lexists(link)
+        closed = False
+        for _ in range(1000):
+            try:
+                if os.read(host.fd, 1 << 16) == b"":
+                    closed = True
+                    break
+            except BlockingIOError:
+                time.sleep(0.01)
+            except OSError:
+                closed = True
+                break
+        assert closed
+    finally:
+        host.close()
+        if proc.poll() is None:
+            proc.kill()
