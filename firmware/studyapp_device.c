@@ -29,6 +29,14 @@ static void wrf64(uint8_t *p, double f) {
 }
 static int finite64(const uint8_t *p) { return ((rd64(p) >> 52) & 0x7FFu) != 0x7FFu; }
 
+/* a count from a double, saturating (a cast of an out-of-range double is undefined in C); NaN gives 0 */
+static int32_t count_of(double v, double lo, double hi) {
+    if (!(v == v)) return 0;
+    if (v < lo) v = lo;
+    if (v > hi) v = hi;
+    return (int32_t)v;
+}
+
 /* a - b as a signed difference of wrapping 32-bit counters */
 static int64_t ahead(uint32_t a, uint32_t b) {
     uint32_t d = a - b;
@@ -369,10 +377,10 @@ void sd_sample(sd_device *d, const double *raw) {
             wrf64(r, raw[c]);
             r += 8;
         } else if (d->format[c] == 1) {
-            wr32(r, (uint32_t)(int32_t)raw[c]);
+            wr32(r, (uint32_t)count_of(raw[c], -2147483648.0, 2147483647.0));
             r += 4;
         } else {
-            uint16_t v = (uint16_t)(int16_t)raw[c];
+            uint16_t v = (uint16_t)(int16_t)count_of(raw[c], -32768.0, 32767.0);
             r[0] = (uint8_t)v;
             r[1] = (uint8_t)(v >> 8);
             r += 2;
