@@ -159,14 +159,15 @@ def tables(rows):
     link_list = list(dict.fromkeys((r["latency"], r["packet"], r["jitter"]) for r in rows))
     sources = list(dict.fromkeys(r["source"] for r in rows))
     order = ["TRUE", "LVT"] + [s for s in sources if s not in ("TRUE", "LVT")]
-    head = "| link | " + " | ".join(order) + " | LVT / best (best) |"
-    lines = [head, "|" + " --- |" * (len(order) + 2)]
+    head = "| link | " + " | ".join(order) + " | LVT / LOWPASS | LVT / best (best) |"
+    lines = [head, "|" + " --- |" * (len(order) + 3)]
     for link in link_list:
         by = {r["source"]: r for r in rows if (r["latency"], r["packet"], r["jitter"]) == link}
         ratio, best = margin({s: by[s]["fmax_median"] for s in by})
         cells = [f"{number(by[s]['fmax_median'])} ({number(by[s]['fmax_min'])}-{number(by[s]['fmax_max'])})"
                  for s in order]
-        lines.append(f"| {link_label(link)} | " + " | ".join(cells) + f" | {ratio:.2f} ({best}) |")
+        lowpass = by["LVT"]["fmax_median"] / by["LOWPASS"]["fmax_median"]
+        lines.append(f"| {link_label(link)} | " + " | ".join(cells) + f" | {lowpass:.2f} | {ratio:.2f} ({best}) |")
     return "\n".join(lines) + "\n"
 
 
@@ -180,16 +181,21 @@ def plot(rows, path):
     sources = list(dict.fromkeys(r["source"] for r in pure))
     fig, ax = plt.subplots(figsize=(8, 5.2), dpi=110)
     styles = {"TRUE": dict(color="black", lw=2.2), "LVT": dict(color="tab:red", lw=2.4)}
-    for i, source in enumerate(sources):
+    others = iter(["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
+                   "tab:olive", "tab:cyan"])
+    for source in sources:
         rs = sorted((r for r in pure if r["source"] == source), key=lambda r: r["latency"])
         x = [r["latency"] * 1000 for r in rs]
         y = [min(r["fmax_median"], 200.0) for r in rs]
-        style = styles.get(source, dict(color=plt.cm.tab10((i + 2) % 10), lw=1.2))
+        style = styles.get(source) or dict(color=next(others), lw=1.1, ls="--")
         ax.plot(x, y, marker="o", ms=3.5, label=source, **style)
         if source in styles:
             ax.fill_between(x, [min(r["fmax_min"], 200.0) for r in rs], [min(r["fmax_max"], 200.0) for r in rs],
                             color=style["color"], alpha=0.12, lw=0)
     ax.set_yscale("log")
+    ticks = [2, 3, 4, 5, 6, 8, 10, 15, 20, 25]
+    ax.set_yticks(ticks, [f"{t:g}" for t in ticks])
+    ax.minorticks_off()
     ax.set_xlabel("link latency (ms; one sample = 0.2 ms at 5 kHz)")
     ax.set_ylabel("breakdown F_max (N), median over seeds")
     ax.set_title("Bowing breakdown against the link's latency (5 kHz, strokes)")
