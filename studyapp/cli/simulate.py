@@ -1,6 +1,6 @@
 """``studyapp simulate``: one simulated recording of bowing the string through the closed loop."""
 
-from studyapp.cli import number_options
+from studyapp.cli import link_options, number_options
 
 SOURCES_HELP = "velocity source in the loop: an estimator name, LVT or TRUE (default LVT)"
 
@@ -19,6 +19,7 @@ def register(subparsers):
     p.add_argument("--gesture", default="strokes", help="strokes, strokes-validation or hold (default strokes)")
     p.add_argument("--f0", type=float, default=None, help="string pitch in Hz (default: the model's)")
     p.add_argument("--seed", type=number_options.seed, default=0, help="random seed (default 0)")
+    link_options.add(p)
     p.add_argument("-o", "--output", required=True, help="output file: .h5, .npz or .csv")
     p.set_defaults(func=run)
 
@@ -89,11 +90,12 @@ def run(args):
     check_playable(rate, check_f0(calibration.F0 if args.f0 is None else args.f0))
     check_source(args.source)
     check_gesture(args.gesture)
+    link = link_options.spec(args)
     samples = int(round(args.duration * rate))
     check_disk(args.output, Path(args.output).suffix.lower(), samples, len(recording.COLUMNS))
 
     sim = Simulation(fmax, rate=rate, duration=args.duration, source=args.source, gesture=args.gesture,
-                     f0=args.f0, seed=args.seed)
+                     f0=args.f0, seed=args.seed, link=link)
     started = time.monotonic()
 
     def progress(done, total):

@@ -7,7 +7,10 @@ acceleration) plus the simulation's ground truth (true velocity and
 acceleration), the force command, the string velocity at the bow and the audio.
 The accelerometer is always simulated here, so every estimator can later be
 run on the recording. ``Simulation`` runs the same loop a block at a time, for
-outputs streamed to disk (``studyapp simulate``).
+outputs streamed to disk (``studyapp simulate``). ``link`` (a link.LinkSpec) puts
+the simulated device behind a link (latency, packets, jitter, frame loss;
+link.py); the metadata's ``link`` says which (seconds and samples), and the
+``force`` column is the host's command, before the link.
 """
 
 import numpy as np
@@ -16,6 +19,7 @@ from studyapp import __version__
 from studyapp.errors import ParameterError
 from studyapp.io.recording import COLUMNS, Recording
 from studyapp.model import calibration
+from studyapp.model.link import IDEAL
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import LVT_SENSOR, is_pseudo
 
@@ -33,7 +37,7 @@ class Simulation:
     """
 
     def __init__(self, fmax, rate=5000.0, duration=7.0, source=LVT_SENSOR, gesture="strokes", f0=None, seed=0,
-                 estimators=None):
+                 estimators=None, link=None):
         try:
             duration = float(duration)
         except (TypeError, ValueError):
@@ -50,9 +54,9 @@ class Simulation:
         if not is_pseudo(source) and source not in estimators:
             estimators[source] = {}
         self.f0 = calibration.F0 if f0 is None else f0
-        self.source, self.gesture, self.seed = source, gesture, seed
+        self.source, self.gesture, self.seed, self.link = source, gesture, seed, link or IDEAL
         config = LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
-                            f0=self.f0, seed=seed, audio=True, accelerometer=True)
+                            f0=self.f0, seed=seed, audio=True, accelerometer=True, link=link)
         self.loop = ClosedLoop(config)
         self.rate = self.loop.rate
         self.total = int(round(duration * self.loop.rate))
@@ -79,17 +83,18 @@ class Simulation:
             "estimators": list(loop.names), "velocity_scale": loop.velocity_scale, "fault": loop.fault,
             "broken": bool(self.broken),  # the stability monitor flagged breakdown at some block
             "model": calibration.describe(),
+            "link": self.link.describe(loop.rate),
         }
 
 
 def simulate(fmax, rate=5000.0, duration=7.0, source=LVT_SENSOR, gesture="strokes", f0=None, seed=0,
-             estimators=None, progress=None):
+             estimators=None, progress=None, link=None):
     """A ``Recording`` of ``duration`` s of bowing at ``fmax`` N with ``source`` in the loop.
 
     ``estimators``: the active set (names or name -> params); the source is
     added when it is an estimator. ``progress(done, total)`` is called per block.
     """
-    sim = Simulation(fmax, rate, duration, source, gesture, f0, seed, estimators)
+    sim = Simulation(fmax, rate, duration, source, gesture, f0, seed, estimators, link)
     parts = {name: [] for name in COLUMNS}
     for block in sim.blocks(progress):
         for name in COLUMNS:
