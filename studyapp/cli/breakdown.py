@@ -68,7 +68,7 @@ def run(args):
     from studyapp.model import breakdown
 
     names = breakdown.sources() if args.all else [breakdown.check_source(args.source, "--source")]
-    validate_rate(args.rate)
+    validate_rate(args.rate, "--rate")
     breakdown.check_seeds(args.seeds, "--seeds")
     breakdown.check_gesture(args.gesture, "--gesture")
     breakdown.check_duration(args.duration, "--duration")

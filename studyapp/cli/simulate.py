@@ -55,7 +55,7 @@ def run(args):
         args.source = LVT_SENSOR
     recording.check_path(args.output)
     output_paths.check_file(args.output)
-    rate = validate_rate(args.rate)
+    rate = validate_rate(args.rate, "--rate")
     if 0 < args.duration and round(args.duration * rate) < 1:  # would write a recording with no samples
         from studyapp.errors import ParameterError
 

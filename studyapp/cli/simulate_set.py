@@ -25,7 +25,7 @@ def run(args):
     from studyapp.model.simulate import DURATION_MAX
 
     # checked before write_set makes the folder, so a bad value leaves nothing behind
-    validate_rate(args.rate)
+    validate_rate(args.rate, "--rate")
     if not 0 < args.duration <= DURATION_MAX:
         raise ParameterError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
                              f"{DURATION_MAX:g}")

@@ -188,6 +188,7 @@ class Session:
         order_row = check_order_row(protocol, order_row)
         study_folder = Path(results) / protocol.study
         participant_folder = study_folder / participant
+        _refuse_existing(participant_folder, participant)  # read-only, before the lock: a refusal changes nothing
         try:
             made = make_folders(participant_folder)
         except OSError as exc:
@@ -200,11 +201,7 @@ class Session:
             _remove_made(made)  # the winner's lock stays: only a free lock file is removed
             raise
         try:
-            existing = session_folders(participant_folder)
-            if existing:
-                raise UserError(
-                    f"participant {participant!r} already has a session in {existing[-1]}: "
-                    "allowed is --resume to continue it, or another participant ID")
+            _refuse_existing(participant_folder, participant)  # again under the lock: one may have begun meanwhile
             with StudyLock(study_folder):
                 folder, info = cls._describe(protocol, participant, study_folder, participant_folder,
                                              seed, apparatus, order_row)
@@ -283,6 +280,7 @@ class Session:
         if not session_folders(participant_folder):
             raise UserError(f"participant {participant!r} has no session to resume in {participant_folder}: "
                             "allowed is to start one without --resume")
+        read_description(session_folders(participant_folder)[-1])  # read-only, before the lock: refused unchanged
         lock = ParticipantLock(participant_folder, participant)
         try:
             folder = session_folders(participant_folder)[-1]
@@ -322,6 +320,13 @@ class Session:
             lock.release()
             raise
         return cls(folder, lock)
+
+
+def _refuse_existing(participant_folder, participant):
+    existing = session_folders(participant_folder)
+    if existing:
+        raise UserError(f"participant {participant!r} already has a session in {existing[-1]}: "
+                        "allowed is --resume to continue it, or another participant ID")
 
 
 def _not_created(folder, left, failure):
