@@ -30,8 +30,10 @@ def register(sub):
                    help="recording files (.npz/.h5/.csv) or directories of them (e.g. from simulate-set); "
                         "none with --objective perceptual")
     p.add_argument("-o", "--output", required=True, metavar="PARAMS.toml", help="where to write the tuned parameters")
-    p.add_argument("--estimators", nargs="+", metavar="NAMES",
-                   help="estimators to tune, comma or space separated (default: the paper's thirteen)")
+    # one value per option (comma separated, the option repeatable): a list of values would swallow the
+    # RECORDING after it ("--estimators LOWPASS rec.npz")
+    p.add_argument("--estimators", action="append", metavar="NAMES",
+                   help="estimators to tune, comma separated, e.g. LOWPASS,KALMAN (default: the paper's thirteen)")
     p.add_argument("--objective", choices=("paper", "perceptual"), default="paper",
                    help="what to minimise: the paper's objective sum of error and delay over the recordings, or "
                         "the audio distance to TRUE in the closed loop (default paper)")

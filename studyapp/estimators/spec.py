@@ -169,7 +169,8 @@ def validate_rate(rate, name="rate"):
         rate = None
     if rate is None or not (RATE_MIN <= rate <= RATE_MAX):
         shown = "not a number" if rate is None else f"{rate:g}"
-        raise ParameterError(f"{name} = {shown}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz")
+        named = f"{name} {shown}" if name.startswith("-") else f"{name} = {shown}"  # an option, or a field
+        raise ParameterError(f"{named}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz")
     return rate
 
 
