@@ -38,11 +38,17 @@ def _existing_parent(path, option):
 
 def _refuse_session_data(path, folder, option):
     """``path`` is an output written in ``folder``: refused when that, or the nearest folder that exists
-    above it (where the missing ones would be made), is a session folder."""
-    folder = Path(os.path.abspath(folder))
-    while not folder.exists() and folder != folder.parent:
-        folder = folder.parent
-    for place in dict.fromkeys([folder, folder.resolve()]):
+    above it (where the missing ones would be made), or any folder above that, is a session folder.
+
+    Both as spelled and as the file system finds it: ``os.path.abspath`` drops ``link/..`` by its
+    letters, while the system follows the link first (``realpath``), so ``link/../SESSION`` lands in
+    the session whichever way it is read."""
+    places = []
+    for start in dict.fromkeys([Path(os.path.abspath(folder)), Path(os.path.realpath(folder))]):
+        while not start.exists() and start != start.parent:
+            start = start.parent
+        places += [start, *start.parents, start.resolve(), *start.resolve().parents]
+    for place in dict.fromkeys(places):
         if is_session_folder(place):
             raise UserError(f"{_named(option, path)}: inside the session folder {place}, whose {EVENTS_FILE}, "
                             f"{SESSION_FILE} and audio files are participant data: allowed is a path outside "

@@ -67,6 +67,8 @@ def check_npz(archive, path, limit=None):
     headers = {}
     for info in archive.infolist():
         where = f"{path}: member {info.filename!r}"
+        if info.filename in headers:
+            raise InputDataError(f"{where} appears twice: allowed is each column once")
         if not info.filename.endswith(".npy"):
             raise InputDataError(f"{where} is not an .npy array")
         _check_packing(info.file_size, info.compress_size, where)
