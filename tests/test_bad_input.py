@@ -665,7 +665,7 @@ CASES_32 = {
     "live-wav-folder": ([*LIVE[:2], f"wav:{S32}", *LIVE[3:]], ".wav"),
     "live-wav-fifo": ([*LIVE[:2], "wav:{in32}/fifo.wav", *LIVE[3:]], "FIFO"),
     "live-wav-trailing-slash": ([*LIVE[:2], "wav:{out}/take.wav/", *LIVE[3:]], ".wav"),
-    "live-wav-is-protocol": ([*LIVE[:2], "wav:{in32}/fifo.wav", *LIVE[3:], "--protocol", PROTOCOL], "FIFO"),
+    "live-wav-is-protocol": ([*LIVE[:2], f"wav:{PROTOCOL}", *LIVE[3:], "--protocol", PROTOCOL], ".wav"),
     **{f"notes-add-events-{name}": (["notes", NOTES_ADD.replace("{name}", name), "--add", "text"], "events.jsonl")
        for name in ("binary", "folder", "zero", "sparse")},
     "run-over-wrong-types": (RESUME32, "p1"),

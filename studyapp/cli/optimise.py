@@ -92,8 +92,8 @@ def run(args):
     if output.suffix.lower() != ".toml":
         raise UserError(f"-o {output}: expected a .toml file")
     checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
-    output_paths.check_file(output, inputs=args.recordings)
-    output_paths.check_file(checkpoint, "--checkpoint", inputs=[*args.recordings, output])
+    output_paths.check_file(args.output, inputs=args.recordings)  # as spelled: Path() drops a trailing '/'
+    output_paths.check_file(args.checkpoint or checkpoint, "--checkpoint", inputs=[*args.recordings, output])
     delay_option.check_max_lag(args.max_lag)
     if args.patience < 1:
         raise UserError(f"--patience {args.patience}: allowed is an integer of at least 1")

@@ -14,6 +14,12 @@ session lock (``.lock``: replacing it would let a second program in beside the
 holder), nor over one of the command's own inputs: an output file is none of
 them, and an output folder is not an input folder and holds no input file (the
 command's fixed file names could fall on one).
+
+Every spelling of a path is checked: empty, a NUL, a trailing ``/`` (``Path``
+would drop it: ``-o x.csv/``), a FIFO, device or socket (never opened:
+``special_files``), a link, and ``..`` after a link (checked as spelled and as
+the file system follows it). An ``--audio wav:FILE`` is an output too
+(``check_audio``): a ``.wav`` name outside every session folder.
 """
 
 import os

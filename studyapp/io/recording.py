@@ -14,7 +14,12 @@ acceleration, acceleration_true (m/s^2), force (N, the force commanded on the ha
 audio (arbitrary units, the body filter's output).
 
 Writes are atomic (``studyapp.io.atomic``): a failure leaves no partial file. ``load``
-raises ``InputDataError`` naming the file and what is wrong with it.
+raises ``InputDataError`` naming the file and what is wrong with it. It holds the whole
+recording in memory, so it reads at most ``LOAD_LIMIT`` bytes: the file, and what an
+archive's members unpack to, checked before anything is read (``archive_bounds``;
+a FIFO, device or sparse file is refused from its status, ``special_files``,
+``file_bounds``); a column must hold real numbers (not booleans, complex numbers
+or text), and the metadata's ``rate`` a positive number.
 """
 
 import json

@@ -8,8 +8,11 @@ named columns as float64. Memory stays that of one block whatever the file's
 length. A UTF-8 byte order mark (Excel's "CSV UTF-8") is accepted.
 
 A bad file stops with one ``InputDataError`` that names the file, the line and
-the column. The header, the first row and the file's kind (a regular file: a
-device such as ``/dev/zero`` never ends) are checked on opening; a bad cell
+the column. The header (each column once), the first row and the file's kind
+(a regular file: a device such as ``/dev/zero`` never ends; not sparse,
+``file_bounds``) are checked on opening; a line longer than ``LINE_LIMIT``
+characters is refused when reached (a file without line breaks is never read
+whole); a bad cell
 further down is found when its block is read, so a caller writing as it reads
 writes atomically (``studyapp.io.atomic``).
 """

@@ -4,10 +4,12 @@ Only a regular file is read (``/dev/zero`` or ``/dev/urandom`` would never
 end), and it is opened without blocking, so a FIFO is refused at once instead
 of waiting forever for a writer (``open_regular``, for every reader of a file
 a person or a crash could have replaced: protocols, parameter files, CSV
-inputs, a session's session.json and events.jsonl). At most ``LIMIT_BYTES`` of
-a small file is read: such files are a few kilobytes, so a larger one is
-refused before it costs memory or parse time. TOML nested deeper than Python's
-recursion limit is refused too (``tomllib`` would raise ``RecursionError``).
+inputs, a session's session.json and events.jsonl), nor a sparse one
+(``file_bounds``). At most ``LIMIT_BYTES`` of a small file is read: such files
+are a few kilobytes, so a larger one is refused before it costs memory or parse
+time. TOML nested deeper than Python's recursion limit is refused too
+(``tomllib`` would raise ``RecursionError``), and JSON nested deeper than
+``bounded_json.MAX_DEPTH`` (``read_json``).
 Every problem is one ``UserError`` naming the file.
 """
 
