@@ -647,7 +647,7 @@ def inputs32(tmp_path_factory):
 
 
 S32 = "{in32}/results/demo/p1/{session}"
-NOTES_ADD = "{in32}/events_{name}/demo/p1/{session}"
+NOTES_ADD = "{in32}/events_{name}/demo/p1"  # the participant folder: its latest session
 RUN32 = [*RUN, "--results", "{out}/r", "--protocol"]
 OPTIMISE32 = ["optimise", "--max-sets", "1", "--workers", "1", "--quiet", "--estimators", "LOWPASS", "{in32}/rec.npz",
               "-o", "{out}/p.toml"]
@@ -666,8 +666,9 @@ CASES_32 = {
     "live-wav-fifo": ([*LIVE[:2], "wav:{in32}/fifo.wav", *LIVE[3:]], "FIFO"),
     "live-wav-trailing-slash": ([*LIVE[:2], "wav:{out}/take.wav/", *LIVE[3:]], ".wav"),
     "live-wav-is-protocol": ([*LIVE[:2], f"wav:{PROTOCOL}", *LIVE[3:], "--protocol", PROTOCOL], ".wav"),
-    **{f"notes-add-events-{name}": (["notes", NOTES_ADD.replace("{name}", name), "--add", "text"], "events.jsonl")
-       for name in ("binary", "folder", "zero", "sparse")},
+    **{f"notes-add-events-{name}": (["notes", NOTES_ADD.replace("{name}", name), "--add", "text"], named)
+       for name, named in (("binary", "no valid event"), ("folder", "is a folder"), ("zero", "(a device)"),
+                           ("sparse", "sparse"))},
     "run-over-wrong-types": (RESUME32, "p1"),
     "run-resume-over-wrong-types": ([*RESUME32, "--resume"], "session.json"),
     # 4. accepted when it should be refused
