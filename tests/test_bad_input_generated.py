@@ -16,8 +16,8 @@ import io
 import json
 import math
 import os
-import signal
 import socket
+import warnings
 import zipfile
 from pathlib import Path
 from unittest import mock
@@ -30,26 +30,10 @@ from hypothesis import strategies as st
 from studyapp.cli import main, output_paths
 from studyapp.errors import InputDataError, UserError
 from studyapp.io import archive_bounds, bounded_json
-from tests.test_bad_input import PROTOCOL, RATE, _npz, _results, _session_of, _signal
+from tests.test_bad_input import PROTOCOL, RATE, _npz, _results, _session_of, _signal, no_hang
 
 SETTINGS = settings(max_examples=25, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-HANG_S = 30  # a reader that blocks or reads for this long has hung (the machine may be busy)
-
-
-@contextlib.contextmanager
-def no_hang(seconds=HANG_S):
-    def hung(signum, frame):
-        raise AssertionError(f"hung for {seconds} s")
-
-    previous = signal.signal(signal.SIGALRM, hung)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
-
 
 @pytest.fixture(scope="module")
 def world(tmp_path_factory):
@@ -267,7 +251,8 @@ def archives(draw):
         np.save(meta, np.array(json.dumps({} if rate is None else {"rate": rate})))
         z.writestr("__meta__.npy", meta.getvalue())
         for name in ["position", "velocity_lvt"] + (["position"] if twice else []):
-            with contextlib.suppress(UserWarning):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # zipfile's "Duplicate name": the point of ``twice``
                 z.writestr(f"{name}.npy", header.getvalue() + values.tobytes())
     return buffer.getvalue(), n * claim * np.dtype(dtype).itemsize
 
@@ -275,8 +260,6 @@ def archives(draw):
 @settings(SETTINGS, max_examples=30)
 @given(archives(), st.sampled_from(["load", "blocks"]))
 def test_an_archive_is_read_or_refused_from_its_directory(tmp_path_factory, case, how):
-    import warnings
-
     from studyapp.io.recording import load
     from studyapp.io.recording_blocks import RecordingBlocks
 
