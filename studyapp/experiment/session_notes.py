@@ -13,7 +13,10 @@ these are the ones added as things happen, and after.
   the participant's lock (``session_lock``: refused, naming the holder, while
   a session of theirs runs in another program), appends, and lets go;
   ``studyapp notes SESSION_DIR --add TEXT`` and the console (its last
-  session) use it.
+  session) use it. The log is read first, without the lock: one that is
+  refused (a FIFO, a device, a folder, too large or sparse, or holding no
+  valid event at all) is refused with the participant's folder, its .lock
+  included, unchanged.
 - ``list_notes(results)``: every note under a results folder, for
   ``studyapp notes RESULTS_DIR`` (a table on stdout, or CSV with ``-o``).
   Notes are not responses, so ``export`` carries none: a note of several
