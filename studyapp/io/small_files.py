@@ -19,7 +19,7 @@ import stat
 import tomllib
 from pathlib import Path
 
-from studyapp.errors import UserError
+from studyapp.errors import InputDataError, UserError
 from studyapp.io import bounded_json
 from studyapp.io.file_bounds import check_not_sparse
 from studyapp.io.special_files import NotARegularFile, kind
@@ -86,7 +86,7 @@ def read_json(path, what, limit=LIMIT_BYTES):
     try:
         return bounded_json.loads(data)
     except ValueError as exc:  # invalid JSON, nested too deeply, not UTF-8
-        raise UserError(f"{path}: not a valid {what} (invalid JSON: {exc})") from None
+        raise InputDataError(f"{path}: not valid JSON ({exc}): allowed is a {what} file") from None
 
 
 def parse_toml(text, source):
