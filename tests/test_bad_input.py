@@ -12,7 +12,9 @@ Not covered: ``gui`` (needs a display; its options are those of ``run``) and
 refused before the engine starts.
 """
 
+import contextlib
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -556,3 +558,253 @@ def test_issue21_a_session_json_fifo_is_read_as_damaged_with_a_warning(inputs, i
         assert proc.returncode == 2 and "Traceback" not in proc.stderr and "not a regular file" in lines[0]
         assert lines[-1].startswith("studyapp: error: ") and "--strict" in lines[-1]
         assert not (out / "y.csv").exists() and not (out / "rep").exists()
+
+
+# ---------------------------------------------------------------------------------------------------
+# Issue 32 (bad input, round three): writes over participant data, hangs, tracebacks, inputs accepted
+# that should be refused, misleading messages. Inputs of their own; the generated cases of the same
+# families are in tests/test_bad_input_generated.py.
+# ---------------------------------------------------------------------------------------------------
+
+def _npy(array):
+    import io
+
+    buffer = io.BytesIO()
+    np.save(buffer, array)
+    return buffer.getvalue()
+
+
+def write_bomb(path, samples, meta=None):
+    """An .npz whose ``position`` member unpacks to ``samples`` float64 zeros from 8 kB per 8 MB (deflate)."""
+    import io
+    import json
+    import zipfile
+
+    header = io.BytesIO()  # the .npy header (magic included) of the full shape, then the zeros
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False, "shape": (samples,)})
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("__meta__.npy", _npy(np.array(json.dumps(meta or {"rate": RATE}))))
+        with z.open("position.npy", "w", force_zip64=True) as member:
+            member.write(header.getvalue())
+            block = bytes(1 << 23)
+            for _ in range(samples * 8 // len(block)):
+                member.write(block)
+        for name in ("acceleration", "velocity_lvt", "velocity_true"):
+            z.writestr(f"{name}.npy", _npy(np.zeros(10)))
+
+
+def _session_of(results):
+    return next(Path(results).rglob("events.jsonl")).parent
+
+
+@pytest.fixture(scope="module")
+def inputs32(tmp_path_factory):
+    import json
+
+    d = tmp_path_factory.mktemp("inputs32")
+    sig = _signal()
+    _results(d / "results")
+    session = _session_of(d / "results")
+    (session / "audio.wav").write_bytes(b"RIFF....WAVE")
+    (d / "link").symlink_to(session)
+    os.mkfifo(d / "fifo.wav")
+    _recording(d / "rec.npz")
+    with open(d / "sparse.csv", "wb") as f:  # 3 GB, all but the header a hole
+        f.write(b"position\n0.1\n")
+        f.truncate(3 << 30)
+    write_bomb(d / "bomb.npz", 50_000_000)  # 400 MB of zeros in 400 kB
+    (d / "dup.csv").write_text("position,position\n0.1,0.2\n0.2,0.3\n")
+    _npz(d / "bool.npz", {**sig, "position": sig["position"] > 0}, {"rate": RATE})
+    _npz(d / "complex.npz", {**sig, "position": sig["position"] + 1j}, {"rate": RATE})
+    for tag, rate in (("1e9", 1e9), ("500", 500), ("1e-300", 1e-300), ("true", True)):
+        _npz(d / f"rate_{tag}.npz", sig, {"rate": rate})
+    (d / "good.csv").write_text("position\n" + "".join(f"{0.001 * i!r}\n" for i in range(50)))
+    for name in ("nested_line", "nested_session"):
+        _results(d / name)
+    with open(_session_of(d / "nested_line") / "events.jsonl", "ab") as f:
+        f.write(b"[" * 100_000 + b"]" * 100_000 + b"\n")
+    (_session_of(d / "nested_session") / "session.json").write_text("[" * 100_000 + "]" * 100_000)
+    for name in ("binary", "folder", "zero", "sparse", "fifo"):  # events.jsonl that notes --add refuses
+        events = _session_of(_results(d / f"events_{name}")) / "events.jsonl"
+        if name == "binary":
+            events.write_bytes(np.random.default_rng(32).integers(0, 256, 5000, dtype=np.uint8).tobytes())
+        elif name == "sparse":
+            with open(events, "ab") as f:
+                f.truncate(2 << 30)
+        else:
+            events.unlink()
+            {"folder": events.mkdir, "zero": lambda: events.symlink_to("/dev/zero"),
+             "fifo": lambda: os.mkfifo(events)}[name]()
+    wrong = _session_of(_results(d / "wrong_types"))
+    info = json.loads((wrong / "session.json").read_text())
+    (wrong / "session.json").write_text(json.dumps({**info, "seed": "abc", "schedule": "x", "participant": 5}))
+    (wrong / "events.jsonl").unlink()  # nothing to rebuild the description from: resume is refused
+    demo = Path(PROTOCOL).read_text()
+    for name, old, new in (("break0", "break_every = 2", "break_every = 0"),
+                           ("rating_inaudible", "fmax = 1.0", "fmax = 0.001"),
+                           ("ceiling_inaudible", "ceiling = 40.0", "ceiling = 0.05")):
+        assert old in demo
+        (d / f"{name}.toml").write_text(demo.replace(old, new))
+    yield d
+
+
+S32 = "{in32}/results/demo/p1/{session}"
+NOTES_ADD = "{in32}/events_{name}/demo/p1"  # the participant folder: its latest session
+RUN32 = [*RUN, "--results", "{out}/r", "--protocol"]
+OPTIMISE32 = ["optimise", "--max-sets", "1", "--workers", "1", "--quiet", "--estimators", "LOWPASS", "{in32}/rec.npz",
+              "-o", "{out}/p.toml"]
+RESUME32 = ["run", "--participant", "p1", "--simulated-participant", "--headless", "--protocol", PROTOCOL,
+            "--results", "{in32}/wrong_types"]
+
+# case: (argv, what the one line must name)
+CASES_32 = {
+    # 1. writes over participant data
+    "live-wav-over-session-audio": ([*LIVE[:2], f"wav:{S32}/audio.wav", *LIVE[3:]], "session folder"),
+    "live-wav-new-in-session": ([*LIVE[:2], f"wav:{S32}/take.wav", *LIVE[3:]], "session folder"),
+    "live-wav-session-by-dotdot": ([*LIVE[:2], f"wav:{S32}/../{{session}}/take.wav", *LIVE[3:]], "session folder"),
+    "live-wav-session-by-link": ([*LIVE[:2], "wav:{in32}/link/take.wav", *LIVE[3:]], "session folder"),
+    "live-wav-events": ([*LIVE[:2], f"wav:{S32}/events.jsonl", *LIVE[3:]], ".wav"),
+    "live-wav-folder": ([*LIVE[:2], f"wav:{S32}", *LIVE[3:]], ".wav"),
+    "live-wav-fifo": ([*LIVE[:2], "wav:{in32}/fifo.wav", *LIVE[3:]], "FIFO"),
+    "live-wav-trailing-slash": ([*LIVE[:2], "wav:{out}/take.wav/", *LIVE[3:]], ".wav"),
+    "live-wav-is-protocol": ([*LIVE[:2], f"wav:{PROTOCOL}", *LIVE[3:], "--protocol", PROTOCOL], ".wav"),
+    **{f"notes-add-events-{name}": (["notes", NOTES_ADD.replace("{name}", name), "--add", "text"], named)
+       for name, named in (("binary", "no valid event"), ("folder", "is a folder"), ("zero", "(a device)"),
+                           ("sparse", "sparse"))},
+    "run-over-wrong-types": (RESUME32, "p1"),
+    "run-resume-over-wrong-types": ([*RESUME32, "--resume"], "session.json"),
+    # 4. accepted when it should be refused
+    "estimate-two-position-columns": (["estimate", "{in32}/dup.csv", *ESTIMATE], "'position' appears twice"),
+    "estimate-boolean-positions": (["estimate", "{in32}/bool.npz", "--estimator", "LOWPASS", "-o", "{out}/e.csv"],
+                                   "bool"),
+    "estimate-out-trailing-slash": (["estimate", "{in32}/good.csv", *ESTIMATE[:4], "-o", "{out}/x.csv/"], "-o"),
+    "estimate-out-dot": (["estimate", "{in32}/good.csv", *ESTIMATE[:4], "-o", "{out}/x.csv/."], "-o"),
+    "export-out-trailing-slash": (["export", "{in32}/results", "-o", "{out}/x.csv/"], "-o"),
+    "evaluate-complex-positions": (["evaluate", "{in32}/complex.npz"], "complex"),
+    "live-estimators-empty": ([*LIVE, "--estimators", ""], "--estimators"),
+    "live-estimators-commas": ([*LIVE, "--estimators", " , "], "--estimators"),
+    "run-results-empty": ([*RUN, "--results", "", "--protocol", PROTOCOL], "--results"),
+    "gui-results-empty": (["gui", "--results", ""], "--results"),
+    "run-break-every-0": ([*RUN32, "{in32}/break0.toml"], "break_every"),
+    "run-rating-fmax-inaudible": ([*RUN32, "{in32}/rating_inaudible.toml"], "[rating] fmax"),
+    "run-ceiling-inaudible": ([*RUN32, "{in32}/ceiling_inaudible.toml"], "[adjustment] ceiling"),
+    # 5. messages that mislead
+    "optimise-recording-after-estimators-checkpoint-fifo": ([*OPTIMISE32, "--checkpoint", "{in32}/fifo.wav"],
+                                                            "--checkpoint"),
+    "optimise-recording-after-estimators-range": ([*OPTIMISE32, "--range", "LOWPASS.cutoff_hz=x"], "--range"),
+    "optimise-recording-after-estimators-scheduler": ([*OPTIMISE32, "--scheduler", "nowhere"], "--scheduler"),
+    "tradeoff-rates-0": ([*TRADEOFF, "-o", "{out}/t", "--rates", "0"], "--rates"),
+    **{f"evaluate-meta-rate-{tag}": (["evaluate", f"{{in32}}/rate_{tag}.npz"], f"rate_{tag}.npz")
+       for tag in ("1e9", "500", "1e-300", "true")},
+    **{f"estimate-meta-rate-{tag}": (["estimate", f"{{in32}}/rate_{tag}.npz", "--estimator", "LOWPASS"],
+                                     f"rate_{tag}.npz") for tag in ("1e9", "500", "1e-300", "true")},
+}
+
+
+def _argv32(template, inputs32, out):
+    session = _session_of(inputs32 / "results").name
+    return [a.replace("{in32}", str(inputs32)).replace("{out}", str(out)).replace("{session}", session)
+            for a in template]
+
+
+def _contents32(folder):
+    """Every file's bytes (locks included) and every name, links as their target."""
+    return {str(p.relative_to(folder)): (os.readlink(p) if p.is_symlink() else p.read_bytes() if p.is_file()
+                                         else p.is_dir()) for p in sorted(Path(folder).rglob("*"))
+            if not (p.is_file() and p.stat().st_size > 1 << 20)}  # the sparse files: their names only
+
+
+@pytest.mark.parametrize("case", list(CASES_32))
+def test_issue32_bad_input_is_refused_in_one_line_naming_it(case, inputs32, tmp_path, capsys, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    monkeypatch.chdir(out)
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    template, named = CASES_32[case]
+    before = (_contents32(inputs32), _tree(out))
+    code = main(_argv32(template, inputs32, out))
+    err = capsys.readouterr().err
+    assert_refused(code, err, before, (_contents32(inputs32), _tree(out)))
+    assert named.replace("{session}", "") in err, err
+
+
+def test_issue32_complex_positions_warn_of_nothing(inputs32, tmp_path, capsys):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's ComplexWarning before the error was a second line
+        code = main(["evaluate", str(inputs32 / "complex.npz")])
+    assert code == 2 and "complex" in capsys.readouterr().err
+
+
+HANG_S = 30  # seconds: a command that takes this long on a refused input has hung (the machine may be busy)
+
+
+@contextlib.contextmanager
+def no_hang(seconds=HANG_S):
+    """Fail, instead of hanging, when the body runs longer than ``seconds`` (SIGALRM interrupts a blocking
+    open or read too: the handler's exception ends it)."""
+    def hung(signum, frame):
+        raise AssertionError(f"hung for {seconds} s")
+
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+HANGS_32 = {
+    "estimate-sparse-3gb-csv": ["estimate", "{in32}/sparse.csv", *ESTIMATE],
+    "evaluate-zip-bomb": ["evaluate", "{in32}/bomb.npz"],
+    "estimate-zip-bomb": ["estimate", "{in32}/bomb.npz", "--estimator", "LOWPASS", "-o", "{out}/e.csv"],
+    "optimise-zip-bomb": [*OPTIMISE32[:-3], "{in32}/bomb.npz", "-o", "{out}/p.toml"],
+    "notes-add-events-fifo": ["notes", NOTES_ADD.replace("{name}", "fifo"), "--add", "text"],
+}
+
+
+@pytest.mark.parametrize("case", list(HANGS_32))
+def test_issue32_no_reader_hangs_on_a_huge_sparse_packed_or_special_input(case, inputs32, tmp_path, capsys,
+                                                                         monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    monkeypatch.chdir(out)
+    before = (_contents32(inputs32), _tree(out))
+    with no_hang():
+        code = main(_argv32(HANGS_32[case], inputs32, out))
+    assert_refused(code, capsys.readouterr().err, before, (_contents32(inputs32), _tree(out)))
+
+
+# 3. deeply nested JSON (a line of events.jsonl, a session.json): read as damaged, never a traceback
+NESTED_32 = {
+    "export": ["export", "{in32}/{name}", "-o", "{out}/x.csv"],
+    "notes": ["notes", "{in32}/{name}"],
+    "notes-add": ["notes", "{in32}/{name}/demo/p1/{session}", "--add", "text"],
+    "plan-results": ["plan", "--protocol", PROTOCOL, "--participant", "p1", "--results", "{in32}/{name}"],
+    "run-replay-gesture": [*RUN32, PROTOCOL, "--replay-gesture", "{in32}/{name}/demo/p1/{session}"],
+}
+
+
+@pytest.mark.parametrize("name", ["nested_line", "nested_session"])
+@pytest.mark.parametrize("command", list(NESTED_32))
+def test_issue32_deeply_nested_json_is_damage_not_a_traceback(command, name, inputs32, tmp_path, capsys,
+                                                               monkeypatch):
+    import shutil
+
+    copy = tmp_path / "in"  # notes --add writes (a repaired log): on a copy
+    shutil.copytree(inputs32 / name, copy / name, symlinks=True)
+    out = tmp_path / "out"
+    out.mkdir()
+    monkeypatch.chdir(out)
+    session = _session_of(copy / name).name
+    argv = [a.replace("{in32}", str(copy)).replace("{out}", str(out)).replace("{name}", name)
+            .replace("{session}", session) for a in NESTED_32[command]]
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "RecursionError" not in err, err
+    assert code in (0, 2), err
+    if code == 2:
+        assert len(err.strip().splitlines()) == 1 and "hand_trace" in err, err  # the replay finds no bowing

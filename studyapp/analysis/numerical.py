@@ -23,7 +23,6 @@ F_max is better when higher but delay when lower (rho of -F_max and delay).
 Only conditions present on both sides count; rho needs three or more.
 """
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +30,9 @@ import pandas as pd
 
 from studyapp.stats.spearman import spearman
 from studyapp.errors import InputDataError
+from studyapp.io.small_files import read_json
+
+EVALUATION_LIMIT = 1 << 26  # bytes: evaluation.json of 13 estimators on 15 recordings is about 100 kB
 
 NUMERICAL_COLUMNS = ["comparison", "subjective", "numerical", "metric", "n", "rho", "p_value", "conditions"]
 
@@ -42,10 +44,7 @@ def load_evaluation(source):
         path = path / "evaluation.json"
     if not path.is_file():
         raise InputDataError(f"{path}: no such evaluation file (expected the output of 'studyapp evaluate -o DIR')")
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputDataError(f"{path}: not valid JSON ({exc})") from None
+    data = read_json(path, "evaluation file", EVALUATION_LIMIT)  # a FIFO, a huge or deeply nested file: one line
     estimators = data.get("estimators") if isinstance(data, dict) else None
     if not isinstance(estimators, dict) or not estimators:
         raise InputDataError(f"{path}: field 'estimators' must be a non-empty object of estimator results")

@@ -43,7 +43,8 @@ from studyapp.analysis.study import analyse
 from studyapp.analysis.summary import SUMMARY_COLUMNS
 from studyapp.analysis.within_subject import FRIEDMAN_COLUMNS, SIGNED_RANK_COLUMNS
 from studyapp.io.atomic import atomic_open
-from studyapp.errors import InputDataError
+from studyapp.errors import InputDataError, UserError
+from studyapp.io.small_files import read_json
 
 RESPONSES_FILE = "responses_analysed.csv"
 SETTINGS_FILE = "analysis_settings.json"
@@ -68,13 +69,13 @@ def open_study(path, include_simulated=False):
         responses, label = load_responses(path, include_simulated=include_simulated)
         return analyse(responses, source=label, include_simulated=include_simulated)
     try:
-        settings = json.loads(settings_path.read_text(encoding="utf-8"))
+        settings = read_json(settings_path, "analysis settings file")
         source, holm, alpha = str(settings["source"]), bool(settings["holm"]), float(settings["alpha"])
         expected, evaluation = settings.get("expected"), settings.get("evaluation")
         # what the analysed responses kept (older folders: the defaults)
         kept = {key: bool(settings.get(key, False)) for key in ("include_practice", "include_simulated")}
         pooled_letters = bool(settings.get("pooled_letters", False))
-    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError) as exc:
+    except (UserError, KeyError, TypeError, ValueError) as exc:
         raise InputDataError(f"{settings_path}: not a valid analysis settings file ({exc})") from None
     responses, _ = load_responses(path / RESPONSES_FILE, **kept)
     evaluation = load_evaluation(evaluation) if evaluation and Path(evaluation).exists() else None

@@ -26,6 +26,7 @@ is not registered is bad input: one line naming the file, the column and the
 row.
 """
 
+import io
 from pathlib import Path
 
 import numpy as np
@@ -35,10 +36,12 @@ from studyapp.errors import InputDataError, UserError
 from studyapp.experiment.export import export_responses
 from studyapp.experiment.records import TRIAL_MAX
 from studyapp.experiment.tasks import task_names, task_type
+from studyapp.io.small_files import read_bytes
 
 REQUIRED_COLUMNS = ["participant", "task", "condition", "trial", "fmax", "rating"]
 TASKS = task_names()
 MEASURED_TASKS = tuple(t for t in TASKS if task_type(t).measure is not None)
+RESPONSES_LIMIT = 1 << 28  # bytes: a study's export is well under a megabyte
 _TEXT_COLUMNS = ["participant", "session", "task", "condition", "protocol_hash"]
 
 
@@ -53,10 +56,11 @@ def load_responses(source, problems=None, include_practice=False, include_simula
     """
     path = Path(source)
     if path.suffix.lower() == ".csv":
-        if not path.is_file():
+        if not path.exists():
             raise InputDataError(f"{path}: no such responses file")
+        data = read_bytes(path, "responses CSV", RESPONSES_LIMIT)  # a FIFO, a device, a sparse or huge file: refused
         try:
-            frame = pd.read_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
+            frame = pd.read_csv(io.BytesIO(data), dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
             raise InputDataError(f"{path}: not a readable CSV file ({_first_line(exc)})") from None
         return check_responses(frame, str(path), csv_rows=True, include_practice=include_practice,

@@ -78,7 +78,7 @@ def run(args):
     from studyapp.model.playable import check_playable
 
     names = breakdown.sources() if args.all else [breakdown.check_source(args.source, "--source")]
-    check_playable(validate_rate(args.rate), calibration.F0)
+    check_playable(validate_rate(args.rate, "--rate"), calibration.F0)
     breakdown.check_seeds(args.seeds, "--seeds")
     breakdown.check_gesture(args.gesture, "--gesture")
     breakdown.check_duration(args.duration, "--duration")

@@ -34,7 +34,7 @@ def run(args):
     from studyapp.evaluation import delay_and_error
     from studyapp.synthetic import stick_slip
 
-    rate = validate_rate(args.rate)
+    rate = validate_rate(args.rate, "--rate")
     if not 0.1 <= args.seconds <= 600:
         raise ParameterError(f"--seconds {args.seconds:g}: allowed is 0.1 to 600")
     sig = stick_slip(rate, args.seconds, f0=F0, seed=args.seed)

@@ -72,10 +72,12 @@ class _Input:
 
         from studyapp.io import recording_blocks, sample_table
         from studyapp.errors import ParameterError
+        from studyapp.estimators.spec import validate_rate
 
         self.path = path
         if Path(path).suffix.lower() in recording_blocks.SUFFIXES:
             self.source = recording_blocks.RecordingBlocks(path)
+            validate_rate(self.source.rate, f"{path}: sample rate (metadata 'rate' or the 't' column)")
             self.rate = _recording_rate(path, self.source.rate, rate)
             self.header = list(self.source.names)
             self.is_table = False
@@ -83,8 +85,8 @@ class _Input:
             if rate is None:
                 raise ParameterError(f"--rate: required for {path} (a CSV carries no sample rate): allowed is "
                                      "a number of Hz from 1000 to 96000")
+            self.rate = validate_rate(rate, "--rate")
             self.source = sample_table.SampleTable(path)
-            self.rate = rate
             self.header = self.source.header
             self.is_table = True
         velocity = "velocity" if "velocity" in self.header else "velocity_lvt"

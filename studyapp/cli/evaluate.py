@@ -21,8 +21,9 @@ def register(sub):
                    help="tuned parameters (from studyapp optimise); with several files (e.g. optimise --seed 0, "
                         "1, 2) the first is evaluated and every file's F_g is compared under one common scale "
                         "(seed_spread.csv)")
-    p.add_argument("--estimators", nargs="+", metavar="NAMES",
-                   help="estimators to evaluate (default: those in --params, else the paper's thirteen)")
+    p.add_argument("--estimators", action="append", metavar="NAMES",  # one value: a list would swallow RECORDINGs
+                   help="estimators to evaluate, comma separated (default: those in --params, else the paper's "
+                        "thirteen)")
     p.add_argument("--reference", choices=("lvt", "true"), default="lvt",
                    help="reference velocity: the LVT tachometer (paper) or the true velocity (default lvt)")
     p.add_argument("--max-lag", type=float, default=0.02, metavar="SECONDS",
@@ -56,7 +57,8 @@ def run(args):
     delay_option.check_max_lag(args.max_lag)
     output = Path(args.output) if args.output else None
     if output is not None:
-        output_paths.check_folder(output, inputs=[*args.recordings, *filter(None, [args.params, args.validation])])
+        output_paths.check_folder(output, inputs=[*args.recordings, *(args.params or []),
+                                                         *filter(None, [args.validation])])
     if args.compare_paper and output is None:
         raise UserError("--compare-paper: needs -o DIR, the folder its two tables are written to")
     params_files = args.params or [None]

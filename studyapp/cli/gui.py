@@ -79,6 +79,9 @@ def run(args):
         from studyapp.experiment.protocol import load_protocol
 
         load_protocol(args.protocol)
+    output_paths.check_audio(args.audio, inputs=[args.protocol] if args.protocol else [])
+    if not args.results.strip():  # Path("") would be the working folder; the rest is checked when a session starts
+        raise UserError("--results '': empty: allowed is a results folder")
     require_display()
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")

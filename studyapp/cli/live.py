@@ -51,6 +51,9 @@ def _estimators(text, source):
     if text.strip().lower() == "all":
         return {n: {} for n in estimators.names() if n != lvt.NAME}
     names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise ParameterError(f"--estimators {text!r}: names no estimator: allowed are comma-separated names from "
+                             f"{', '.join(estimators.names())}, or all")
     unknown = [n for n in names if n not in estimators.names()]
     if unknown:
         raise ParameterError(f"--estimators: unknown {unknown[0]!r}; allowed are {', '.join(estimators.names())} or all")
@@ -70,6 +73,7 @@ def run(args):
     import sys
     import time
 
+    from studyapp.cli import output_paths
     from studyapp.engine.config import EngineConfig
     from studyapp.engine.engine import Engine
     from studyapp.errors import ParameterError
@@ -79,6 +83,7 @@ def run(args):
         args.source = LVT_SENSOR
     if args.seconds is not None and not args.seconds > 0:
         raise ParameterError(f"--seconds {args.seconds}: allowed is a positive number")
+    output_paths.check_audio(args.audio, inputs=[args.protocol] if args.protocol else [])
 
     def say(text):
         print(text, file=sys.stderr, flush=True)

@@ -30,8 +30,10 @@ def register(sub):
                    help="recording files (.npz/.h5/.csv) or directories of them (e.g. from simulate-set); "
                         "none with --objective perceptual")
     p.add_argument("-o", "--output", required=True, metavar="PARAMS.toml", help="where to write the tuned parameters")
-    p.add_argument("--estimators", nargs="+", metavar="NAMES",
-                   help="estimators to tune, comma or space separated (default: the paper's thirteen)")
+    # one value per option (comma separated, the option repeatable): a list of values would swallow the
+    # RECORDING after it ("--estimators LOWPASS rec.npz")
+    p.add_argument("--estimators", action="append", metavar="NAMES",
+                   help="estimators to tune, comma separated, e.g. LOWPASS,KALMAN (default: the paper's thirteen)")
     p.add_argument("--objective", choices=("paper", "perceptual"), default="paper",
                    help="what to minimise: the paper's objective sum of error and delay over the recordings, or "
                         "the audio distance to TRUE in the closed loop (default paper)")
@@ -90,8 +92,8 @@ def run(args):
     if output.suffix.lower() != ".toml":
         raise UserError(f"-o {output}: expected a .toml file")
     checkpoint = Path(args.checkpoint) if args.checkpoint else output.with_name(output.name + ".checkpoint.json")
-    output_paths.check_file(output, inputs=args.recordings)
-    output_paths.check_file(checkpoint, "--checkpoint", inputs=[*args.recordings, output])
+    output_paths.check_file(args.output, inputs=args.recordings)  # as spelled: Path() drops a trailing '/'
+    output_paths.check_file(args.checkpoint or checkpoint, "--checkpoint", inputs=[*args.recordings, output])
     delay_option.check_max_lag(args.max_lag)
     if args.patience < 1:
         raise UserError(f"--patience {args.patience}: allowed is an integer of at least 1")

@@ -103,6 +103,7 @@ def run(args):
     check_order_row(protocol, args.order_row)
     output_paths.check_folder(args.results, "--results")
     if not args.headless:
+        output_paths.check_audio(args.audio, inputs=[args.protocol, *filter(None, [args.replay_gesture])])
         args.audio = args.audio or "device"
         args.midi = args.midi or "first"
         return _run_in_gui(args)

@@ -79,7 +79,7 @@ def run(args):
         args.source = LVT_SENSOR
     recording.check_path(args.output)
     output_paths.check_file(args.output)
-    rate = validate_rate(args.rate)
+    rate = validate_rate(args.rate, "--rate")
     if not 0 < args.duration <= DURATION_MAX:
         raise ParameterError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
                              f"{DURATION_MAX:g}")

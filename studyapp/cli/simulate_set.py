@@ -27,7 +27,7 @@ def run(args):
     from studyapp.model.simulate import DURATION_MAX
 
     # checked before write_set makes the folder, so a bad value leaves nothing behind
-    check_playable(validate_rate(args.rate), calibration.F0)
+    check_playable(validate_rate(args.rate, "--rate"), calibration.F0)
     if not 0 < args.duration <= DURATION_MAX:
         raise ParameterError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
                              f"{DURATION_MAX:g}")

@@ -74,7 +74,7 @@ def run(args):
     if not 0 < args.duration <= DURATION_MAX:
         raise UserError(f"--duration {args.duration:g}: allowed is a number of seconds above 0 and at most "
                         f"{DURATION_MAX:g}")
-    rates = [validate_rate(r) for r in (args.rates or DEFAULT_RATES)]
+    rates = [validate_rate(r, "--rates") for r in (args.rates or DEFAULT_RATES)]
     for rate in rates:  # the recordings are simulated: the string must play at each rate
         check_playable(rate, calibration.F0)
     fmax = list(args.fmax or DEFAULT_FMAX)

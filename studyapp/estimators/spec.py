@@ -161,13 +161,16 @@ class EstimatorSpec:
         }
 
 
-def validate_rate(rate):
+def validate_rate(rate, name="rate"):
+    """``rate`` as a float in [RATE_MIN, RATE_MAX]; ``ParameterError`` naming ``name`` (an option, a file's field)."""
     try:
-        rate = to_float(rate)
+        rate = None if isinstance(rate, bool) else to_float(rate)
     except (TypeError, ValueError):
-        raise ParameterError(f"rate = {rate!r}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz") from None
-    if not (RATE_MIN <= rate <= RATE_MAX):
-        raise ParameterError(f"rate = {shown(rate)}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz")
+        rate = None
+    if rate is None or not (RATE_MIN <= rate <= RATE_MAX):
+        text = "not a number" if rate is None else shown(rate)
+        named = f"{name} {text}" if name.startswith("-") else f"{name} = {text}"  # an option, or a file's field
+        raise ParameterError(f"{named}: allowed is a number from {RATE_MIN:g} to {RATE_MAX:g} Hz")
     return rate
 
 

@@ -14,8 +14,10 @@ from pathlib import Path
 
 from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
+from studyapp.io.small_files import read_json
 
 FORMAT = "studyapp-optimise-checkpoint/1"
+LIMIT_BYTES = 1 << 28  # a checkpoint of the thirteen is a few hundred kB
 
 
 def write(path, state):
@@ -25,13 +27,9 @@ def write(path, state):
 
 def read(path):
     path = Path(path)
-    try:
-        with open(path, encoding="utf-8") as f:
-            state = json.load(f)
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such checkpoint file") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise UserError(f"{path}: not a checkpoint (invalid JSON: {exc})") from None
+    if not path.exists():
+        raise UserError(f"{path}: no such checkpoint file")
+    state = read_json(path, "checkpoint", LIMIT_BYTES)  # a FIFO, a huge or deeply nested file: one line
     if not isinstance(state, dict) or state.get("format") != FORMAT:
         raise UserError(f"{path}: not a checkpoint of studyapp optimise (expected format {FORMAT})")
     return state

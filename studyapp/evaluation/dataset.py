@@ -28,7 +28,7 @@ from studyapp.errors import InputDataError, ParameterError, UserError
 from studyapp.estimators import create
 from studyapp.estimators.bounds import all_good
 from studyapp.estimators.registry import spec
-from studyapp.estimators.spec import RATE_MAX
+from studyapp.estimators.spec import RATE_MAX, validate_rate
 from studyapp.evaluation import kernels
 from studyapp.evaluation.batch import batches
 from studyapp.evaluation.metric import DEFAULT_METHOD, Reference, check_method
@@ -67,6 +67,7 @@ def reference_column(reference):
 def take_from_recording(recording, name, reference="lvt", sha256=None):
     """A ``Take`` from a ``studyapp.io.recording.Recording`` (columns by the CSV names)."""
     columns = recording.columns
+    validate_rate(recording.rate, f"{name}: sample rate (metadata 'rate' or the 't' column)")
     wanted = ["position", "acceleration", "velocity_lvt", reference_column(reference)]
     for column in wanted:
         if column not in columns:

@@ -85,6 +85,14 @@ def load_traces(events, source="the session log"):
     if not traces:
         raise UserError(f"{source}: no hand_trace record: allowed is the events.jsonl of a session bowed with "
                         "the participant's bowing surface")
+    for step, record in traces.items():  # checked here, before a session starts, not when its step comes
+        try:
+            HandReplay(record)
+        except (KeyError, TypeError, ValueError, IndexError, OverflowError) as exc:
+            raise UserError(f"{source}: hand_trace of step {step!r}: t, x_mm and bow must be lists of finite "
+                            f"numbers of one length ({type(exc).__name__})") from None
+        except UserError as exc:
+            raise UserError(f"{source}: step {step!r}: {exc}") from None
     return traces
 
 

@@ -23,11 +23,12 @@ Lines without a checksum before the first line that has one (a session begun
 by a version that wrote none) are read as they are.
 """
 
-import json
 import re
 import zlib
 from dataclasses import dataclass, field
 
+from studyapp.errors import UserError
+from studyapp.io import bounded_json
 from studyapp.io.small_files import read_regular
 
 _CRC = re.compile(rb',"crc":"([0-9a-f]{8})"\}')
@@ -40,7 +41,7 @@ NO_CHECKSUM = "no checksum"
 def _event(text):
     """The JSON object ``text`` holds as an event (a dict with a ``type``), or the reason it is not one."""
     try:
-        event = json.loads(text)
+        event = bounded_json.loads(text)  # a line nested too deeply is not valid JSON either
     except ValueError:
         return None, "not valid JSON"
     if not isinstance(event, dict) or "type" not in event:
@@ -146,11 +147,17 @@ def scan(data):
 
 def read_log(path):
     """``scan`` of the log at ``path`` (empty when there is none); ``UserError`` for a FIFO or device
-    (never read: it would block or never end) or a log above ``LOG_LIMIT``."""
+    (never read: it would block or never end), a folder, a sparse file or a log above ``LOG_LIMIT``."""
     try:
         return scan(read_regular(path, "session log (events.jsonl)", LOG_LIMIT))
     except FileNotFoundError:
         return LogScan()
+    except IsADirectoryError:
+        raise UserError(f"{path}: is a folder: allowed is a session log file") from None
+    except UserError:
+        raise
+    except OSError as exc:  # permissions, an I/O error: one line, never a traceback
+        raise UserError(f"{path}: cannot read the session log ({exc.strerror or exc})") from None
 
 
 def read_events(path):

@@ -43,6 +43,7 @@ Data safety (docs/experiment.md "Data safety"):
 - Folders and files get the modes of ``data_modes`` (private by default).
 """
 
+import fcntl
 import json
 import os
 import shutil
@@ -61,7 +62,7 @@ from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_proto
 from studyapp.experiment.schedule import Trial, build_schedule
 from studyapp.experiment.log_scan import written_twice
 from studyapp.experiment.session_description import read_description, session_folders
-from studyapp.experiment.session_files import EVENTS_FILE, FORMAT, SESSION_FILE
+from studyapp.experiment.session_files import EVENTS_FILE, FORMAT, LOCK_FILE, SESSION_FILE
 from studyapp.experiment.session_info import (
     check_experimenter,
     check_notes,
@@ -188,6 +189,8 @@ class Session:
         order_row = check_order_row(protocol, order_row)
         study_folder = Path(results) / protocol.study
         participant_folder = study_folder / participant
+        if not _lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
+            _refuse_existing(participant_folder, participant)
         try:
             made = make_folders(participant_folder)
         except OSError as exc:
@@ -200,11 +203,7 @@ class Session:
             _remove_made(made)  # the winner's lock stays: only a free lock file is removed
             raise
         try:
-            existing = session_folders(participant_folder)
-            if existing:
-                raise UserError(
-                    f"participant {participant!r} already has a session in {existing[-1]}: "
-                    "allowed is --resume to continue it, or another participant ID")
+            _refuse_existing(participant_folder, participant)  # again under the lock: one may have begun meanwhile
             with StudyLock(study_folder):
                 folder, info = cls._describe(protocol, participant, study_folder, participant_folder,
                                              seed, apparatus, order_row)
@@ -283,6 +282,8 @@ class Session:
         if not session_folders(participant_folder):
             raise UserError(f"participant {participant!r} has no session to resume in {participant_folder}: "
                             "allowed is to start one without --resume")
+        if not _lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
+            read_description(session_folders(participant_folder)[-1])
         lock = ParticipantLock(participant_folder, participant)
         try:
             folder = session_folders(participant_folder)[-1]
@@ -322,6 +323,29 @@ class Session:
             lock.release()
             raise
         return cls(folder, lock)
+
+
+def _lock_taken(participant_folder):
+    """True when another open of the participant's lock holds it (its refusal, naming the holder, comes
+    first); tested on a descriptor of our own that creates and writes nothing."""
+    try:
+        fd = os.open(Path(participant_folder) / LOCK_FILE, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # dropped when fd closes
+        return False
+    except OSError:
+        return True
+    finally:
+        os.close(fd)
+
+
+def _refuse_existing(participant_folder, participant):
+    existing = session_folders(participant_folder)
+    if existing:
+        raise UserError(f"participant {participant!r} already has a session in {existing[-1]}: "
+                        "allowed is --resume to continue it, or another participant ID")
 
 
 def _not_created(folder, left, failure):

@@ -4,13 +4,13 @@ participant's session folders, read without writing anything.
 Below session.py, which writes them, so that enrolment.py (which session.py uses) can read them too.
 """
 
-import json
 from pathlib import Path
 
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.session_files import EVENTS_FILE, FORMAT, SESSION_FILE
 from studyapp.experiment.session_log import read_log
+from studyapp.io import bounded_json
 from studyapp.io.small_files import LIMIT_BYTES, open_regular
 
 CREATED = records.SESSION_CREATED
@@ -31,7 +31,27 @@ def _check_description(info, where):
     for key in ("participant", "session", "seed", "protocol", "schedule"):
         if key not in info:
             raise ValueError(f"no {key!r}")
+    # the types every reader relies on: a hand-edited or damaged file is damaged, not a traceback
+    _check_types(info, _TYPES, "")
+    _check_types(info["protocol"], _PROTOCOL_TYPES, "protocol.")
+    for number, trial in enumerate(info["schedule"]):
+        if not isinstance(trial, dict):
+            raise ValueError(f"'schedule[{number}]' is {type(trial).__name__}, allowed is an object")
+        _check_types(trial, _TRIAL_TYPES, f"schedule[{number}].")
     return info
+
+
+_TYPES = {"participant": str, "session": str, "seed": int, "protocol": dict, "schedule": list, "study": str,
+          "simulated": bool, "order_row": int}
+_PROTOCOL_TYPES = {"sha256": str, "text": str, "path": str}
+_TRIAL_TYPES = {"step": int, "task": str, "trial": int, "conditions": list}
+
+
+def _check_types(values, types, prefix):
+    for key, kind in types.items():
+        if key in values and not (isinstance(values[key], kind)
+                                  and (kind is bool or not isinstance(values[key], bool))):
+            raise ValueError(f"{prefix}{key!r} is {type(values[key]).__name__}, allowed is {kind.__name__}")
 
 
 def read_description(folder):
@@ -44,7 +64,7 @@ def read_description(folder):
     path = folder / SESSION_FILE
     try:
         with open_regular(path, "session description", "r", encoding="utf-8") as f:  # a FIFO is damaged, not waited on
-            return _check_description(json.loads(f.read(LIMIT_BYTES)), path), []
+            return _check_description(bounded_json.loads(f.read(LIMIT_BYTES)), path), []
     except (OSError, ValueError, UnicodeDecodeError) as exc:
         problem = "missing" if isinstance(exc, FileNotFoundError) else f"damaged ({exc})"
     created = next((e for e in read_log(folder / EVENTS_FILE).events if e.get("type") == CREATED), None)

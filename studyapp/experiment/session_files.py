@@ -7,6 +7,7 @@
 """
 
 import os
+import stat
 from pathlib import Path
 
 SESSION_FILE = "session.json"
@@ -16,12 +17,21 @@ FORMAT = "studyapp-session/1"
 
 
 def is_session_folder(folder):
-    """True when ``folder`` holds an ``events.jsonl``, or a ``session.json`` of this format."""
+    """True when ``folder`` holds an ``events.jsonl``, or a ``session.json`` of this format (or one that is
+    not a regular file, a FIFO: never opened, and taken as a damaged session's, so nothing is written beside it)."""
     folder = Path(folder)
     if os.path.lexists(folder / EVENTS_FILE):
         return True
     try:
-        with open(folder / SESSION_FILE, "rb") as f:  # written by json.dump, "format" first
-            return FORMAT.encode() in f.read(200)
+        # O_NONBLOCK: a FIFO opens at once instead of waiting for a writer
+        fd = os.open(folder / SESSION_FILE, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError:
+        return os.path.lexists(folder / SESSION_FILE) and not os.path.isfile(folder / SESSION_FILE)
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return not stat.S_ISDIR(os.fstat(fd).st_mode)
+        return FORMAT.encode() in os.read(fd, 200)  # written by json.dump, "format" first
     except OSError:
         return False
+    finally:
+        os.close(fd)

@@ -13,7 +13,10 @@ these are the ones added as things happen, and after.
   the participant's lock (``session_lock``: refused, naming the holder, while
   a session of theirs runs in another program), appends, and lets go;
   ``studyapp notes SESSION_DIR --add TEXT`` and the console (its last
-  session) use it.
+  session) use it. The log is read first, without the lock: one that is
+  refused (a FIFO, a device, a folder, too large or sparse, or holding no
+  valid event at all) is refused with the participant's folder, its .lock
+  included, unchanged.
 - ``list_notes(results)``: every note under a results folder, for
   ``studyapp notes RESULTS_DIR`` (a table on stdout, or CSV with ``-o``).
   Notes are not responses, so ``export`` carries none: a note of several
@@ -36,6 +39,7 @@ from studyapp.experiment.session_files import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_info import check_notes
 from studyapp.experiment.session_lock import ParticipantLock
 from studyapp.experiment.session_log import SessionLog, read_log
+from studyapp.io.special_files import refuse_special
 
 NOTE = records.NOTE
 NOTE_COLUMNS = ["study", "participant", "session", "wall", "step", "task", "text"]
@@ -66,6 +70,13 @@ def add_note(folder, text):
     event = note_event(text)
     folder = session_folder_of(folder)
     info, _ = read_description(folder)
+    # read-only, before the lock: a log that is refused (a FIFO, a device, a folder, too large) is refused
+    # with the participant's folder, its .lock included, unchanged
+    refuse_special(folder / EVENTS_FILE, "a session log file", f"{folder / EVENTS_FILE}")
+    log = read_log(folder / EVENTS_FILE)
+    if not log.events and (log.damaged or log.malformed or log.torn):
+        raise UserError(f"{folder / EVENTS_FILE}: holds no valid event ({len(log.damaged) + len(log.malformed)} "
+                        "damaged lines): allowed is a session's log; nothing written")
     lock = ParticipantLock(folder.parent, info["participant"])
     try:
         with SessionLog(folder / EVENTS_FILE) as log:

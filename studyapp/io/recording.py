@@ -14,10 +14,16 @@ acceleration, acceleration_true (m/s^2), force (N, the force commanded on the ha
 audio (arbitrary units, the body filter's output).
 
 Writes are atomic (``studyapp.io.atomic``): a failure leaves no partial file. ``load``
-raises ``InputDataError`` naming the file and what is wrong with it.
+raises ``InputDataError`` naming the file and what is wrong with it. It holds the whole
+recording in memory, so it reads at most ``LOAD_LIMIT`` bytes: the file, and what an
+archive's members unpack to, checked before anything is read (``archive_bounds``;
+a FIFO, device or sparse file is refused from its status, ``special_files``,
+``file_bounds``); a column must hold real numbers (not booleans, complex numbers
+or text), and the metadata's ``rate`` a positive number.
 """
 
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,6 +31,11 @@ import numpy as np
 
 from studyapp import __version__
 from studyapp.errors import InputDataError, UserError
+from studyapp.io import bounded_json
+from studyapp.io.archive_bounds import check_h5, open_npz
+from studyapp.io.file_bounds import check_not_sparse, check_size
+from studyapp.io.small_files import open_regular
+from studyapp.io.special_files import refuse_special
 from studyapp.io.atomic import atomic_open, atomic_path
 
 COLUMNS = (
@@ -32,6 +43,8 @@ COLUMNS = (
     "acceleration_true", "force", "string_velocity", "audio",
 )
 SUFFIXES = (".h5", ".npz", ".csv")
+LOAD_LIMIT = 1 << 30  # bytes a whole recording may take in memory: 15 M samples of 9 columns, 50 min at 5 kHz
+HEADER_LIMIT = 1 << 20  # characters of a CSV recording's metadata line or header
 FORMAT_VERSION = 1  # stored as meta["format"]; meta["version"] is the app's version
 
 
@@ -106,14 +119,24 @@ def save(recording, path):
             np.savetxt(f, table, delimiter=",", fmt="%.17g")
 
 
+def check_file(path):
+    """``InputDataError`` unless ``path`` is a regular file, not sparse (file_bounds); its ``os.stat``."""
+    refuse_special(path, "a recording file")
+    if not os.path.exists(path):
+        raise InputDataError(f"{path}: no such file")
+    if not os.path.isfile(path):
+        raise InputDataError(f"{path}: not a regular file: allowed is a recording file")
+    status = os.stat(path)
+    check_not_sparse(status, path, "recording")
+    return status
+
+
 def load(path):
-    """Read a recording written by ``save`` (or any CSV with the ``COLUMNS`` header)."""
+    """Read a recording written by ``save`` (or any CSV with the ``COLUMNS`` header), at most ``LOAD_LIMIT``
+    bytes of it (a file, or what its members unpack to: archive_bounds)."""
     path = Path(path)
     suffix = _suffix(path)
-    if not path.exists():
-        raise InputDataError(f"{path}: no such file")
-    if not path.is_file():
-        raise InputDataError(f"{path}: not a regular file: allowed is a recording file")
+    check_size(check_file(path).st_size, LOAD_LIMIT, path, "recording file")
     try:
         if suffix == ".npz":
             columns, meta = _load_npz(path)
@@ -127,13 +150,7 @@ def load(path):
         raise InputDataError(f"{path}: not a readable {suffix} recording ({type(exc).__name__}: {exc})") from None
     if not columns or not any(len(values) for values in columns.values()):
         raise InputDataError(f"{path}: no samples: allowed is a recording of at least one sample")
-    rate = meta.get("rate")
-    if rate is not None:
-        try:  # metadata is any JSON: "abc" or a list is no rate
-            rate = float(rate)
-        except (TypeError, ValueError):
-            raise InputDataError(f"{path}: metadata 'rate' = {rate!r}: allowed is a sample rate in Hz "
-                                 "(a positive number)") from None
+    rate = meta_rate(meta, path)
     if rate is None and "t" in columns and len(columns["t"]) > 1:
         # t is k / rate printed to 17 digits: the rate comes back to within rounding
         span = float(columns["t"][-1] - columns["t"][0])
@@ -146,18 +163,36 @@ def load(path):
         raise InputDataError(f"{path}: {exc}") from None
 
 
+def meta_rate(meta, path):
+    """The metadata's ``rate`` as a float, or None when it has none; ``InputDataError`` naming ``path``
+    for one that is no positive finite number (metadata is any JSON: ``"abc"``, a list, ``true``)."""
+    rate = meta.get("rate")
+    if rate is None:
+        return None
+    if not isinstance(rate, bool):
+        try:
+            value = float(rate)
+        except (TypeError, ValueError):
+            value = None
+        if value is not None and np.isfinite(value) and value > 0:
+            return value
+    raise InputDataError(f"{path}: metadata 'rate' = {rate!r}: allowed is a sample rate in Hz (a positive number)")
+
+
 def parse_meta(text, path):
     """The metadata JSON ``text`` as a dict; ``InputDataError`` naming ``path`` otherwise."""
     try:
-        meta = json.loads(text)
-    except json.JSONDecodeError:
-        raise InputDataError(f"{path}: metadata is not valid JSON") from None
+        meta = bounded_json.loads(text)
+    except ValueError as exc:  # invalid, or nested too deeply
+        raise InputDataError(f"{path}: metadata is not valid JSON ({exc})") from None
     if not isinstance(meta, dict):
         raise InputDataError(f"{path}: metadata must be a JSON object")
     return meta
 
 
 def _load_npz(path):
+    archive, _ = open_npz(path, LOAD_LIMIT)
+    archive.close()
     with np.load(path, allow_pickle=False) as data:
         meta = parse_meta(str(data["__meta__"]), path) if "__meta__" in data.files else {}
         columns = {k: np.asarray(data[k], dtype=np.float64) for k in data.files if k != "__meta__"}
@@ -170,25 +205,25 @@ def _load_h5(path):
     with h5py.File(path, "r") as f:
         raw = f.attrs.get("meta", "{}")
         meta = parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), path)
-        columns = {}
-        for k in f.keys():
-            dtype = getattr(f[k], "dtype", None)  # a group has none
-            if dtype is None or dtype.kind not in "biuf":
-                raise InputDataError(f"{path}: column {k!r} holds {dtype or 'a group'}, not numbers")
-            columns[k] = np.asarray(f[k][()], dtype=np.float64)
+        check_h5(f, path, LOAD_LIMIT)
+        columns = {k: np.asarray(f[k][()], dtype=np.float64) for k in f.keys()}
     return columns, meta
 
 
 def _load_csv(path):
     meta = {}
-    with open(path, encoding="utf-8-sig") as f:  # -sig: a byte order mark (Excel's CSV UTF-8) is accepted
-        first = f.readline()
+    # -sig: a byte order mark (Excel's CSV UTF-8) is accepted
+    with open_regular(path, "recording", "r", encoding="utf-8-sig") as f:
+        first = f.readline(HEADER_LIMIT)
         if first.startswith("#"):
             meta = parse_meta(first[1:].strip(), path)
-            header = f.readline()
+            header = f.readline(HEADER_LIMIT)
         else:
             header = first
         names = [h.strip() for h in header.strip().split(",")]
+        twice = next((n for i, n in enumerate(names) if n in names[:i]), None)
+        if twice is not None:
+            raise InputDataError(f"{path}: column {twice!r} appears twice in the header: allowed is each column once")
         missing = [c for c in COLUMNS if c not in names]
         if missing:
             raise InputDataError(f"{path}: CSV header lacks the column(s) {', '.join(missing)}; expected {', '.join(COLUMNS)}")

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from studyapp.errors import InputDataError
-from studyapp.io.recording import parse_meta
+from studyapp.io.archive_bounds import check_dtype, check_h5, open_npz
+from studyapp.io.recording import check_file, meta_rate, parse_meta
 
 SUFFIXES = (".npz", ".h5", ".hdf5")
 
@@ -35,8 +36,7 @@ class _NpyStream:
             shape, _, dtype = np.lib.format.read_array_header_2_0(self.file)
         else:
             raise InputDataError(f"{path}: {member}: .npy format {version} is not supported")
-        if dtype.hasobject or dtype.kind not in "biuf":
-            raise InputDataError(f"{path}: column {member[:-4]!r} holds {dtype}, not numbers")
+        check_dtype(dtype, member[:-4], path)
         self.shape, self.dtype = shape, dtype
 
     def read(self, n):
@@ -54,10 +54,7 @@ class RecordingBlocks:
         suffix = self.path.suffix.lower()
         if suffix not in SUFFIXES:
             raise InputDataError(f"{path}: not a recording: allowed suffixes are {', '.join(SUFFIXES)}")
-        if not self.path.exists():
-            raise InputDataError(f"{path}: no such file")
-        if not self.path.is_file():
-            raise InputDataError(f"{path}: not a regular file: allowed is a recording file")
+        check_file(self.path)  # a FIFO, a device, a sparse file
         self._h5 = self._zip = None
         try:
             shapes = self._open_h5() if suffix != ".npz" else self._open_npz()
@@ -79,7 +76,7 @@ class RecordingBlocks:
         self.rate = self._rate()
 
     def _open_npz(self):
-        self._zip = zipfile.ZipFile(self.path)
+        self._zip, _ = open_npz(self.path)  # what each member unpacks to, checked before unpacking
         self.meta, members = {}, {}
         for member in self._zip.namelist():
             if not member.endswith(".npy"):
@@ -103,16 +100,11 @@ class RecordingBlocks:
         self._h5 = h5py.File(self.path, "r")
         raw = self._h5.attrs.get("meta", "{}")
         self.meta = parse_meta(raw.decode() if isinstance(raw, bytes) else str(raw), self.path)
-        shapes = {}
-        for name in self._h5.keys():
-            dtype = getattr(self._h5[name], "dtype", None)  # a group has none
-            if dtype is None or dtype.kind not in "biuf":
-                raise InputDataError(f"{self.path}: column {name!r} holds {dtype or 'a group'}, not numbers")
-            shapes[name] = self._h5[name].shape
-        return shapes
+        check_h5(self._h5, self.path)
+        return {name: self._h5[name].shape for name in self._h5.keys()}
 
     def _rate(self):
-        rate = self.meta.get("rate")
+        rate = meta_rate(self.meta, self.path)
         if rate is None and "t" in self.names and self.length > 1:
             first = last = None
             for block in self.blocks(1 << 16, ["t"]):

@@ -8,8 +8,11 @@ named columns as float64. Memory stays that of one block whatever the file's
 length. A UTF-8 byte order mark (Excel's "CSV UTF-8") is accepted.
 
 A bad file stops with one ``InputDataError`` that names the file, the line and
-the column. The header, the first row and the file's kind (a regular file: a
-device such as ``/dev/zero`` never ends) are checked on opening; a bad cell
+the column. The header (each column once), the first row and the file's kind
+(a regular file: a device such as ``/dev/zero`` never ends; not sparse,
+``file_bounds``) are checked on opening; a line longer than ``LINE_LIMIT``
+characters is refused when reached (a file without line breaks is never read
+whole); a bad cell
 further down is found when its block is read, so a caller writing as it reads
 writes atomically (``studyapp.io.atomic``).
 """
@@ -23,6 +26,9 @@ import numpy as np
 from studyapp.errors import InputDataError
 from studyapp.number_text import to_float
 from studyapp.io.small_files import NotARegularFile, open_regular
+
+
+LINE_LIMIT = 1 << 16  # characters: a row of a few numbers is a few hundred
 
 
 class SampleTable:
@@ -43,11 +49,15 @@ class SampleTable:
         try:
             if not stat.S_ISREG(os.fstat(self._file.fileno()).st_mode):
                 raise InputDataError(f"{path}: not a regular file: allowed is a CSV file")
-            self._reader = csv.reader(self._file)
+            self._reader = csv.reader(self._lines())
             header = self._next_row()
             if not header:
                 raise InputDataError(f"{path}: empty file; expected a header row with a 'position' column")
             self.header = [h.strip() for h in header]
+            twice = next((h for i, h in enumerate(self.header) if h in self.header[:i]), None)
+            if twice is not None:
+                raise InputDataError(f"{path}: column {twice!r} appears twice in the header: allowed is each "
+                                     "column once")
             for name in required:
                 if name not in self.header:
                     raise InputDataError(f"{path}: column {name!r} missing; the header has {', '.join(self.header)}")
@@ -57,6 +67,19 @@ class SampleTable:
         except BaseException:
             self._file.close()
             raise
+
+    def _lines(self):
+        """The file's lines, each at most ``LINE_LIMIT`` characters (a file without line breaks is not read whole)."""
+        number = 0
+        while True:
+            line = self._file.readline(LINE_LIMIT + 1)
+            number += 1
+            if len(line) > LINE_LIMIT:
+                raise InputDataError(f"{self.path}: line {number} is longer than {LINE_LIMIT} characters: allowed "
+                                     "is one sample per line")
+            if not line:
+                return
+            yield line
 
     def _next_row(self):
         """The next non-blank row (a trailing blank line is not a sample), checked for its length; None at the end."""

@@ -102,7 +102,7 @@ def test_estimate_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, con
 
 def test_estimate_rate_out_of_range(samples, capsys):
     err = one_line_error(capsys, ["estimate", str(samples[0]), "--estimator", "BDIFF", "--rate", "200000"])
-    assert "rate = 200000: allowed is a number from 1000 to 96000 Hz" in err
+    assert "--rate 200000: allowed is a number from 1000 to 96000 Hz" in err
 
 
 def test_missing_input_file(tmp_path, capsys):

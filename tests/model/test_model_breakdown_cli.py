@@ -86,7 +86,7 @@ def test_markdown_is_headed_by_date_and_command(never_broken, tmp_path, capsys):
     (["--source", "NOPE"], "--source 'NOPE': allowed are BDIFF"),
     (["--source", "LVT", "--seeds", "0"], "--seeds 0: allowed is a whole number from 1 to 100"),
     (["--source", "LVT", "--seeds", "1000000"], "--seeds 1000000"),
-    (["--all", "--rate", "500"], "rate = 500: allowed is a number from 1000 to 96000 Hz"),
+    (["--all", "--rate", "500"], "--rate 500: allowed is a number from 1000 to 96000 Hz"),
     (["--source", "LVT", "--gesture", "wiggle"], "--gesture 'wiggle': allowed are hold, strokes"),
     (["--source", "LVT", "--duration", "0"], "--duration 0.0: allowed is a number of seconds from 0.5 to 60"),
     (["--source", "LVT", "--all"], "not allowed with argument"),

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from studyapp.experiment.audible_fmax import ALLOWED as AUDIBLE, FMAX_AUDIBLE
 from studyapp.experiment import records
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.records import integer, text
@@ -123,7 +124,7 @@ class Adjustment:
         return AdjustmentSpec(
             conditions=table.conditions("conditions", bounds.estimators, 1, len(bounds.estimators)),
             trials=table.integer("trials", 1, 100),
-            ceiling=table.number("ceiling", 0.0, FMAX_LIMIT, "N", low_open=True),
+            ceiling=table.number("ceiling", FMAX_AUDIBLE, FMAX_LIMIT, AUDIBLE),
             decades=table.number("decades", 0.1, 12.0, "decades", default=3.0),
             knob=table.integer("knob", 0, bounds.knobs - 1, default=0),
             confirm_pad=pad,

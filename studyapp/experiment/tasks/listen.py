@@ -15,6 +15,7 @@ The simulated participant bows through the whole trial.
 
 from dataclasses import dataclass
 
+from studyapp.experiment.audible_fmax import ALLOWED as AUDIBLE, FMAX_AUDIBLE
 from studyapp.experiment import records
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.records import text
@@ -91,7 +92,7 @@ class Listen:
     def parse(self, table, bounds):
         return ListenSpec(
             conditions=table.conditions("conditions", bounds.estimators, 1, len(bounds.estimators)),
-            fmax=table.number("fmax", 0.0, FMAX_LIMIT, "N", low_open=True),
+            fmax=table.number("fmax", FMAX_AUDIBLE, FMAX_LIMIT, AUDIBLE),
             duration_s=table.number("duration_s", *DURATION_RANGE, "s"),
             instructions=table.string("instructions"),
             **read_phases(table, confirmed=False),

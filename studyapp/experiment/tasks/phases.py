@@ -5,8 +5,9 @@ and ran 55 trials in one sitting (Sec. 8.2). A protocol says, per task:
 
 - ``practice``: trials before the real ones (0 .. 20, default 0), marked
   ``practice`` in the log and the export and left out of the analysis;
-- ``break_every``: a break page after every N real trials, not after the
-  last (0 = none, the default);
+- ``break_every``: a break page after every N real trials (1 .. 1000), not
+  after the last; left out, there are none (0 is refused: a break every 0
+  trials means nothing);
 - ``min_listen_s``: a confirm is accepted only once each condition of the
   trial has been heard that long (s, 0 .. 600, default 0) with the bow on and
   F_max above 0 (``confirm_pad.ConfirmPadTrial``); a task that is not
@@ -42,7 +43,8 @@ def read_phases(table, confirmed=True):
         table.fail("bow", f"= {bow!r}", bow_allowed)
     fields = PhaseFields(
         practice=table.integer("practice", 0, PRACTICE_MAX, default=0),
-        break_every=table.integer("break_every", 0, BREAK_EVERY_MAX, default=0),
+        # "a break every 0 trials" means nothing: left out, there are none; given, it is 1 or more
+        break_every=table.integer("break_every", 1, BREAK_EVERY_MAX) if "break_every" in table.values else 0,
         min_listen_s=(table.number("min_listen_s", 0.0, MIN_LISTEN_MAX, "s", default=0.0) if confirmed else 0.0),
         bow=bow,
     )

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from studyapp.experiment.audible_fmax import ALLOWED as AUDIBLE, FMAX_AUDIBLE
 from studyapp.experiment import records
 from studyapp.experiment.latin_square import participant_row
 from studyapp.experiment.records import integer, number, text
@@ -140,7 +141,7 @@ class Rating:
         instructions = table.string("instructions")
         return RatingSpec(
             conditions=table.conditions("conditions", bounds.estimators, 2, bounds.knobs),
-            fmax=table.number("fmax", 0.0, FMAX_LIMIT, "N", low_open=True),
+            fmax=table.number("fmax", FMAX_AUDIBLE, FMAX_LIMIT, AUDIBLE),
             confirm_pad=pad,
             instructions=instructions,
             **read_phases(table),
