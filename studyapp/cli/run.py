@@ -102,6 +102,10 @@ def run(args):
     protocol = load_protocol(args.protocol)
     check_order_row(protocol, args.order_row)
     output_paths.check_folder(args.results, "--results")
+    if args.resume:
+        from studyapp.experiment.enrolment import check_same_player
+
+        check_same_player(args.results, protocol.study, args.participant, args.simulated_participant)
     if not args.headless:
         args.audio = args.audio or "device"
         args.midi = args.midi or "first"
@@ -130,7 +134,8 @@ def run(args):
         progress(f"warning: {note}")
     progress(f"session {session.folder} ({len(session.finished_steps())} of {len(session.schedule)} trials done, "
              f"{order_text(session.info)})")
-    runner = ArchivingRunner(session, progress=progress) if archive else SessionRunner(session, progress=progress)
+    runner = (ArchivingRunner(session, progress=progress) if archive
+              else SessionRunner(session, progress=progress, simulated=True))
     if archive:
         progress(f"audio: archiving what is heard to {runner.path}")
     try:

@@ -95,7 +95,7 @@ class Console(QMainWindow):
         stop_key = QAction("Emergency stop", self)
         stop_key.setShortcut(QKeySequence(Qt.Key.Key_Escape))
         stop_key.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
-        stop_key.triggered.connect(controller.emergency_stop)
+        stop_key.triggered.connect(lambda: controller.emergency_stop("operator"))
         self.addAction(stop_key)
 
         self.progress = ProgressPanel()  # the state, the step, the condition, the response, a pickup
@@ -317,7 +317,7 @@ class Console(QMainWindow):
 
     def _on_state(self, state):
         emergency = state == State.EMERGENCY
-        self.progress.show_state(state)
+        self.progress.show_state(state, self.controller.stopped_by)
         active = self.controller.in_session
         self.buttons.show_state(state, active)
         self.setup.set_editable(not active)

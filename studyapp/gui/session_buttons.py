@@ -29,7 +29,7 @@ class SessionButtons(QWidget):
         self.stop_button = QPushButton("EMERGENCY STOP")
         self.stop_button.setStyleSheet(STOP_STYLE)
         self.stop_button.setToolTip("zero the force now (Esc)")
-        self.stop_button.clicked.connect(controller.emergency_stop)
+        self.stop_button.clicked.connect(lambda: controller.emergency_stop("operator"))
         row = QHBoxLayout()
         row.addWidget(self.start_button)
         row.addWidget(self.pause_button)
