@@ -82,6 +82,7 @@ class Console(QMainWindow):
         self.replay = None  # {step: hand_trace}: the simulated participant's hand replays them (run --replay-gesture)
         self.notices = {}
         self.confirmation = None
+        self._typed = None  # the session fields as typed, while a resumed session shows its own
         self._midi_shown = None
         self.caller = GuiThreadCaller(self)
         self.setWindowTitle("studyapp — experimenter console")
@@ -237,6 +238,9 @@ class Console(QMainWindow):
             self.setup.show_error(str(exc))
             return None
         self.setup.show_error("")
+        if self.setup.resume.isChecked():  # the session's own values, not the placeholders (given back at its end)
+            self._typed = self.setup.typed_session_info()
+            self.setup.fill_session_info(**{key: session.info.get(key) for key in self._typed})
         if self.setup.simulated.isChecked():
             self.simulated = SimulatedSession(self.controller, self, self.caller, session.seed,
                                               replay=self.replay).start()
@@ -326,6 +330,9 @@ class Console(QMainWindow):
         if state in REST:
             self.knobs.set_captions([])
             self.page_controls.show_none()
+            if self._typed is not None:
+                self.setup.fill_session_info(**self._typed)
+                self._typed = None
 
     def _on_trial(self, trial, step, total, instructions, phase="trial", number=None, of=None):
         self.progress.show_trial(trial, step, total, phase, number, of)
@@ -336,7 +343,9 @@ class Console(QMainWindow):
 
     def _on_page(self, kind, title, text, by, step, tone_hz, level_dbfs):
         self.participant_window.show_page(kind, title, text, by)
-        self.page_controls.show_page(kind, title, by, tone_hz, level_dbfs)
+        runner = self.controller.runner
+        page = runner.trial.page if runner is not None and runner.trial is not None else None
+        self.page_controls.show_page(kind, title, by, tone_hz, level_dbfs, page.note if page is not None else "")
 
     def _on_knob(self, index, value):
         self.knobs.show_knob(index, value)

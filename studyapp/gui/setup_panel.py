@@ -6,7 +6,9 @@ Latin-square order row ("auto": from the participant's enrolment). They are
 checked when the session starts; a refusal shows in the panel's error line
 (below the form, wrapped to its whole height). Resuming takes only the
 participant, the protocol and the results folder: with "Resume" ticked the
-session's information (set when it started) is greyed and not passed on.
+session's information (set when it started) is greyed and not passed on; once
+the session is open the fields show its stored values (the console fills
+them from session.json, and gives back what was typed when it ends).
 
 The apparatus lines say what the engine really opened, in words: the device
 (the simulated 1-DOF device unless a driver is configured), the audio output
@@ -157,6 +159,12 @@ class SetupPanel(QWidget):
         self.session_number.setValue(int(session_number) if session_number not in (None, "") else 0)
         self.notes.setText(notes or "")
         self.order_row.setValue(int(order_row) if order_row not in (None, "") else -1)
+
+    def typed_session_info(self):
+        """What the fields hold now, as ``fill_session_info`` takes it (to give it back after a resumed session)."""
+        number, row = self.session_number.value(), self.order_row.value()
+        return {"experimenter": self.experimenter.text(), "session_number": number or None,
+                "notes": self.notes.text(), "order_row": None if row < 0 else row}
 
     def select_protocol(self, path):
         """Show ``path`` as the chosen protocol (adding it to the list)."""
