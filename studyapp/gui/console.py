@@ -238,6 +238,7 @@ class Console(QMainWindow):
             self.setup.show_error(str(exc))
             return None
         self.setup.show_error("")
+        self.setup.remember_results()
         if self.setup.resume.isChecked():  # the session's own values, not the placeholders (given back at its end)
             self._typed = self.setup.typed_session_info()
             self.setup.fill_session_info(**{key: session.info.get(key) for key in self._typed})

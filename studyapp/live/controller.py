@@ -40,11 +40,13 @@ each logged during a session.
 """
 
 import time
+from pathlib import Path
 
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.enrolment import apparatus_is_simulated, check_same_player
 from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.results_folder import used_rows_text
 from studyapp.experiment.schedule import counted
 from studyapp.experiment.session import Session, check_participant
 from studyapp.experiment.session_notes import add_note, note_event
@@ -155,6 +157,7 @@ class SessionController:
             raise UserError("the emergency stop is set: clear it (Resume) before starting a session")
         check_participant(participant)
         simulated = apparatus_is_simulated(apparatus)
+        used = used_rows_text(Path(results) / self.protocol.study, simulated)  # before this one enrols
         if resume:
             check_same_player(results, self.protocol.study, participant, simulated)
             session = Session.resume(self.protocol, participant, results, seed=seed, **(details or {}))
@@ -167,6 +170,7 @@ class SessionController:
         self.last_session = session.folder
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
+        self.message(f"results folder {Path(results).resolve()}; before this session, {used}")
         self.fire("open")
         return session
 
