@@ -42,6 +42,8 @@ each logged during a session.
 import time
 from pathlib import Path
 
+from studyapp.engine.config import HANG_TIMEOUT
+from studyapp.engine.load_margin import busy_warning, load_per_core
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.enrolment import apparatus_is_simulated, check_same_player
@@ -171,6 +173,9 @@ class SessionController:
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
         self.message(f"results folder {Path(results).resolve()}; before this session, {used}")
+        busy = busy_warning(load_per_core(), HANG_TIMEOUT)
+        if busy is not None:
+            self.message(busy, level="warning")
         self.fire("open")
         return session
 
