@@ -86,7 +86,7 @@ def main(args):
         console.resize(*size)
     console.show()
     if screen is not None:
-        console.participant_window.show_full_screen(screen)
+        console.place_participant(screen)  # never over the console's session buttons (participant_placement.py)
     if participant:
         console.show_participant.setChecked(True)
     if shot:

@@ -57,6 +57,7 @@ from studyapp.gui.analysis_view import AnalysisView
 from studyapp.gui.gui_thread import GuiThreadCaller
 from studyapp.gui.live_tab import LiveTab
 from studyapp.gui.page_controls import PageControls
+from studyapp.gui.participant_placement import beside_console, confine
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.progress_panel import ProgressPanel
 from studyapp.gui.session_buttons import SessionButtons
@@ -124,6 +125,7 @@ class Console(QMainWindow):
         scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         scroll.setMinimumWidth(details.minimumSizeHint().width() + scroll.verticalScrollBar().sizeHint().width())
         left = QWidget()
+        self.left_column = left  # the set-up, progress and session buttons: never covered by the participant
         lv = QVBoxLayout(left)
         lv.addWidget(scroll, 1)
         lv.addWidget(self.blind)  # in view without scrolling, at 1,366 x 768 too
@@ -211,6 +213,14 @@ class Console(QMainWindow):
         self.setWindowState(self.windowState() | Qt.WindowState.WindowMaximized if small
                             else self.windowState() & ~Qt.WindowState.WindowMaximized)
 
+    def place_participant(self, screen):
+        """The participant's window full-screen on ``screen``, or beside the console's left column on its own."""
+        if screen is self.screen():
+            self.participant_window.show()
+            beside_console(self.participant_window, self, self.left_column)
+        else:
+            self.participant_window.show_full_screen(screen)
+
     def keyPressEvent(self, event):
         if event.key() == Qt.Key.Key_Space:  # the participant's space bar: the bow, never a button
             self.participant_window.keyPressEvent(event)
@@ -297,6 +307,7 @@ class Console(QMainWindow):
     # the timer --------------------------------------------------------------
     def _tick(self):
         self.controller.poll()
+        confine(self.participant_window, self, self.controller.state == State.RUNNING)
         self.status.show_frame_rate(self.scope.frame_rate())
         sim = self.simulated
         if sim is not None and sim.done:
