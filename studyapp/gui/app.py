@@ -73,6 +73,7 @@ def build(args):
 
 def main(args):
     """Run the console until it is closed; returns the exit code."""
+    from studyapp.gui.participant_placement import place
     from studyapp.gui.participant_screen import choose_screen
 
     app = application()
@@ -86,7 +87,7 @@ def main(args):
         console.resize(*size)
     console.show()
     if screen is not None:
-        console.place_participant(screen)  # never over the console's session buttons (participant_placement.py)
+        place(console, screen)  # never over the console's session buttons (participant_placement.py)
     if participant:
         console.show_participant.setChecked(True)
     if shot:

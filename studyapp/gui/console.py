@@ -57,7 +57,7 @@ from studyapp.gui.analysis_view import AnalysisView
 from studyapp.gui.gui_thread import GuiThreadCaller
 from studyapp.gui.live_tab import LiveTab
 from studyapp.gui.page_controls import PageControls
-from studyapp.gui.participant_placement import beside_console, confine
+from studyapp.gui.participant_placement import confine
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.progress_panel import ProgressPanel
 from studyapp.gui.session_buttons import SessionButtons
@@ -212,14 +212,6 @@ class Console(QMainWindow):
         small = (width, height) != PREFERRED_SIZE
         self.setWindowState(self.windowState() | Qt.WindowState.WindowMaximized if small
                             else self.windowState() & ~Qt.WindowState.WindowMaximized)
-
-    def place_participant(self, screen):
-        """The participant's window full-screen on ``screen``, or beside the console's left column on its own."""
-        if screen is self.screen():
-            self.participant_window.show()
-            beside_console(self.participant_window, self, self.left_column)
-        else:
-            self.participant_window.show_full_screen(screen)
 
     def keyPressEvent(self, event):
         if event.key() == Qt.Key.Key_Space:  # the participant's space bar: the bow, never a button

@@ -38,6 +38,16 @@ def beside_console(participant, console, left_column):
     participant.setGeometry(QRect(right, area.y(), max(1, area.right() - right + 1), area.height()))
 
 
+def place(console, screen):
+    """The participant's window full-screen on ``screen``, or beside the console's left column on its own."""
+    participant = console.participant_window
+    if screen is console.screen():
+        participant.show()
+        beside_console(participant, console, console.left_column)
+    else:
+        participant.show_full_screen(screen)
+
+
 def clamped(point, rect):
     """``point`` moved inside ``rect`` (QPoint, QRect)."""
     return QPoint(min(max(point.x(), rect.left()), rect.right()), min(max(point.y(), rect.top()), rect.bottom()))

@@ -3,12 +3,12 @@ buttons on one screen, and the pointer stays on the participant's screen while a
 
 from PySide6.QtCore import QPoint, QRect
 
-from studyapp.gui.participant_placement import clamped, confine
+from studyapp.gui.participant_placement import clamped, confine, place
 
 
 def test_on_the_consoles_screen_the_participant_window_leaves_the_session_buttons_in_view(idle_console, qapp):
     console = idle_console
-    console.place_participant(console.screen())
+    place(console, console.screen())
     qapp.processEvents()
     p = console.participant_window
     try:
