@@ -20,6 +20,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.transforms import blended_transform_factory
 
+from studyapp.analysis.counted import counted
 from studyapp.analysis.rank_sum import POOLED
 from studyapp.io.atomic import atomic_path
 
@@ -126,7 +127,19 @@ def _draw_box_plot(figure, task, study, ylabel, title):
         ax.text(x, 1.01, letters[name], transform=above, ha="center", va="bottom", fontsize=9)
     ax.tick_params(axis="x", labelrotation=30)
     ax.grid(True, axis="y", alpha=0.3)
-    _footnote(figure, letters_footnote(study, task, source))
+    _footnote(figure, letters_footnote(study, task, source) + simulated_footnote(study, task))
+
+
+def simulated_footnote(study, task):
+    """With simulated participants analysed (--include-simulated): how many of the task's participants they are."""
+    if not study.include_simulated:
+        return ""
+    responses = study.responses
+    rows = responses[responses["task"] == task.task]
+    everyone = rows["participant"].astype(str).unique()
+    simulated = rows.loc[rows["simulated"].astype(bool), "participant"].astype(str).unique() \
+        if "simulated" in rows else []
+    return f"\n{len(simulated)} of {counted(len(everyone), 'participant')} simulated (--include-simulated)"
 
 
 def letters_footnote(study, task, source):
@@ -136,7 +149,8 @@ def letters_footnote(study, task, source):
         return (f"letters (pooled, on request): conditions sharing a letter do not differ (Wilcoxon rank-sum, "
                 f"p < {study.alpha:g}{correction}),\n{POOLED}")
     n = task.within.n_participants
-    return (f"letters: conditions sharing a letter do not differ within subjects ({n} participants: Friedman, "
+    return (f"letters: conditions sharing a letter do not differ within subjects ({counted(n, 'participant')}: "
+            "Friedman, "
             f"then Wilcoxon signed-rank,\nHolm-corrected, p < {study.alpha:g})")
 
 

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from studyapp import __version__
+from studyapp.analysis.counted import counted
 from studyapp.analysis.missing_trials import describe_missing
 from studyapp.analysis.rank_sum import POOLED
 from studyapp.stats.signed_rank import EXACT_LIMIT
@@ -83,7 +84,7 @@ def _inputs(study):
     correction = "Holm-corrected p-values" if study.holm else "uncorrected p-values (as the paper)"
     items = [
         f"Source: <code>{html.escape(study.source)}</code>",
-        f"{len(study.participants)} participants: {html.escape(', '.join(study.participants))}",
+        f"{counted(len(study.participants), 'participant')}: {html.escape(', '.join(study.participants))}",
         f"{len(responses)} responses ({(responses['task'] == 'adjustment').sum()} adjustment, "
         f"{(responses['task'] == 'rating').sum()} rating)",
         f"The paper's pairwise Wilcoxon rank-sum tests (normal approximation with tie correction), "
@@ -96,13 +97,14 @@ def _inputs(study):
                                     if study.pooled_letters else "the within-subject tests'"),
     ]
     if study.simulated_left_out:
-        items.append(f"Left out: {len(study.simulated_left_out)} simulated participants "
+        items.append(f"Left out: {counted(len(study.simulated_left_out), 'simulated participant')} "
                      f"({html.escape(', '.join(study.simulated_left_out))}); "
                      "<code>--include-simulated</code> analyses them too")
     if study.include_simulated:
-        simulated = ", ".join(_simulated_participants(study)) or "none present"
+        simulated = _simulated_participants(study)
         items.append(f'<span class="warn">Simulated participants included (--include-simulated): '
-                     f"{html.escape(simulated)}</span>")
+                     f"{html.escape(', '.join(simulated)) or 'none present'} ({len(simulated)} of "
+                     f"{counted(len(study.participants), 'participant')} simulated)</span>")
     hashes = study.protocol_hashes()
     if len(hashes) > 1:
         items.append(f'<span class="warn">The responses come from {len(hashes)} different protocols</span>')

@@ -34,6 +34,7 @@ from itertools import combinations
 
 import pandas as pd
 
+from studyapp.analysis.counted import counted
 from studyapp.stats.friedman import MIN_CONDITIONS, RELIABLE_PARTICIPANTS, Friedman, friedman_test
 from studyapp.stats.friedman import minimum_p as friedman_minimum_p
 from studyapp.stats.holm import holm_adjust
@@ -71,7 +72,7 @@ class WithinSubject:
         if k < MIN_CONDITIONS:
             lines.append(f"Friedman's test needs {MIN_CONDITIONS} or more conditions (here {k})")
         elif n < RELIABLE_PARTICIPANTS:
-            line = (f"Friedman's test with {n} participants: its chi-square p is unreliable below "
+            line = (f"Friedman's test with {counted(n, 'participant')}: its chi-square p is unreliable below "
                     f"{RELIABLE_PARTICIPANTS} participants, read it as a guide")
             smallest = friedman_minimum_p(n, k)
             if smallest >= alpha:
@@ -84,12 +85,12 @@ class WithinSubject:
             return lines
         if pairs == 1:
             lines.append(
-                f"a signed-rank test on {n} participants cannot reach p < {alpha:g} two-sided: the smallest "
+                f"a signed-rank test on {counted(n, 'participant')} cannot reach p < {alpha:g} two-sided: the smallest "
                 f"exact p is 2^(1-n) = {smallest:.3g}; {needed} participants are needed"
             )
         else:
             lines.append(
-                f"no pair can be significant with {n} participants: the smallest exact two-sided signed-rank p "
+                f"no pair can be significant with {counted(n, 'participant')}: the smallest exact two-sided signed-rank p "
                 f"is 2^(1-n) = {smallest:.3g}, and Holm's correction over the {pairs} pairs multiplies it by "
                 f"{pairs}: {pairs * smallest:.3g}, not below {alpha:g}; {needed} participants are needed"
             )
@@ -131,7 +132,9 @@ def within_subject(values, conditions, alpha=0.05):
     if len(medians):
         for name_a, name_b in combinations(list(conditions), 2):
             test = signed_rank_test(medians[name_a].to_numpy(), medians[name_b].to_numpy())
-            rows.append((name_a, name_b, test.statistic, test.p_value, test.effect_size))
+            # one participant's sign is all a single pair has: r = +-1 says nothing, so it is not given
+            effect = test.effect_size if len(medians) >= 2 else float("nan")
+            rows.append((name_a, name_b, test.statistic, test.p_value, effect))
     table = pd.DataFrame(rows, columns=["condition_a", "condition_b", "statistic", "p_value", "effect_size"])
     for column in ("condition_a", "condition_b"):
         table[column] = table[column].astype(object)

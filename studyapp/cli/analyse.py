@@ -50,6 +50,7 @@ def register(subparsers):
 
 
 def run(args):
+    from studyapp.analysis.counted import counted
     from studyapp.analysis.numerical import load_evaluation
     from studyapp.analysis.report_folder import write_report_folder
     from studyapp.analysis.responses import load_responses
@@ -81,9 +82,10 @@ def run(args):
     expected = {"adjustment": args.trials} if args.trials else None
     study = analyse(responses, source=label, evaluation=evaluation, holm=args.holm, alpha=args.alpha, expected=expected,
                     pooled_letters=args.pooled_letters, include_simulated=args.include_simulated)
-    say(f"{len(study.participants)} participants, {len(responses)} responses")
+    say(f"{counted(len(study.participants), 'participant')}, {counted(len(responses), 'response')}")
     if study.simulated_left_out:
-        say(f"left out {len(study.simulated_left_out)} simulated participants ({', '.join(study.simulated_left_out)}): "
+        say(f"left out {counted(len(study.simulated_left_out), 'simulated participant')} "
+            f"({', '.join(study.simulated_left_out)}): "
             "--include-simulated analyses them too")
     for line in study.warnings() + study.sample_size_warnings():
         say(f"warning: {line}")

@@ -1,4 +1,4 @@
-"""``studyapp bench estimators|loop|live|midi|memory|force-cut``: speed and memory, measured, never asserted in tests."""
+"""``studyapp bench estimators|loop|live|midi|memory|force-cut|heartbeat``: speed and memory, measured, never asserted in tests."""
 
 
 def register(sub):
@@ -46,6 +46,11 @@ def register(sub):
                    help="python: a pure-Python loop; gil: one C call holding the interpreter's lock (default both)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.force_cut_benchmark"))
+
+    p = kinds.add_parser("heartbeat", help="the engine's heartbeat silences and watchdog trips under this machine's load")
+    p.add_argument("--seconds", type=float, default=60.0, help="run length (default 60)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.engine.heartbeat_benchmark"))
 
 
 def _run(module):

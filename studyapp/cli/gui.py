@@ -42,7 +42,9 @@ def register(sub):
     parser.add_argument("--protocol", metavar="FILE",
                         help="study protocol (default: protocols/sinclair2014.toml, else the first in protocols/)")
     parser.add_argument("--participant", metavar="ID", help="participant pseudonym to fill in")
-    parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
+    parser.add_argument("--results", default=None, metavar="DIR",
+                        help="results folder (default: the one last used in the console, else $STUDYAPP_RESULTS, "
+                             "else ~/.local/share/studyapp/results; made absolute)")
     parser.add_argument("--resume", action="store_true", help="tick 'resume the unfinished session'")
     parser.add_argument("--simulated-participant", action="store_true", help="a simulated participant plays")
     parser.add_argument("--start", action="store_true", help="start the session at once (needs --participant)")

@@ -16,7 +16,8 @@ def register(sub):
     parser.add_argument("--protocol", required=True, metavar="FILE", help="study protocol (TOML)")
     parser.add_argument("--participant", required=True, metavar="ID",
                         help="participant pseudonym: 1 to 32 letters, digits, '_' or '-'")
-    parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
+    parser.add_argument("--results", default=None, metavar="DIR",
+                        help="results folder (default: $STUDYAPP_RESULTS, else ~/.local/share/studyapp/results; made absolute)")
     parser.add_argument("--order-row", metavar="N",
                         help="the Latin-square order row, from 0 (default: from the participant's enrolment)")
     parser.add_argument("--simulated-participant", action="store_true",
@@ -38,7 +39,9 @@ def run(args):
     from studyapp.experiment.session import check_participant
 
     check_participant(args.participant)
-    results = Path(args.results)
+    from studyapp.experiment.results_folder import absolute
+
+    results = absolute(args.results)
     if results.exists() and not results.is_dir():
         raise UserError(f"--results {results}: is not a folder: allowed is a results folder (or one not made yet)")
     if args.output is not None:

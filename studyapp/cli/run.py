@@ -40,7 +40,8 @@ def register(sub):
     parser.add_argument("--headless", action="store_true",
                         help="no display: run in this process (needs --simulated-participant)")
     parser.add_argument("--resume", action="store_true", help="continue the participant's unfinished session")
-    parser.add_argument("--results", default="results", metavar="DIR", help="results folder (default: results)")
+    parser.add_argument("--results", default=None, metavar="DIR",
+                        help="results folder (default: $STUDYAPP_RESULTS, else ~/.local/share/studyapp/results; made absolute)")
     parser.add_argument("--seed", type=number_options.seed, default=None, metavar="N",
                         help="session seed (default: from the study seed and the participant's enrolment)")
     parser.add_argument("--audio", default=None, metavar="SPEC",
@@ -75,6 +76,7 @@ def replay_traces(path):
 def run(args):
     import contextlib
     import sys
+    from pathlib import Path
 
     from studyapp.cli import output_paths
     from studyapp.errors import UserError
@@ -101,7 +103,15 @@ def run(args):
     args.replay = replay_traces(args.replay_gesture) if args.replay_gesture is not None else None
     protocol = load_protocol(args.protocol)
     check_order_row(protocol, args.order_row)
+    from studyapp.experiment.results_folder import absolute, used_rows_text
+
+    args.results = str(absolute(args.results))  # one study, one folder: never relative to where it was started
     output_paths.check_folder(args.results, "--results")
+    used = used_rows_text(Path(args.results) / protocol.study, args.simulated_participant)  # before this one enrols
+    if args.resume:
+        from studyapp.experiment.enrolment import check_same_player
+
+        check_same_player(args.results, protocol.study, args.participant, args.simulated_participant)
     if not args.headless:
         output_paths.check_audio(args.audio, inputs=[args.protocol, *filter(None, [args.replay_gesture])])
         args.audio = args.audio or "device"
@@ -129,9 +139,11 @@ def run(args):
                                  **session_info_of(args))
     for note in session.notes:
         progress(f"warning: {note}")
+    progress(f"results folder {args.results}; before this session, {used}")
     progress(f"session {session.folder} ({len(session.finished_steps())} of {len(session.schedule)} trials done, "
              f"{order_text(session.info)})")
-    runner = ArchivingRunner(session, progress=progress) if archive else SessionRunner(session, progress=progress)
+    runner = (ArchivingRunner(session, progress=progress) if archive
+              else SessionRunner(session, progress=progress, simulated=True))
     if archive:
         progress(f"audio: archiving what is heard to {runner.path}")
     try:

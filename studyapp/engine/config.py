@@ -7,6 +7,7 @@ worker), so it holds only plain values; a real device driver is named as
 
 from dataclasses import dataclass, field
 
+from studyapp.engine.load_margin import hang_timeout_for, load_per_core
 from studyapp.engine.safety import SafetyLimits
 from studyapp.errors import ParameterError
 from studyapp.model.sources import LVT_SENSOR, with_pseudo_sources
@@ -14,6 +15,7 @@ from studyapp.model.sources import LVT_SENSOR, with_pseudo_sources
 BLOCK_PERIOD = 0.002  # s: default block length; commands and MIDI act at block boundaries
 TELEMETRY_MAX = 60.0  # s of telemetry the rings may keep (a minute at 96 kHz: ~1 GB with all estimators)
 HANG_TIMEOUT_MAX = 5.0  # s: a watchdog slower than that watches nothing
+HANG_TIMEOUT = 0.08  # s: the heartbeat bound on a machine that is not busy (load_margin.py: more when it is)
 
 
 def block_samples(rate, period=BLOCK_PERIOD):
@@ -41,7 +43,8 @@ class EngineConfig:
     telemetry_seconds: float = 4.0  # history kept in the rings
     realtime: bool = True  # ask for SCHED_FIFO for the worker's loop thread (falls back silently)
     device: str | None = None  # "module:factory" of a real device driver; None: the simulated device
-    hang_timeout: float = 0.08  # s without a heartbeat before the force guard calls the worker hung
+    # s without a heartbeat before the force guard calls the worker hung: HANG_TIMEOUT, more on a busy machine
+    hang_timeout: float = field(default_factory=lambda: hang_timeout_for(load_per_core(), HANG_TIMEOUT))
     # s without the force guard's heartbeat before the worker switches its own force off: the guard's
     # failure is the rarer one, so the deadline is looser than hang_timeout, sparing a loaded machine false trips
     guard_timeout: float = 0.2

@@ -17,12 +17,23 @@ volume, a rating) takes effect only when its movement covers the knob position
 mapping, held or not; None if never seen) and ``value`` the new one, it acts
 when
 
-    min(previous, value) <= target <= max(previous, value)    (just value == target without a previous)
+    min(previous, value) <= target <= max(previous, value)    (|value - target| <= 2 without a previous)
 
 A knob that set the level itself keeps acting (its previous position is the
 target); one whose level was changed by anything else (a new trial, a pause,
 an on-screen knob) must first be turned through the new level. Positions are
 knob steps (0..127). On-screen knobs show the level itself and need no pickup.
+
+A knob never seen (a new engine: the first start, a resume, a restart) sends
+its first message only once it moves, so it cannot land on the level it rests
+at: an LPD8 knob resting at 0 turned up first sends 1. Without a previous
+position a knob therefore acts when its first value is within
+``PICKUP_SLACK`` = 2 steps of the level (one step, and a second one
+coalesced into the same block, midi.coalesce): a knob resting at either end,
+or at the level anywhere between, is picked up, and the largest jump this
+allows is two steps: from 0 to F_max(2) = 0.41 N on the shipped protocols' two-decade
+knob, or 7.6 % of F_max above its bottom). Before issue 31 it waited for exactly
+the level, and a knob at the bottom never acted.
 """
 
 from studyapp.engine import commands as cmd
@@ -33,10 +44,13 @@ from studyapp.model.controls import KNOB_MAX, FmaxKnob, FmaxLinear, Select, Volu
 LEVEL_ACTIONS = (FmaxKnob, FmaxLinear, Volume, Select)
 
 
+PICKUP_SLACK = 2  # knob steps: a knob never seen may have moved this far off the level in its first message
+
+
 def passes_through(target, previous, value):
     """True when a knob moving from ``previous`` (None: unknown) to ``value`` reaches ``target``."""
     if previous is None:
-        return value == target
+        return abs(value - target) <= PICKUP_SLACK
     return min(previous, value) <= target <= max(previous, value)
 
 

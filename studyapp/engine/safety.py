@@ -63,8 +63,8 @@ CLEAR_HINT = "press Resume to clear"
 
 def force_off_text(reason, silence=0.0):
     """The fault, in plain words, for ``force_enable`` cleared for ``reason`` (status.FORCE_OFF_REASONS)."""
-    if reason == "operator":
-        return f"Emergency stop (operator): force off — {CLEAR_HINT}"
+    if reason in ("operator", "participant"):
+        return f"Emergency stop ({reason}): force off — {CLEAR_HINT}"
     if reason == "watchdog":
         return (f"watchdog: the engine stopped answering for {1e3 * silence:.0f} ms; force switched off for "
                 f"safety — {CLEAR_HINT}")

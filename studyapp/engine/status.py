@@ -62,8 +62,9 @@ TEXTS = {"source": 32, "fault": 200, "audio": 120, "midi": 120}
 _HEARTBEAT, _STATE = NUMBERS.index("heartbeat"), NUMBERS.index("state")
 
 STATES = ("starting", "running", "stopping", "stopped", "failed")
-# "parent": cleared without a reason given; "guard": the worker found the force guard silent
-FORCE_OFF_REASONS = ("parent", "operator", "watchdog", "guard")
+# "parent": cleared without a reason given; "guard": the worker found the force guard silent; "operator" and
+# "participant": the emergency stop, by the experimenter's controls or by Esc on the participant's window
+FORCE_OFF_REASONS = ("parent", "operator", "watchdog", "guard", "participant")
 
 _SEQ = 8
 SPINS = 100  # yields before a reader of the whole record starts sleeping

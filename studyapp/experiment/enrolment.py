@@ -59,3 +59,26 @@ def enrolled(study_folder):
 def enrolment_index(study_folder, participant, simulated):
     """The enrolment index of a new ``participant``: participants of the same kind enrolled before them."""
     return sum(1 for name, kind in enrolled(study_folder).items() if name != participant and kind == bool(simulated))
+
+
+def check_same_player(results, study, participant, simulated):
+    """Refuse (``UserError``) to resume ``participant``'s latest session with the other kind of player.
+
+    A real participant's log is never continued by the simulated participant, nor a simulated one's by a
+    person (its order row was counted among the simulated): read only, before anything opens the log.
+    """
+    sessions = session_folders(Path(results) / study / participant)
+    if not sessions:
+        return
+    try:
+        info, _ = read_description(sessions[-1])
+    except UserError:
+        return  # resume itself says what is wrong with it
+    stored = is_simulated(info)
+    if stored == bool(simulated):
+        return
+    if stored:
+        raise UserError(f"participant {participant!r}: session {sessions[-1]} was played by the simulated "
+                        "participant: allowed is to resume it with --simulated-participant")
+    raise UserError(f"participant {participant!r}: session {sessions[-1]} is a real participant's: allowed is to "
+                    "resume it without --simulated-participant (a machine never continues a person's log)")

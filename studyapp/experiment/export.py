@@ -33,10 +33,12 @@ order_row, simulated``.
   records of its step, summed over its attempts); empty for a session without
   a real-time engine (``studyapp run``).
 
-- ``simulated``: True when the simulated participant played the session
-  (``enrolment.is_simulated``: session.json's ``simulated``, or its
-  ``apparatus.participant`` for older sessions); the analysis leaves these
-  rows out by default (``studyapp analyse --include-simulated``).
+- ``simulated``: True when the simulated participant gave the response: the
+  response's own ``simulated`` (every response logged since issue 31 says who
+  gave it), else, for older logs, the session's (``enrolment.is_simulated``:
+  session.json's ``simulated``, or its ``apparatus.participant``); the
+  analysis leaves these rows out by default (``studyapp analyse
+  --include-simulated``).
 - ``experimenter``, ``session_number``, ``order_row``: from session.json
   (``session_info``); empty when not given, or for a session stored before
   they were. The experimenter's ``notes`` stay in session.json: free text of
@@ -125,7 +127,8 @@ def _session_rows(folder, problems):
             raise InputDataError(f"{folder / EVENTS_FILE}: response event seq {seq}: {wrong}")
         base = {**common, "task": event["task"], "trial": event["trial"], "fmax": event["fmax"],
                 "time": event["wall"], "step": event["step"], "duration": event.get("duration"),
-                "practice": event.get("practice") is True}
+                "practice": event.get("practice") is True,
+                "simulated": event.get("simulated", common["simulated"]) is True}
         base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows

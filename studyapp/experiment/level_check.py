@@ -49,4 +49,4 @@ def calibrated(page, protocol):
     statement = (f"The tone is as loud as the bowed string in this study: {rms:.1f} dBFS RMS "
                  f"(peak {tone_peak_dbfs(rms):.1f} dBFS), the string's typical level at F_max = {fmax:g} N"
                  f"{f' (the {task} task)' if task else ''}.")
-    return replace(page, level_dbfs=round(tone_peak_dbfs(rms), 2), text=f"{page.text}\n\n{statement}")
+    return replace(page, level_dbfs=round(tone_peak_dbfs(rms), 2), note=statement)  # the experimenter's, not on the page

@@ -17,8 +17,9 @@ ones (Sec. 8.2). A protocol lists its pages as an array of tables:
   scale, peak: -18 dBFS is the output limiter's knee, engine/signal_chain.py);
   without ``level_dbfs`` the tone is as loud as the stimulus (its RMS the
   bowed string's typical RMS at the protocol's F_max, computed from the model
-  when the schedule is made and stated on the page: ``level_check``). The
-  experimenter confirms it, not the participant.
+  when the schedule is made and stated in the page's ``note``, which only the
+  experimenter's console shows: ``level_check``; the participant's page never
+  speaks of dBFS or F_max). The experimenter confirms it, not the participant.
 
 Pages are Markdown: single line breaks (a TOML triple-quoted string's) join
 into one paragraph, a blank line starts another.
@@ -60,6 +61,7 @@ class Page:
     tone_hz: float | None = None
     level_dbfs: float | None = None
     pad: int = 0  # the pad that acknowledges it (the confirm pad of the task it belongs to)
+    note: str = ""  # for the experimenter only (the level check's computed level): never on the participant's page
 
     @property
     def by(self):
@@ -72,7 +74,8 @@ class Page:
     @classmethod
     def from_dict(cls, d):
         return cls(kind=d["kind"], text=d["text"], title=d["title"], task=d.get("task"),
-                   tone_hz=d.get("tone_hz"), level_dbfs=d.get("level_dbfs"), pad=int(d.get("pad", 0)))
+                   tone_hz=d.get("tone_hz"), level_dbfs=d.get("level_dbfs"), pad=int(d.get("pad", 0)),
+                   note=str(d.get("note", "")))
 
 
 def markdown(text):

@@ -91,8 +91,8 @@ def abort(reason: str | None = None) -> dict:
     return {"type": "abort"} if reason is None else {"type": "abort", "reason": reason}
 
 
-def emergency_stop() -> dict:
-    return {"type": "emergency_stop"}
+def emergency_stop(by: str = "operator") -> dict:
+    return {"type": "emergency_stop", "by": by}
 
 
 def emergency_clear() -> dict:
@@ -199,8 +199,8 @@ def response_problem(event, task_types):
     edited file, another program's line). Fields every response has: ``step`` an
     integer from 0 to ``STEP_MAX``, ``task`` one of ``task_types`` (name -> task
     type), ``trial`` an integer from 1 to ``TRIAL_MAX``, ``fmax`` a number from 0
-    to ``FMAX_MAX`` (N), ``wall`` the time as text, ``practice`` (when present)
-    true or false; the rest is the task type's (its ``response_problem``).
+    to ``FMAX_MAX`` (N), ``wall`` the time as text, ``practice`` and ``simulated`` (when
+    present) true or false; the rest is the task type's (its ``response_problem``).
     """
     if not isinstance(event, dict):
         return f"event {event!r}: allowed is a JSON object"
@@ -212,6 +212,7 @@ def response_problem(event, task_types):
         ("fmax", number(event.get("fmax"), FMAX_MAX), f"a number from 0 to {FMAX_MAX:g} (N)"),
         ("wall", text(event.get("wall")), "the time as ISO-8601 text"),
         ("practice", isinstance(event.get("practice", False), bool), "true or false (absent: false)"),
+        ("simulated", isinstance(event.get("simulated", False), bool), "true or false (absent: as session.json)"),
     ]
     for name, ok, allowed in checks:
         if not ok:

@@ -35,6 +35,7 @@ from studyapp.experiment.schedule import Trial, build_schedule
 from studyapp.experiment.session import check_participant
 from studyapp.experiment.session_description import read_description, session_folders
 from studyapp.experiment.session_files import EVENTS_FILE
+from studyapp.experiment.results_folder import used_rows_text
 from studyapp.experiment.session_info import check_order_row, order_rows
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import task_type
@@ -59,6 +60,8 @@ class RunPlan:
     steps: list
     session: Path | None = None  # the stored session the plan comes from (None: predicted)
     squares: dict = field(default_factory=dict)  # task -> {"rows": n, "rows_used": [...]}
+    results: Path | None = None  # the results folder (absolute)
+    used: str = ""  # the order rows the study's participants of this kind already have (results_folder.py)
 
     @property
     def seconds(self):
@@ -73,14 +76,17 @@ def make_plan(protocol, participant, results, order_row=None, simulated=False):
     typical = _recorded_durations(study_folder)
     existing = session_folders(study_folder / participant)
     if existing:
-        return _stored_plan(protocol, participant, existing[-1], order_row, typical)
+        plan = _stored_plan(protocol, participant, existing[-1], order_row, typical)
+        plan.results, plan.used = Path(results), used_rows_text(study_folder, plan.simulated)
+        return plan
     index = enrolment_index(study_folder, participant, simulated)
     rows = order_rows(protocol)
     source = "enrolment" if order_row is None else "set"
     row = index % rows if order_row is None else order_row
     schedule, squares = build_schedule(protocol, index, order_row=row)
     return RunPlan(protocol, participant, bool(simulated), row, rows, source,
-                   [_planned(protocol, trial, typical) for trial in schedule], squares=squares)
+                   [_planned(protocol, trial, typical) for trial in schedule], squares=squares,
+                   results=Path(results), used=used_rows_text(study_folder, simulated))
 
 
 def _stored_plan(protocol, participant, folder, order_row, typical):
@@ -213,6 +219,7 @@ def plan_markdown(plan, blind=False):
         f"- Protocol: `{p.path}` (sha256 `{p.sha256[:12]}`), study **{p.study}**, {p.rate:g} Hz",
         f"- Participant: **{plan.participant}**{' (simulated)' if plan.simulated else ''}, {where}",
         f"- Order: {_order_line(plan)}",
+        *([f"- Results folder: `{plan.results}`; {plan.used}"] if plan.results is not None else []),
         f"- Steps: {len(steps)} ({_count(sum(s.trial.page is not None for s in steps), 'page')}, "
         f"{_count(sum(s.trial.practice for s in steps), 'practice trial')}, "
         f"{_count(sum(s.trial.page is None and not s.trial.practice for s in steps), 'trial')})",

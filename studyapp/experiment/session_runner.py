@@ -4,10 +4,14 @@ logs them, and keeps the closed loop on the task's condition and F_max.
 Whoever plays the session (the simulated participant, or the GUI for a person
 with MIDI knobs) calls the same methods: ``start_trial``, ``knob``, ``pad``,
 ``set_bowing``, ``advance`` (run the loop for a while, which also ticks the
-task, telling it whether the bow is on: ``tick(dt, bowing)``),
+task, telling it whether the block was heard: ``tick(dt, heard)``, heard
+being the bow on, the string sounding (its velocity not all zero), no fault
+and the sound not muted (``audible``)),
 ``acknowledge_page`` and ``finish``. Every record a task returns is appended
 to the session log with the trial's ``step`` and ``task`` (and ``practice``
-true for a practice trial). The loop's faults and the stability monitor's
+true for a practice trial), and every ``response`` with ``simulated``: whether
+the simulated participant gave it (``simulated``; by default as the session's
+description says). The loop's faults and the stability monitor's
 changes of verdict are logged too.
 
 A page step (task ``page``) has no loop: nothing sounds while the participant
@@ -44,6 +48,7 @@ import numpy as np
 
 from studyapp import __version__
 from studyapp.experiment import records
+from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.hand_trace import HandTrace
 from studyapp.experiment.session_log import LogWriteError
 from studyapp.experiment.tasks import task_type
@@ -63,11 +68,14 @@ def closed_loop_factory(protocol, audio=False):
 
 
 class SessionRunner:
-    def __init__(self, session, make_loop=None, progress=None):
+    def __init__(self, session, make_loop=None, progress=None, simulated=None):
         self.session = session
+        # who answers: every response says whether a machine gave it (None: as session.json says)
+        self.simulated = is_simulated(session.info) if simulated is None else bool(simulated)
         self.protocol = session.protocol
         self.make_loop = make_loop or closed_loop_factory(self.protocol)
         self.progress = progress or (lambda message: None)
+        self.audible = lambda: True  # the console's mute: a muted string is not heard (controller.py)
         self.trial = None
         self.task = None
         self.loop = None
@@ -85,6 +93,8 @@ class SessionRunner:
         if self.trial is not None:
             practice = {"practice": True} if self.trial.practice else {}
             event = {"step": self.trial.step, "task": self.trial.task, **practice, **event}
+        if event.get("type") == "response":
+            event = {**event, "simulated": self.simulated}
         try:
             return self.session.log.append(event)
         except LogWriteError:
@@ -173,8 +183,8 @@ class SessionRunner:
     def pad(self, index):
         return self._handle(self.task.pad(index))
 
-    def tick(self, dt):
-        return self._handle(self.task.tick(dt, self.bowing))
+    def tick(self, dt, heard=None):
+        return self._handle(self.task.tick(dt, self.bowing if heard is None else heard))
 
     def acknowledge_page(self, by):
         """The current page acknowledged ``by`` the participant or the experimenter ([] on a trial)."""
@@ -227,8 +237,15 @@ class SessionRunner:
         if self.loop.fault is not None and self.loop.fault != self._fault:
             self._fault = self.loop.fault
             self.log(records.fault(str(self.loop.fault), self.task.fmax))
-        self.tick(n / self.loop.rate)
+        self.tick(n / self.loop.rate, heard=self._heard(block))
         return block
+
+    def _heard(self, block):
+        """True when ``block`` was heard: the bow on, the string sounding, no fault, the sound not muted."""
+        if not (self.bowing and self.audible() and self.loop.fault is None):
+            return False
+        string = block.get("string_velocity") if isinstance(block, dict) else None
+        return string is None or bool(np.any(string != 0.0))
 
     def finish(self, reason="done"):
         """Log the end of this run; and of the session, when every trial has a response."""

@@ -28,6 +28,10 @@ from studyapp.experiment.tasks import task_type
 from studyapp.model.controls import KNOB_MAX
 
 
+class TrialRestarted(Exception):
+    """The current trial was started again (an emergency stop, an engine restart): play it from its start."""
+
+
 class SimulatedParticipant:
     def __init__(self, seed, bow_time=0.25, probe_time=1.2, reaction_time=0.05, rest_time=1.0,
                  retries=12, adjust_gesture=None, rating_jitter=0.05,
@@ -48,7 +52,10 @@ class SimulatedParticipant:
     def play(self, runner):
         """Play every remaining trial of ``runner``'s session."""
         while (trial := runner.start_trial()) is not None:
-            self.play_trial(runner, trial)
+            try:
+                self.play_trial(runner, trial)
+            except TrialRestarted:
+                continue  # start_trial gives the same step again
 
     def play_trial(self, runner, trial):
         """Play ``trial``, the runner's current trial, to its response."""
@@ -91,6 +98,17 @@ class SimulatedParticipant:
         if short:
             runner.set_bowing(True)
             runner.advance(max(short.values()) + self.reaction_time)
+
+    def confirm(self, runner):
+        """Hear the setting with the bow on, then press the confirm pad; a refusal is read and answered
+        by listening longer (``retries`` times at most): a person confirms only what they heard."""
+        for _ in range(self.retries):
+            runner.set_bowing(True)
+            runner.advance(self.reaction_time)
+            self.listen_enough(runner)
+            runner.pad(runner.task.confirm_pad)
+            if runner.task.done:
+                return
 
     def rest(self, runner):
         """Lift the bow until the string is calm again (at most ``rest_time`` s), then bow again."""

@@ -21,6 +21,7 @@ from PySide6.QtWidgets import QApplication
 
 from studyapp.errors import UserError
 from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.results_folder import absolute
 from studyapp.experiment.session_info import check_order_row
 from studyapp.gui.setup_panel import find_protocols
 
@@ -60,7 +61,8 @@ def build(args):
         console.setup.select_protocol(protocol)
     if getattr(args, "participant", None):
         console.setup.participant.setText(args.participant)
-    console.setup.results.setText(str(getattr(args, "results", "results")))
+    if getattr(args, "results", None) is not None:  # else the folder this machine remembers (setup_panel.py)
+        console.setup.results.setText(str(absolute(args.results)))
     console.setup.resume.setChecked(bool(getattr(args, "resume", False)))
     console.setup.simulated.setChecked(bool(getattr(args, "simulated_participant", False)))
     console.replay = getattr(args, "replay", None)
@@ -71,6 +73,7 @@ def build(args):
 
 def main(args):
     """Run the console until it is closed; returns the exit code."""
+    from studyapp.gui.participant_placement import place
     from studyapp.gui.participant_screen import choose_screen
 
     app = application()
@@ -84,7 +87,7 @@ def main(args):
         console.resize(*size)
     console.show()
     if screen is not None:
-        console.participant_window.show_full_screen(screen)
+        place(console, screen)  # never over the console's session buttons (participant_placement.py)
     if participant:
         console.show_participant.setChecked(True)
     if shot:

@@ -57,6 +57,7 @@ from studyapp.gui.analysis_view import AnalysisView
 from studyapp.gui.gui_thread import GuiThreadCaller
 from studyapp.gui.live_tab import LiveTab
 from studyapp.gui.page_controls import PageControls
+from studyapp.gui.participant_placement import confine
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.progress_panel import ProgressPanel
 from studyapp.gui.session_buttons import SessionButtons
@@ -82,6 +83,7 @@ class Console(QMainWindow):
         self.replay = None  # {step: hand_trace}: the simulated participant's hand replays them (run --replay-gesture)
         self.notices = {}
         self.confirmation = None
+        self._typed = None  # the session fields as typed, while a resumed session shows its own
         self._midi_shown = None
         self.caller = GuiThreadCaller(self)
         self.setWindowTitle("studyapp — experimenter console")
@@ -95,7 +97,7 @@ class Console(QMainWindow):
         stop_key = QAction("Emergency stop", self)
         stop_key.setShortcut(QKeySequence(Qt.Key.Key_Escape))
         stop_key.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
-        stop_key.triggered.connect(controller.emergency_stop)
+        stop_key.triggered.connect(lambda: controller.emergency_stop("operator"))
         self.addAction(stop_key)
 
         self.progress = ProgressPanel()  # the state, the step, the condition, the response, a pickup
@@ -123,6 +125,7 @@ class Console(QMainWindow):
         scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         scroll.setMinimumWidth(details.minimumSizeHint().width() + scroll.verticalScrollBar().sizeHint().width())
         left = QWidget()
+        self.left_column = left  # the set-up, progress and session buttons: never covered by the participant
         lv = QVBoxLayout(left)
         lv.addWidget(scroll, 1)
         lv.addWidget(self.blind)  # in view without scrolling, at 1,366 x 768 too
@@ -237,6 +240,10 @@ class Console(QMainWindow):
             self.setup.show_error(str(exc))
             return None
         self.setup.show_error("")
+        self.setup.remember_results()
+        if self.setup.resume.isChecked():  # the session's own values, not the placeholders (given back at its end)
+            self._typed = self.setup.typed_session_info()
+            self.setup.fill_session_info(**{key: session.info.get(key) for key in self._typed})
         if self.setup.simulated.isChecked():
             self.simulated = SimulatedSession(self.controller, self, self.caller, session.seed,
                                               replay=self.replay).start()
@@ -292,6 +299,7 @@ class Console(QMainWindow):
     # the timer --------------------------------------------------------------
     def _tick(self):
         self.controller.poll()
+        confine(self.participant_window, self, self.controller.state == State.RUNNING)
         self.status.show_frame_rate(self.scope.frame_rate())
         sim = self.simulated
         if sim is not None and sim.done:
@@ -317,7 +325,7 @@ class Console(QMainWindow):
 
     def _on_state(self, state):
         emergency = state == State.EMERGENCY
-        self.progress.show_state(state)
+        self.progress.show_state(state, self.controller.stopped_by)
         active = self.controller.in_session
         self.buttons.show_state(state, active)
         self.setup.set_editable(not active)
@@ -326,6 +334,9 @@ class Console(QMainWindow):
         if state in REST:
             self.knobs.set_captions([])
             self.page_controls.show_none()
+            if self._typed is not None:
+                self.setup.fill_session_info(**self._typed)
+                self._typed = None
 
     def _on_trial(self, trial, step, total, instructions, phase="trial", number=None, of=None):
         self.progress.show_trial(trial, step, total, phase, number, of)
@@ -336,7 +347,9 @@ class Console(QMainWindow):
 
     def _on_page(self, kind, title, text, by, step, tone_hz, level_dbfs):
         self.participant_window.show_page(kind, title, text, by)
-        self.page_controls.show_page(kind, title, by, tone_hz, level_dbfs)
+        runner = self.controller.runner
+        page = runner.trial.page if runner is not None and runner.trial is not None else None
+        self.page_controls.show_page(kind, title, by, tone_hz, level_dbfs, page.note if page is not None else "")
 
     def _on_knob(self, index, value):
         self.knobs.show_knob(index, value)

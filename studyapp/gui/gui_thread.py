@@ -13,6 +13,9 @@ import threading
 from PySide6.QtCore import QObject, Qt, QThread, Signal
 
 
+TIMEOUT = 120.0  # s: a GUI thread on a machine at a load of 20 on 2 cores took over 10 s (issue 31)
+
+
 class GuiThreadCaller(QObject):
     _posted = Signal(object)
 
@@ -24,7 +27,7 @@ class GuiThreadCaller(QObject):
     def _run(job):
         job()
 
-    def __call__(self, fn, timeout=10.0):
+    def __call__(self, fn, timeout=TIMEOUT):
         if QThread.currentThread() is self.thread():
             return fn()
         done = threading.Event()

@@ -2,7 +2,7 @@
 
 During a page step it says which page is showing and who goes on from it.
 For the headphone level check (a ``calibration`` page) it names the tone and
-level playing and offers "Confirm level", the experimenter's acknowledgement
+level playing (its tooltip: how the level was computed, the page's ``note``) and offers "Confirm level", the experimenter's acknowledgement
 (``SessionController.acknowledge_page("experimenter")``); the participant
 cannot end that page. Hidden between pages.
 """
@@ -27,13 +27,14 @@ class PageControls(QWidget):
         layout.addWidget(self.confirm_button)
         self.show_none()
 
-    def show_page(self, kind, title, by, tone_hz=None, level_dbfs=None):
+    def show_page(self, kind, title, by, tone_hz=None, level_dbfs=None, note=""):
         calibration = kind == "calibration"
         if calibration:
             text = f"Page: {title} — reference tone {tone_hz:g} Hz at {level_dbfs:g} dBFS"
         else:
             text = f"Page: {title} ({kind}) — the {by} continues"
         self.label.setText(text)
+        self.label.setToolTip(note)  # the level check's computed level: the experimenter's, kept off the page
         self.confirm_button.setVisible(calibration)
         self.setVisible(True)
 

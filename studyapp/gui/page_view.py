@@ -5,7 +5,9 @@ by Qt's Markdown reader (``QTextBrowser.setMarkdown``): ``**bold**`` is bold,
 a single line break (a TOML triple-quoted string's) joins the lines into one
 paragraph, a blank line starts another. Large type, to be read from 60 cm.
 A page the experimenter confirms (the headphone level check) shows no
-Continue button, only a line saying the experimenter will go on.
+Continue button, only a line saying the experimenter will go on. Continue is
+clicked, never pressed with a key: it never takes the keyboard focus, so the
+space bar (the participant's bow) cannot acknowledge a page.
 """
 
 from PySide6.QtCore import Qt, Signal
@@ -29,6 +31,7 @@ class PageView(QWidget):
         self.title.setStyleSheet(f"font-size: {TITLE_PT}pt; font-weight: bold;")
         self.text = QTextBrowser()
         self.text.setOpenExternalLinks(False)
+        self.text.setFocusPolicy(Qt.FocusPolicy.NoFocus)  # the keys stay the window's (space: the bow)
         self.text.setFrameShape(QTextBrowser.Shape.NoFrame)
         font = self.text.font()
         font.setPointSize(TEXT_PT)
@@ -37,6 +40,9 @@ class PageView(QWidget):
         self.continue_button = QPushButton("Continue")
         self.continue_button.setStyleSheet(f"font-size: {TEXT_PT}pt; padding: 12px 40px;")
         self.continue_button.clicked.connect(self.continued)
+        # a click, never a key: a focused Continue would take the space bar, which is the bow (issue 31)
+        self.continue_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.continue_button.setAutoDefault(False)
         self.waiting = QLabel(WAIT_FOR_EXPERIMENTER)
         self.waiting.setWordWrap(True)
         self.waiting.setStyleSheet(f"font-size: {TEXT_PT}pt; color: #555;")

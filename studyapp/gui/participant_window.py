@@ -47,7 +47,7 @@ Progress counts the current task's practice or real trials ("Practice 1 of
 import re
 import time
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QEvent, Qt
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from studyapp.estimators import names as estimator_names
@@ -174,6 +174,9 @@ class ParticipantWindow(QWidget):
             e.trial.connect(self._on_trial)
             e.bowing.connect(self.show_bowing)
             e.refused.connect(lambda reason: self.show_refusal(reason))
+        for widget in self.findChildren(QWidget):  # no child takes a key: Space is the bow, Esc the stop
+            widget.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.resize(1000, 700)
 
     # what the console (or the controller's events) tell it --------------------------
@@ -279,7 +282,18 @@ class ParticipantWindow(QWidget):
             self.controller.set_bowing(not self.bowing)
         self.show_bowing(self.bowing)  # a refused toggle leaves the button as the bow is
 
+    def event(self, event):
+        # Esc here is the participant's: taken before the console's application-wide shortcut (the operator's)
+        if event.type() == QEvent.Type.ShortcutOverride and event.key() == Qt.Key.Key_Escape:
+            event.accept()
+            return True
+        return super().event(event)
+
     def keyPressEvent(self, event):
+        if event.key() == Qt.Key.Key_Escape:
+            if self.controller is not None:
+                self.controller.emergency_stop("participant")
+            return
         if event.key() == Qt.Key.Key_Space:
             now = self.clock()
             if not event.isAutoRepeat() and now - self._toggled >= BOUNCE_S:

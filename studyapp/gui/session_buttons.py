@@ -29,7 +29,7 @@ class SessionButtons(QWidget):
         self.stop_button = QPushButton("EMERGENCY STOP")
         self.stop_button.setStyleSheet(STOP_STYLE)
         self.stop_button.setToolTip("zero the force now (Esc)")
-        self.stop_button.clicked.connect(controller.emergency_stop)
+        self.stop_button.clicked.connect(lambda: controller.emergency_stop("operator"))
         row = QHBoxLayout()
         row.addWidget(self.start_button)
         row.addWidget(self.pause_button)
@@ -43,7 +43,9 @@ class SessionButtons(QWidget):
         self.start_button.setEnabled(state in REST)
         self.abort_button.setEnabled(in_session)
         self.pause_button.setEnabled(state in (State.RUNNING, State.PAUSED, State.EMERGENCY, State.ENGINE_LOST))
-        self.pause_button.setText("Pause" if state == State.RUNNING else "Resume")
+        # "Resume" only where there is something to resume: idle, starting or finished it reads "Pause" (greyed)
+        self.pause_button.setText("Resume" if state in (State.PAUSED, State.EMERGENCY, State.ENGINE_LOST)
+                                  else "Pause")
 
     def _pause_or_resume(self):
         c = self.controller

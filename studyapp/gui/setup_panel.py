@@ -6,7 +6,9 @@ Latin-square order row ("auto": from the participant's enrolment). They are
 checked when the session starts; a refusal shows in the panel's error line
 (below the form, wrapped to its whole height). Resuming takes only the
 participant, the protocol and the results folder: with "Resume" ticked the
-session's information (set when it started) is greyed and not passed on.
+session's information (set when it started) is greyed and not passed on; once
+the session is open the fields show its stored values (the console fills
+them from session.json, and gives back what was typed when it ends).
 
 The apparatus lines say what the engine really opened, in words: the device
 (the simulated 1-DOF device unless a driver is configured), the audio output
@@ -15,11 +17,16 @@ when it fell back to the null sink) and the MIDI input (a port, or none and
 why, in which case the on-screen knobs are the controls; or none yet, when
 the engine waits for a controller to be plugged in: ``show_midi`` follows
 the engine's status as it arrives).
+
+The results folder is shown absolute and remembered on this machine
+(``QSettings`` "studyapp", key ``results/folder``) when a session starts in
+it; a new console starts with it (else with the command line's default,
+experiment/results_folder.py), whatever folder it was started from.
 """
 
 from pathlib import Path
 
-from PySide6.QtCore import Signal
+from PySide6.QtCore import QSettings, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -34,6 +41,16 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
+
+from studyapp.experiment.results_folder import absolute, default_results
+
+RESULTS_KEY = "results/folder"
+
+
+def remembered_results():
+    """The results folder this machine used last (``QSettings`` key ``results/folder``), else the default."""
+    value = QSettings("studyapp", "studyapp").value(RESULTS_KEY)
+    return str(absolute(value)) if isinstance(value, str) and value else str(default_results())
 
 
 def find_protocols(folder="protocols"):
@@ -63,7 +80,7 @@ class SetupPanel(QWidget):
         browse.setToolTip("choose a protocol file")
         browse.setFixedWidth(28)
         browse.clicked.connect(self._browse_protocol)
-        self.results = QLineEdit("results")
+        self.results = QLineEdit(remembered_results())
         results_browse = QPushButton("…")
         results_browse.setFixedWidth(28)
         results_browse.setToolTip("choose the results folder")
@@ -140,7 +157,16 @@ class SetupPanel(QWidget):
 
     @property
     def results_folder(self):
-        return self.results.text().strip() or "results"
+        """The results folder, absolute (results_folder.py): never relative to where the console started."""
+        return str(absolute(self.results.text().strip() or None))
+
+    def remember_results(self):
+        """Show the folder a session started in as an absolute path, and remember it on this machine."""
+        folder = self.results_folder
+        self.results.setText(folder)
+        store = QSettings("studyapp", "studyapp")
+        store.setValue(RESULTS_KEY, folder)
+        store.sync()
 
     @property
     def session_info(self):
@@ -157,6 +183,12 @@ class SetupPanel(QWidget):
         self.session_number.setValue(int(session_number) if session_number not in (None, "") else 0)
         self.notes.setText(notes or "")
         self.order_row.setValue(int(order_row) if order_row not in (None, "") else -1)
+
+    def typed_session_info(self):
+        """What the fields hold now, as ``fill_session_info`` takes it (to give it back after a resumed session)."""
+        number, row = self.session_number.value(), self.order_row.value()
+        return {"experimenter": self.experimenter.text(), "session_number": number or None,
+                "notes": self.notes.text(), "order_row": None if row < 0 else row}
 
     def select_protocol(self, path):
         """Show ``path`` as the chosen protocol (adding it to the list)."""

@@ -17,8 +17,9 @@ preview's. The protocol's ``fmax_ceiling`` is the engine's hard clamp, in the
 preview too.
 """
 
+from studyapp.engine.load_margin import hang_timeout_for, load_per_core
 from studyapp.engine import commands as cmd
-from studyapp.engine.config import EngineConfig
+from studyapp.engine.config import HANG_TIMEOUT, EngineConfig
 from studyapp.engine.safety import SafetyLimits
 from studyapp.experiment.tasks import task_type
 from studyapp.live.engine_host import EngineHost
@@ -76,6 +77,8 @@ class Apparatus:
 
     def replace(self, config, describe):
         """Start an engine with ``config``; the old one stops in the background."""
+        if self.hang_timeout is None:  # the bound follows the machine's load at each start (engine/load_margin.py)
+            config.hang_timeout = hang_timeout_for(load_per_core(), HANG_TIMEOUT)
         old, self.host = self.host, self.make_host(config, describe).start()
         if old is not None:
             old.stop(wait=False)

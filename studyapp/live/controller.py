@@ -40,10 +40,15 @@ each logged during a session.
 """
 
 import time
+from pathlib import Path
 
+from studyapp.engine.config import HANG_TIMEOUT
+from studyapp.engine.load_margin import busy_warning, load_per_core
 from studyapp.errors import UserError
 from studyapp.experiment import records
+from studyapp.experiment.enrolment import apparatus_is_simulated, check_same_player
 from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.results_folder import used_rows_text
 from studyapp.experiment.schedule import counted
 from studyapp.experiment.session import Session, check_participant
 from studyapp.experiment.session_notes import add_note, note_event
@@ -84,6 +89,8 @@ class SessionController:
         self.fed = 0  # end (sample number) of the telemetry read while a trial ran
         self.trial_serial = 0  # counts steps started (restarts too); tags the step's samples and controls
         self.sound = MasterSound()  # the console's master volume and mute (master_sound.py)
+        self.stopped_by = "operator"  # who pressed the emergency stop last (states.emergency)
+        self.simulated = False  # the simulated participant plays the session (apparatus "participant")
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
         self._next_status = 0.0
 
@@ -151,16 +158,24 @@ class SessionController:
         if not self.at_rest:
             raise UserError("the emergency stop is set: clear it (Resume) before starting a session")
         check_participant(participant)
+        simulated = apparatus_is_simulated(apparatus)
+        used = used_rows_text(Path(results) / self.protocol.study, simulated)  # before this one enrols
         if resume:
+            check_same_player(results, self.protocol.study, participant, simulated)
             session = Session.resume(self.protocol, participant, results, seed=seed, **(details or {}))
         else:
             described = {"device": self.apparatus.device or "simulated", "engine": "real-time", **(apparatus or {})}
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
                                      **(details or {}))
         self.session = session
+        self.simulated = simulated  # who answers: stamped on every response (SessionRunner)
         self.last_session = session.folder
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
+        self.message(f"results folder {Path(results).resolve()}; before this session, {used}")
+        busy = busy_warning(load_per_core(), HANG_TIMEOUT)
+        if busy is not None:
+            self.message(busy, level="warning")
         self.fire("open")
         return session
 
@@ -175,8 +190,11 @@ class SessionController:
         """Give a paused trial back to the participant."""
         self.fire("resume")
 
-    def emergency_stop(self):
-        """Zero the force now (shared-memory word, then F_max 0, the bow lifted, no knob mapping)."""
+    def emergency_stop(self, by="operator"):
+        """Zero the force now (shared-memory word, then F_max 0, the bow lifted, no knob mapping).
+
+        ``by``: who stopped, ``operator`` (the console) or ``participant`` (Esc on the participant's window)."""
+        self.stopped_by = by
         self.fire("emergency")
 
     def clear_emergency(self):

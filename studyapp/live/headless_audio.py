@@ -30,7 +30,8 @@ AUDIO_FILE = "audio.wav"
 
 class ArchivingRunner(SessionRunner):
     def __init__(self, session, progress=None):
-        super().__init__(session, make_loop=closed_loop_factory(session.protocol, audio=True), progress=progress)
+        super().__init__(session, make_loop=closed_loop_factory(session.protocol, audio=True), progress=progress,
+                         simulated=True)  # headless, only the simulated participant plays
         self.chain = SignalChain(self.protocol.rate, WAV_RATE)
         self.recorder = AudioRecorder(session.folder / AUDIO_FILE, self.chain.rate, file_mode())
         self.path = self.recorder.path  # audio.wav, or audio-2.wav, ... for a resumed session

@@ -20,7 +20,10 @@ same slots a person's clicks reach.
 engine's output (from the moment of the call) to the trial, then returns
 those samples from the telemetry ring: the participant hears exactly what the
 engine played. A paused session therefore pauses the participant too; an
-aborted or closed one ends it (``Stopped``). Trials are started by the
+aborted or closed one ends it (``Stopped``). A trial started again (after an
+emergency stop, or on a new engine after a lost one) raises ``TrialRestarted``
+from the participant's next call, so it plays the trial again from its start
+(the bow put back, the knob from 0), never on with what it did before. Trials are started by the
 controller as soon as the previous one has its response; ``start_trial``
 waits for the next one.
 """
@@ -31,7 +34,7 @@ import time
 import numpy as np
 
 from studyapp.experiment.hand_trace import ReplayingHand
-from studyapp.experiment.simulated_participant import SimulatedParticipant
+from studyapp.experiment.simulated_participant import SimulatedParticipant, TrialRestarted
 from studyapp.live.controls import PAGE_SETTLE_S
 from studyapp.live.states import ACTIVE, State
 
@@ -62,10 +65,20 @@ class ParticipantProxy:
         if self.stop.is_set() or self.controller.state not in ACTIVE:
             raise Stopped()
 
+    def _check_attempt(self):
+        """``TrialRestarted`` once the participant's trial was started again (same step, a new attempt)."""
+        self._check()
+        c = self.controller
+        runner = c.runner
+        if (self._trial is not None and c.playing and c.trial_serial != self._seen and runner is not None
+                and runner.trial is not None and runner.trial.step == self._trial.step):
+            raise TrialRestarted()
+
     def _wait_running(self):
         while not self.controller.playing:
             self._check()
             time.sleep(WAIT_STEP)
+        self._check_attempt()
 
     def _current(self, name):
         # The controller starts the next trial as soon as this one has its response, so the
@@ -108,7 +121,7 @@ class ParticipantProxy:
         c = self.controller
         ticket = self.act(lambda: (press(), c.controls_sent)[1])
         while ticket is not None and c.controls_taken < ticket:
-            self._check()
+            self._check_attempt()
             time.sleep(WAIT_STEP)
 
     def knob(self, index, value):
@@ -151,7 +164,7 @@ class ParticipantProxy:
             engine = c.engine
             start = engine.ring.committed
             while c.engine is engine and c.fed < start + n:
-                self._check()
+                self._check_attempt()
                 time.sleep(WAIT_STEP)
             if c.engine is engine:
                 # (a new engine after a failure starts its sample count again: listen again then)

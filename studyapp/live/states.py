@@ -16,7 +16,8 @@ sender of commands), ``media`` (reference tone, audio cues, trial health),
 ``controls`` (pickup, latency) and ``steps`` (a trial or page started, held, ended).
 
 Emergency stop: at once, the engine's ``force_enable`` word in shared memory
-is cleared with the reason "operator" (the worker latches a fault and zeroes
+is cleared with the reason "operator", or "participant" for Esc on the
+participant's window (``stopped_by``, logged with the stop; the worker latches a fault and zeroes
 its force scale at its next block, ``studyapp.engine.safety``), F_max is set
 to 0, the bow lifted, the knobs unmapped. Clearing unlatches it and, once the
 engine reports it cleared, starts the current trial again from its beginning
@@ -70,7 +71,9 @@ def begin(c):
 
 
 def begin_run(c):
-    c.runner = SessionRunner(c.session, make_loop=lambda *loop: steps.make_loop(c, *loop), progress=c.message)
+    c.runner = SessionRunner(c.session, make_loop=lambda *loop: steps.make_loop(c, *loop), progress=c.message,
+                             simulated=c.simulated)
+    c.runner.audible = lambda: not c.sound.muted
     c.runner.begin()
     engine_up(c)
 
@@ -180,7 +183,7 @@ def restart_failed(c):
 
 # the emergency stop -------------------------------------------------------------------------------------
 def emergency(c):
-    c.apparatus.disable_force("operator")
+    c.apparatus.disable_force(c.stopped_by)
     c.media.reference_tone(False)
     loop = c.runner.loop if c.runner is not None else None
     if loop is not None and c.engine is not None and loop.engine is c.engine:
@@ -188,8 +191,8 @@ def emergency(c):
     else:
         c.apparatus.silence()
     if c.runner is not None and c.state != State.EMERGENCY:
-        c.runner.log(records.emergency_stop())
-    c.message(force_off_text("operator"), level="error")
+        c.runner.log(records.emergency_stop(c.stopped_by))
+    c.message(force_off_text(c.stopped_by), level="error")
     c.events.bowing.emit(on=False)
     return State.EMERGENCY
 

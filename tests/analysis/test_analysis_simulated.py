@@ -7,6 +7,7 @@ analysed as participants. ``analyse`` now leaves out rows with ``simulated`` Tru
 
 import contextlib
 import io
+import re
 
 import pandas as pd
 
@@ -71,3 +72,32 @@ def test_a_bad_simulated_cell_is_named(tmp_path):
     frame.to_csv(tmp_path / "bad.csv", index=False)
     code, err = _analyse(tmp_path / "bad.csv", "-o", tmp_path / "out")
     assert code == 2 and "column 'simulated' at line 6 is 'maybe'; allowed: True, False" in err
+
+
+def test_figures_and_report_say_how_many_participants_are_simulated_in_the_singular_too(tmp_path):
+    """Issue 31 items 3 and 10: Figs. 7-8 with --include-simulated say how many are simulated; "1 participant"."""
+    from studyapp.analysis.figures import simulated_footnote
+    from studyapp.analysis.responses import load_responses
+    from studyapp.analysis.study import analyse
+
+    responses, label = load_responses(_mixed(tmp_path, real=3, simulated=1), include_simulated=True)
+    study = analyse(responses, source=label, include_simulated=True)
+    assert simulated_footnote(study, study.adjustment).strip() == "1 of 4 participants simulated (--include-simulated)"
+    assert simulated_footnote(analyse(responses, source=label), study.adjustment) == ""
+    code, err = _analyse(_mixed(tmp_path, real=1, simulated=1), "-o", tmp_path / "one")
+    assert code == 0, err
+    assert "1 participant," in err and "left out 1 simulated participant (SIM01)" in err
+    html = (tmp_path / "one" / "report.html").read_text()
+    assert "1 participant: P01" in html and not re.search(r"(?<!\d)1 participants", html)
+
+
+def test_no_effect_size_for_one_participant():
+    """Issue 31 item 10: with one participant every pair's r is +-1 by construction: not given."""
+    import math
+
+    from studyapp.analysis.within_subject import within_subject
+
+    one = pd.DataFrame({"participant": ["P01"] * 3, "condition": ["A", "B", "C"], "value": [1.0, 2.0, 3.0]})
+    assert all(math.isnan(r) for r in within_subject(one, ["A", "B", "C"]).signed_rank["effect_size"])
+    two = pd.concat([one, one.assign(participant="P02", value=[1.5, 2.5, 3.5])])
+    assert list(within_subject(two, ["A", "B", "C"]).signed_rank["effect_size"]) == [-1.0, -1.0, -1.0]

@@ -12,7 +12,12 @@ ADJUST = {"knob1": ("fmax_log", 40.0, 2.0)}
 
 
 @pytest.mark.parametrize("target, previous, value, acts", [
-    (0, None, 0, True),  # never seen: only landing on the level picks it up
+    (0, None, 0, True),  # never seen: landing on the level picks it up
+    (0, None, 1, True),  # ... and so does the first step off it: an LPD8 knob turned up from 0 first sends 1
+    (0, None, 2, True),  # (two coalesced steps)
+    (0, None, 3, False),
+    (127, None, 126, True),  # resting at the top, turned down
+    (50, None, 51, True),  # resting at the level, mid-range
     (0, None, 100, False),
     (0, 100, 99, False),  # turned, but not through the level
     (0, 5, 0, True),

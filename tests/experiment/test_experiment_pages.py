@@ -317,7 +317,7 @@ def test_bow_auto_puts_the_bow_on_at_each_trial_start_and_logs_it(tmp_path):
         else:
             assert (last["type"], last["on"], last["step"]) == ("bowing", True, trial.step)
             assert runner.loop.bowing is True
-            runner.knob(0, 20), runner.pad(3)
+            runner.knob(0, 20), runner.advance(0.05), runner.pad(3)  # heard (the bow is on), then confirmed
     assert [b for task, phase, b in started if phase != "page"] == [False, False, True, True, True, True, True, True]
     session.close()
 

@@ -85,8 +85,8 @@ def test_rating_ignores_unassigned_knobs_and_rejects_bad_values():
 def test_adjustment_sequence_with_overshoot():
     task = AdjustmentTrial("LOWPASS", trial=2, ceiling=40.0, decades=3.0, knob=0, confirm_pad=1)
     assert task.fmax == 0.0 and task.source == "LOWPASS"
-    script = [("pad", 1), ("knob", 1, 99), ("knob", 0, 60), ("tick", 0.5), ("knob", 0, 100),
-              ("tick", 0.5), ("knob", 0, 96), ("pad", 0), ("pad", 1)]
+    script = [("pad", 1), ("knob", 1, 99), ("knob", 0, 60), ("tick", 0.5, True), ("knob", 0, 100),
+              ("tick", 0.5, True), ("knob", 0, 96), ("pad", 0), ("pad", 1)]
     records = play(task, script)
     assert records[0] == {"type": "pad", "index": 1, "accepted": False, "reason": "F_max is 0: turn the knob up first"}
     knobs = [r for r in records if r["type"] == "knob"]
@@ -96,9 +96,21 @@ def test_adjustment_sequence_with_overshoot():
     assert response == {
         "type": "response", "task": "adjustment", "condition": "LOWPASS", "trial": 2,
         "fmax": pytest.approx(expected), "value": 96,
-        "peak_fmax": pytest.approx(40.0 * 10 ** (-3 * 27 / 126)), "duration": 1.0,
+        "peak_fmax": pytest.approx(40.0 * 10 ** (-3 * 27 / 126)),
+        "heard_fmax": pytest.approx(40.0 * 10 ** (-3 * 27 / 126)), "duration": 1.0,
     }
     assert task.done and task.knob(0, 5) == [] and task.fmax == pytest.approx(expected)
+
+
+def test_adjustment_refuses_a_setting_never_heard():
+    """Issue 31 item 4: after a stop or a restart a knob turned up over silence is not a response."""
+    task = AdjustmentTrial("LVT", trial=1, ceiling=40.0, decades=2.0)
+    play(task, [("knob", 0, 30), ("tick", 0.5, True), ("knob", 0, 127), ("tick", 0.5, False)])
+    (refused,) = task.pad(0)
+    assert refused["accepted"] is False and refused["reason"].startswith("this setting has not been heard yet")
+    assert "F_max" not in refused["reason"] and not task.done
+    task.knob(0, 30)  # back to what was heard: taken
+    assert task.pad(0)[-1]["fmax"] == pytest.approx(task.heard_fmax)
 
 
 def test_fmax_knob_map_is_logarithmic_from_zero_to_the_ceiling():

@@ -53,8 +53,9 @@ def test_a_toml_paragraph_with_hard_line_breaks_is_one_paragraph(qapp):
     view.show_page("instructions", "Instructions", markdown(instructions), "participant")
     document = view.text.document()
     assert document.blockCount() == 1
-    assert "the\nhandle" not in document.toPlainText()
-    assert "when you bow, but the handle feels no force" in " ".join(document.toPlainText().split())
+    assert "it does\nnot" not in document.toPlainText()
+    assert "when you bow, but it does not grip yet" in " ".join(document.toPlainText().split())
+    assert "handle" not in document.toPlainText()  # the participant holds no handle (issue 31 item 10)
     shipped = [t.page for t in steps if t.page and t.page.kind == "instructions"]
     view.show_page("instructions", shipped[1].title, shipped[1].text, "participant")
     assert view.text.document().blockCount() == 3  # the shipped page: three paragraphs as written
@@ -112,3 +113,27 @@ def test_the_console_and_participant_window_walk_through_the_pages(paged_console
     c.pad(0)
     c.poll()
     assert participant.refusal.text() == "Not rated yet: the second dial."  # issue 22 item 15: as the docs promise
+
+
+def test_space_never_acknowledges_a_page_and_esc_there_is_the_participants_stop(paged_console, qtbot, tmp_path):
+    from PySide6.QtCore import Qt
+
+    window, c = paged_console, paged_console.controller
+    up(c)
+    c.start_session("P01", tmp_path / "results")
+    up(c)
+    participant = window.participant_window
+    participant.show()
+    qtbot.mouseClick(participant.page_view.continue_button, Qt.MouseButton.LeftButton)  # welcome, by mouse
+    window.page_controls.confirm_button.click()  # the level check, the experimenter's
+    step = c.runner.trial.step
+    assert c.runner.trial.page is not None
+    # the space bar on the participant's window (where the focus is, if anywhere): the bow, never Continue
+    qtbot.keyClick(participant.focusWidget() or participant, Qt.Key.Key_Space)
+    assert c.runner.trial.step == step and c.runner.trial.page is not None
+    qtbot.keyClick(participant.focusWidget() or participant, Qt.Key.Key_Escape)
+    assert c.emergency and c.stopped_by == "participant"
+    stop = [e for e in c.session.events() if e["type"] == "emergency_stop"]
+    assert stop[-1]["by"] == "participant"
+    assert "(participant)" in window.state_label.text()
+    participant.hide()

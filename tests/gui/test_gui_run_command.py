@@ -82,7 +82,7 @@ def test_run_resume_after_a_crash_reopens_the_participant_screen_full_screen(lap
     first = probe(laptop_display, tmp_path, "wait", "--audio", "null", "--midi", "none", "--participant-screen", "0")
     try:
         before = first_report(first)
-        assert before["participant"]["full_screen"] and before["participant"]["screen"] == 0
+        assert before["participant"]["screen"] == 0
     finally:
         os.killpg(first.pid, signal.SIGKILL)  # the crash: the app, its engine, all at once
         first.wait(30)
@@ -94,8 +94,12 @@ def test_run_resume_after_a_crash_reopens_the_participant_screen_full_screen(lap
         if again.poll() is None:
             os.killpg(again.pid, signal.SIGKILL)
     p = after["participant"]
-    assert p["visible"] and p["full_screen"] and p["screen"] == 0, after
-    assert p["geometry"] == [0, 0, *SCREEN], after
+    assert p["visible"] and p["screen"] == 0, after
+    # one screen: the participant's window leaves the console's session buttons in view (issue 31 item 5)
+    x = p["geometry"][0]
+    assert not p["full_screen"] and x > 0, after
+    for name, rect in after["buttons"].items():
+        assert rect[0] + rect[2] <= x, (name, rect, p)
     assert after["step"] is not None
 
 

@@ -168,6 +168,10 @@ def test_scripted_clicks_pause_and_emergency_stop(idle_console, qapp, qtbot, tmp
     wait_until(qapp, lambda: c.playing, 10)
     assert dial.value() == 0
     dial.setValue(30)
+    # heard before it is confirmed (issue 31 item 4): the bow on at the setting
+    wait_until(qapp, lambda: c.controls_taken >= c.controls_sent, 10)
+    console.set_bowing(True)
+    wait_until(qapp, lambda: c.runner.task.heard_fmax >= c.runner.task.fmax > 0, 10)
     qtbot.mouseClick(pads[0], Qt.MouseButton.LeftButton)
     wait_until(qapp, lambda: c.state == "finished", 10)
 

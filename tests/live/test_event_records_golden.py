@@ -150,8 +150,11 @@ def scripted_session(tmp_path):
         if c.runner is None:
             break
         task = c.runner.trial.task
-        if task == "adjustment":
-            c.knob(0, 30), c.pad(0), c.poll()
+        if task == "adjustment":  # turned up, heard (the bow is the protocol's), confirmed
+            c.knob(0, 30), c.poll()
+            c.host.play(0.1)
+            c.poll()
+            c.pad(0), c.poll()
         else:
             c.host.play(0.1)
             c.poll()

@@ -60,7 +60,8 @@ def test_the_level_check_is_as_loud_as_the_bowed_string(sinclair):
     info = json.loads((sinclair / "session.json").read_text())
     (page,) = [s["page"] for s in info["schedule"] if s.get("page") and s["page"]["kind"] == "calibration"]
     assert page["level_dbfs"] == pytest.approx(tone + 3.01, abs=0.1)  # the tone played is the page's
-    assert f"{tone:.1f} dBFS RMS" in page["text"]  # and the page says so
+    assert f"{tone:.1f} dBFS RMS" in page["note"]  # and the experimenter's note says so
+    assert "dBFS" not in page["text"]  # the participant's page does not (issue 31 item 10)
 
 
 def test_without_audio_nothing_is_archived(tmp_path):

@@ -106,6 +106,14 @@ def play_rating(c):
     c.poll()
 
 
+def heard(c):
+    """Bow at the setting in force for a moment: a confirm is taken only for what was heard."""
+    c.poll()  # the worker's report of the knob: the setting in force
+    c.set_bowing(True)
+    c.host.play(0.05)
+    c.poll()
+
+
 def reach(c, state):
     """Drive the controller into ``state`` through its public methods and the engine's states."""
     if state == S.IDLE:
@@ -117,6 +125,7 @@ def reach(c, state):
         else:
             play_rating(c)
             c.knob(0, 30)
+            heard(c)
             c.pad(0)
             c.poll()
         return
@@ -411,6 +420,7 @@ def test_each_session_engine_records_the_audio_with_a_cue_at_each_trial_start_an
     up(c)  # a new engine: a new recording (the worker picks audio-2.wav), the trial starts again
     second = c.host.engine
     c.knob(0, 30)
+    heard(c)
     c.pad(0)
     c.poll()
     assert c.state == S.FINISHED

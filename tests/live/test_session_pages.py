@@ -106,7 +106,7 @@ def test_a_page_holds_the_loop_silent_and_the_pad_acknowledges_it(c):
     assert page(c) == "calibration"
     acknowledged = [e for e in log(c) if e["type"] == "response"]
     assert acknowledged == [{"step": 0, "task": "page", "type": "response", "trial": 1, "fmax": 0.0,
-                             "kind": "welcome", "title": "Welcome", "by": "participant"}]
+                             "kind": "welcome", "title": "Welcome", "by": "participant", "simulated": False}]
 
 
 def test_the_level_check_plays_its_tone_until_the_experimenter_confirms_it(c):

@@ -10,7 +10,12 @@ back if they overshot, and confirms with the pad. The response is the F_max
 at the confirm; the highest F_max reached during the trial is kept too, as a
 record of the overshoot. A confirm at F_max = 0 is refused (no force on the
 handle, so nothing can break down: it is a slip of the hand; the string
-still sounds when bowed, F_max scaling only the force fed back). Other knobs are ignored.
+still sounds when bowed, F_max scaling only the force fed back). So is a
+confirm above ``heard_fmax``, the largest F_max the attempt has run at with
+the bow on and the string sounding (the runner's ``heard``, for at least one
+block): nothing is confirmed that was not heard, e.g. a knob turned up over
+silence after an emergency stop or an engine restart (issue 31); the response
+keeps ``heard_fmax``. Other knobs are ignored.
 
 An interrupted trial starts again from F_max = 0 (a sudden return to a high
 F_max could be unsafe on a real device): nothing is restored.
@@ -52,6 +57,8 @@ from studyapp.experiment.tasks.phases import PhaseFields, read_phases
 from studyapp.model.controls import KNOB_MAX, FmaxKnob
 from studyapp.model.limits import FMAX_LIMIT
 
+HEARD_TOLERANCE = 1e-9  # relative: the same knob position gives the same F_max, float for float
+
 
 @dataclass(frozen=True)
 class AdjustmentSpec(PhaseFields):
@@ -76,6 +83,7 @@ class AdjustmentTrial(ConfirmPadTrial):
         self.knob_index = knob
         self.value = 0
         self.peak_value = 0
+        self.heard_fmax = 0.0  # the largest F_max heard in this attempt (bow on, the string sounding)
 
     @property
     def source(self):
@@ -93,8 +101,17 @@ class AdjustmentTrial(ConfirmPadTrial):
         self.peak_value = max(self.peak_value, value)
         return [records.knob(index, value, fmax=self.fmax)]
 
+    def tick(self, dt, bowing=False):
+        if bowing and dt > 0.0 and not self.done:
+            self.heard_fmax = max(self.heard_fmax, self.fmax)
+        return super().tick(dt, bowing)
+
     def refusal(self):
-        return "F_max is 0: turn the knob up first" if self.value == 0 else None
+        if self.value == 0:
+            return "F_max is 0: turn the knob up first"
+        if self.fmax > self.heard_fmax * (1.0 + HEARD_TOLERANCE):
+            return "this setting has not been heard yet: bow the string, listen, then confirm"
+        return None
 
     def listen_label(self, condition):
         return "the string"
@@ -106,6 +123,7 @@ class AdjustmentTrial(ConfirmPadTrial):
             "fmax": self.fmax,
             "value": self.value,
             "peak_fmax": self.action.fmax(self.peak_value),
+            "heard_fmax": self.heard_fmax,
             "duration": self.elapsed,
         }
 
@@ -205,8 +223,7 @@ class Adjustment:
         if broken:
             value = round(value + participant.criterion + rng.normal(0.0, participant.hand_jitter))
         participant.turn(runner, knob, int(np.clip(value, 1, KNOB_MAX)), rng)
-        participant.listen_enough(runner)
-        runner.pad(runner.task.confirm_pad)
+        participant.confirm(runner)
 
 
 TASK_TYPE = Adjustment()
