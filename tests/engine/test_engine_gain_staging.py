@@ -94,3 +94,26 @@ def test_the_level_check_is_heard_within_1_db_of_the_rating_stimulus_at_the_volu
     tone_rms = 20 * math.log10(np.sqrt(np.mean(tone**2)))
     assert abs(tone_rms - stimulus) <= 1.0, (tone_rms, stimulus)
     assert tone_rms == pytest.approx(page.level_dbfs - 3.01 + volume_db, abs=0.05)  # the page's level, x volume
+
+
+def test_the_engine_reports_every_sample_its_limiter_bent(tmp_path):
+    import time
+
+    from scipy.io import wavfile
+
+    from studyapp.engine import commands as cmd
+    from studyapp.engine.config import EngineConfig
+    from studyapp.engine.engine import Engine
+
+    path = tmp_path / "loud.wav"
+    config = EngineConfig(rate=RATE, estimators={}, source="LVT", fmax=40.0, audio=f"wav:{path}", midi="none",
+                          realtime=False)  # 40 N: far above 1.25 x LVT's breakdown, bent by the limiter
+    with Engine(config) as engine:
+        engine.send(cmd.SetBowing(True))
+        time.sleep(1.5)
+        status = engine.status()
+    summary = engine.summary
+    _, pcm = wavfile.read(path)
+    above = int(np.sum(np.abs(pcm / 32767.0) > KNEE))
+    assert status["audio_limited"] > 0 and summary["audio_limited"] >= status["audio_limited"]
+    assert abs(summary["audio_limited"] - above) <= 2 + above // 1000  # the file's rounding

@@ -127,7 +127,7 @@ def test_the_engine_records_what_is_heard_with_cues_at_the_trials_first_samples(
     windows = sliding_window_view(heard, 64)
     offset = np.flatnonzero(np.all(windows == recorded[1000:1064], axis=1))
     assert offset.size == 1 and np.array_equal(heard[offset[0] - 1000:][:recorded.size], recorded)
-    assert np.std(recorded) > 100  # the bowed string, not silence
+    assert np.std(recorded) > 10  # the bowed string (at the stimulus gain, -33 dB), not silence
     cues = _cues(record.parent)
     assert [(r["file"], r["trial"], r["event"]) for r in cues] == [("audio.wav", "1", "start"), ("audio.wav", "2", "start")]
     # each cue sits where the telemetry says its trial's first sample is heard, give or take a block: the
