@@ -4,7 +4,7 @@ While on, the sink's output is
 
     y[j] = (1 - c[j]) s[j] + a[j] sin(phi_0 + omega j),   omega = 2 pi hz / fs,
 
-with s the string's sound after the volume knob, fs the sink's rate, c the
+with s the string's sound (after the fixed stimulus gain), fs the sink's rate, c the
 crossfade (0: the string, 1: the tone) and a the tone's peak amplitude,
 A = 10^(level_dbfs / 20) (peak, dB re full scale, so -20 dBFS is a peak of
 0.1; its RMS is 3.01 dB lower), at most the output limiter's knee (-18 dBFS,
@@ -14,9 +14,11 @@ carried from block to block (phi_0 is the phase reached at the end of the
 previous block; 0 when the tone starts from silence): the tone is one sine
 whatever the block sizes.
 
-The tone does not pass through the participant's volume knob: a level check
-must be at the level the protocol names, whatever the knob was left at. The
-experimenter's mute still silences it (mute means silence).
+The tone goes through the volume after it, as the string does (issue 31): the
+level check is heard at the stimulus level with the volume in force, so the
+headphones are set for what the participant will hear at that volume. Its
+level is at most the limiter's knee and the volume only attenuates, so the
+tone is never bent. The experimenter's mute silences it (mute means silence).
 """
 
 import math

@@ -1,10 +1,23 @@
 """What reaches the headphones: the loop's audio through one chain, live and headless alike.
 
-    x (haptic rate) -> gate: silence while the bow is lifted, fades at every start, stop and cut
+    x (haptic rate) -> stimulus gain: a fixed G = 10^(STIMULUS_GAIN_DB / 20) (model/stimulus_level.py)
+      -> gate: silence while the bow is lifted, fades at every start, stop and cut
       -> resampler (haptic rate -> the sink's rate, resampler.py)
-      -> volume and mute (Gain, ramped over one block)
-      -> reference tone (reference_tone.py; not through the volume)
-      -> soft limiter: no sample ever above CEILING_DBFS
+      -> reference tone (reference_tone.py: the level check, in place of the string)
+      -> volume and mute (Gain, ramped over one block: the listener's comfort, string and tone alike)
+      -> soft limiter: no sample ever above CEILING_DBFS; every sample it bends is counted (``limited``)
+
+Gain staging. The loop's audio (the body's radiated sound and the handle's
+buzz, model/body.py, model/contact_mic.py) is scaled by one fixed gain so
+that the stimulus stays linear, under the limiter's knee, over every F_max a
+protocol's knob reaches below 1.25 x LVT's bowing breakdown; the volume only
+attenuates (-40 to 0 dB, model/controls.py VOLUME_DB), so it can never push
+the stimulus into the limiter. The limiter is a safety net for what lies
+beyond (a loop broken far above its breakdown): ``limited`` counts the output
+samples it bends, which the worker reports (``audio_limited``), the session
+logs per trial (``trial_health``) and the recorder writes in audio_cues.csv.
+The level check's tone is mixed before the volume, so it is heard at the
+stimulus level with the volume in force.
 
 Gate. The bow lifted means silence: the string's ringing and the handle's
 buzz (contact_mic.py) are not heard while the bow is off the string (the
@@ -23,16 +36,17 @@ boundary are still there to be faded to zero, and the new block fades in from
 zero: the output is exactly 0 from the lift on. The fades are made at the
 haptic rate, before the resampler, which then sees a continuous signal.
 
-Limiter. After the volume (which may raise the level up to 4x) a soft clip
-bounds every sample below the ceiling C = 10^(CEILING_DBFS / 20):
+Limiter. After the volume a soft clip bounds every sample below the ceiling
+C = 10^(CEILING_DBFS / 20):
 
     y = x                                          for |x| <= K,  K = C 10^(-KNEE_DB / 20)
     y = sign(x) (K + (C - K) tanh((|x| - K) / (C - K)))   above,
 
 continuous with slope 1 at the knee K and |y| <= C always (tanh reaches 1 only
-in floating point, for inputs far above the knee). The typical bowed
-string (1 N, strokes: about -36 dBFS RMS, peaks about -27 dBFS) stays under
-the knee; only loud breakdown sounds are bent, never clipped flat.
+in floating point, for inputs far above the knee). A sample is bent exactly
+when its input is above the knee K, so the samples above K in the output are
+the samples the limiter touched. The levels the gain gives are in
+docs/engine.md ("Levels", from scripts/audio_levels.py).
 
 Position. The chain counts the haptic samples it took (``taken``); the first
 sample of the next block appears in the output at frame
@@ -47,11 +61,13 @@ import numpy as np
 from studyapp.engine.reference_tone import ReferenceTone
 from studyapp.engine.resampler import Resampler
 from studyapp.errors import ParameterError
+from studyapp.model.stimulus_level import KNEE_DBFS, STIMULUS_GAIN
 
 CEILING_DBFS = -12.0  # the documented peak: no output sample exceeds it
-KNEE_DB = 6.0  # the limiter bends the signal only above CEILING_DBFS - KNEE_DB
+KNEE_DB = CEILING_DBFS - KNEE_DBFS  # 6 dB: the limiter bends the signal only above the knee, KNEE_DBFS (-18)
 FADE_S = 0.005  # s: every start, stop and cut fades over this (and the gate looks ahead this far)
 CEILING = 10.0 ** (CEILING_DBFS / 20.0)
+KNEE = 10.0 ** (KNEE_DBFS / 20.0)
 
 
 def soft_limit(x, ceiling=CEILING, knee_db=KNEE_DB):
@@ -146,8 +162,9 @@ class Gate:
 class SignalChain:
     """``process(audio, sounding, cut)``: one block of the loop's audio -> what the listener hears."""
 
-    def __init__(self, haptic_rate, rate, fade=FADE_S):
+    def __init__(self, haptic_rate, rate, fade=FADE_S, gain=STIMULUS_GAIN):
         self.haptic_rate = float(haptic_rate)
+        self.stimulus_gain = float(gain)
         self.rate = float(rate)
         self.gate = Gate(self.haptic_rate, fade)
         self.resampler = Resampler(self.haptic_rate, self.rate)
@@ -155,6 +172,7 @@ class SignalChain:
         self.tone = ReferenceTone(self.rate)
         self.taken = 0  # haptic samples taken so far
         self.emitted = 0  # output frames so far
+        self.limited = 0  # output frames the limiter bent (above the knee)
 
     @property
     def delay(self):
@@ -166,13 +184,16 @@ class SignalChain:
         return int(round((self.taken + self.gate.length) * self.rate / self.haptic_rate))
 
     def _finish(self, samples):
-        out = soft_limit(self.tone.mix(self.gain.apply(samples)))
+        out = self.gain.apply(self.tone.mix(samples))
+        self.limited += int(np.count_nonzero(np.abs(out) > KNEE))
+        soft_limit(out)
         self.emitted += out.shape[0]
         return out
 
     def process(self, audio, sounding=True, cut=False):
         self.taken += audio.shape[0]
-        return self._finish(self.resampler.process(self.gate.process(audio, sounding, cut)))
+        gated = self.gate.process(self.stimulus_gain * np.asarray(audio, dtype=np.float64), sounding, cut)
+        return self._finish(self.resampler.process(gated))
 
     def silence(self, n):
         """``n`` haptic samples of nothing (a page: no loop); the tone still plays."""

@@ -47,6 +47,7 @@ NUMBERS = (
     "deadline_misses",  # blocks finished after their deadline on the pacing clock
     "audio_underruns",  # device periods the engine did not fill in time (silence played)
     "audio_xruns",  # xruns the audio device itself reported
+    "audio_limited",  # output samples the limiter bent (above its knee: signal_chain.py)
     "faults",  # faults raised so far (latched or not)
     "fault_latched",  # 1 while a latched fault holds the force at zero
     "fmax",  # F_max in force now, N
@@ -169,7 +170,7 @@ class StatusBlock:
     def _snapshot(self, numbers, texts):
         out = {key: float(numbers[i]) for i, key in enumerate(NUMBERS)}
         for key in ("blocks", "samples", "deadline_misses", "audio_underruns", "audio_xruns",
-                    "faults", "midi_messages", "block"):
+                    "audio_limited", "faults", "midi_messages", "block"):
             out[key] = int(out[key])
         out["state"] = STATES[int(out["state"])]
         out["fault_latched"] = bool(out["fault_latched"])

@@ -316,7 +316,7 @@ class Worker(ControlRouting):
             self._faults_seen += len(new_faults)
             status.set(
                 heartbeat=finished, blocks=self.k, samples=self.k * self.block, load=pacing.loads[-1],
-                audio_underruns=self.sink.underruns, audio_xruns=self.sink.xruns,
+                audio_underruns=self.sink.underruns, audio_xruns=self.sink.xruns, audio_limited=self.sink.limited,
                 fault_latched=self.safety.latched is not None, fmax=self.loop.fmax,
                 force_scale=self.loop.force_scale,
             )
@@ -345,7 +345,7 @@ class Worker(ControlRouting):
             "rate": self.loop.rate, "blocks": self.k, "samples": self.k * self.block,
             "seconds": t["seconds"], "achieved_rate": t["achieved_rate"], "deadline_misses": int(s.get("deadline_misses")),
             "audio_underruns": self.sink.underruns, "audio_xruns": self.sink.xruns,
-            "audio_frames": self.sink.frames_played, "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
+            "audio_limited": self.sink.limited, "audio_frames": self.sink.frames_played, "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
             "midi_overflows": self.midi.overflows if self.midi else 0,
             "command_latency_max": float(s.get("command_latency_max")),
             "load_mean": t["load_mean"], "load_p99": t["load_p99"], "load_max": t["load_max"], "realtime": self.realtime,

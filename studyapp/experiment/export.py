@@ -28,10 +28,11 @@ order_row, simulated``.
 - Pages (task ``page``) are not responses of the study: their
   acknowledgements stay in events.jsonl and make no row.
 - ``time`` is the ISO-8601 wall time of the response (the confirm).
-- ``deadline_misses``, ``underruns``, ``faults``, ``events_dropped``: what the
-  real-time engine counted while the trial ran (the session's ``trial_health``
-  records of its step, summed over its attempts); empty for a session without
-  a real-time engine (``studyapp run``).
+- ``deadline_misses``, ``underruns``, ``faults``, ``events_dropped``,
+  ``limited``: what the real-time engine counted while the trial ran (the
+  session's ``trial_health`` records of its step, summed over its attempts;
+  ``limited``: the output samples the limiter bent, 0 for logs made before it
+  was counted); empty for a session without a real-time engine (``studyapp run``).
 
 - ``simulated``: True when the simulated participant gave the response: the
   response's own ``simulated`` (every response logged since issue 31 says who
@@ -68,7 +69,7 @@ from studyapp.experiment.session_description import read_description
 from studyapp.experiment.session_files import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import TASK_TYPES, task_type
-from studyapp.experiment.trial_health import HEALTH_COLUMNS
+from studyapp.experiment.trial_health import ADDED, HEALTH_COLUMNS
 from studyapp.io.atomic import atomic_open
 
 SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
@@ -142,7 +143,7 @@ def _trial_health(events):
             continue
         counts = health.setdefault(event.get("step"), dict.fromkeys(HEALTH_COLUMNS, 0))
         for column in HEALTH_COLUMNS:
-            value = event.get(column)
+            value = event.get(column, 0 if column in ADDED else None)
             if not isinstance(value, int) or isinstance(value, bool) or value < 0:
                 seq = event.get("seq", "?")
                 raise InputDataError(f"trial_health event seq {seq}: {column} = {value!r}: "

@@ -169,10 +169,12 @@ def knob_latency(controls: int, midi: int, median: float, largest: float) -> dic
     return {"type": "knob_latency", "controls": controls, "midi": midi, "median": median, "max": largest}
 
 
-def trial_health(trial: int, deadline_misses: int, underruns: int, faults: int, events_dropped: int) -> dict:
-    """The engine's fault counters while a trial ran (``underruns``: the audio underruns)."""
+def trial_health(trial: int, deadline_misses: int, underruns: int, faults: int, events_dropped: int,
+                 limited: int) -> dict:
+    """The engine's fault counters while a trial ran (``underruns``: the audio underruns; ``limited``: the
+    output samples the limiter bent)."""
     return {"type": "trial_health", "trial": trial, "deadline_misses": deadline_misses, "underruns": underruns,
-            "faults": faults, "events_dropped": events_dropped}
+            "faults": faults, "events_dropped": events_dropped, "limited": limited}
 
 
 # checks of a logged field ------------------------------------------------------------------------------

@@ -186,11 +186,12 @@ class SessionRunner:
     def tick(self, dt, heard=None):
         return self._handle(self.task.tick(dt, self.bowing if heard is None else heard))
 
-    def acknowledge_page(self, by):
-        """The current page acknowledged ``by`` the participant or the experimenter ([] on a trial)."""
+    def acknowledge_page(self, by, volume_db=0.0):
+        """The current page acknowledged ``by`` the participant or the experimenter ([] on a trial), at the
+        master volume ``volume_db`` (dB; a level check records it)."""
         if not hasattr(self.task, "acknowledge"):
             return []
-        return self._handle(self.task.acknowledge(by))
+        return self._handle(self.task.acknowledge(by, volume_db))
 
     def set_bowing(self, on):
         on = bool(on)

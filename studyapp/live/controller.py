@@ -267,7 +267,7 @@ class SessionController:
         if self.playing and runner.trial is not None and runner.trial.page is not None:
             if by == "participant" and self.controls.settling("continue"):
                 return
-            self.take_records(runner.acknowledge_page(by))
+            self.take_records(runner.acknowledge_page(by, volume_db=self.sound.db))
 
     def set_bowing(self, on):
         self.hand.set_bowing(on)

@@ -4,9 +4,9 @@
 closed loop in-process (``SessionRunner``), with no device and not in real
 time. ``ArchivingRunner`` is that runner with the loop's audio rendered and
 passed, block by block, through the live engine's signal chain
-(engine/signal_chain.py: silence while the bow is lifted, fades at every
-start, stop and cut, the resampler, volume, the level check's reference tone,
-the limiter) into the live engine's recorder (engine/audio/recorder.py). So
+(engine/signal_chain.py: the stimulus gain, silence while the bow is lifted,
+fades at every start, stop and cut, the resampler, the level check's
+reference tone, the volume, the limiter) into the live engine's recorder (engine/audio/recorder.py). So
 the file holds what a participant would have heard, and the checks made on
 it hold for a live session too.
 

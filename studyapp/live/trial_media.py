@@ -16,9 +16,10 @@ The reference tone. A calibration page (the headphone level check) sends
 stopped, or the session ended).
 
 Trial health. The engine's counters (``deadline_misses``, ``audio_underruns``,
-``faults``, ``events_dropped``) are read when a step starts and when it ends
+``faults``, ``events_dropped``, ``audio_limited``) are read when a step starts and when it ends
 (its response, the session's end, or its engine lost); their differences are
-logged as a ``trial_health`` record (``underruns`` for the audio underruns),
+logged as a ``trial_health`` record (``underruns`` for the audio underruns,
+``limited`` for the output samples the limiter bent),
 which export carries as columns.
 """
 

@@ -10,8 +10,20 @@ handle along it.
   covers v t_r / 2, so a stroke of length L cruises for (L - v t_r) / v.
 - ``Playback``: a recorded trajectory (m), played at the loop rate; the last
   sample is held.
-- ``Live``: a target set from outside (the GUI's mouse) at block boundaries;
-  inside a block the target moves linearly from the old to the new value.
+- ``Live``: a target set from outside (the GUI's mouse) at block boundaries,
+  followed by a critically damped second-order glide (corner LIVE_HZ):
+
+      x'' = w^2 (target - x) - 2 w x',   w = 2 pi LIVE_HZ,
+
+  solved exactly over each block for the target held constant,
+  e = x - target, e(t) = (e0 + (v0 + w e0) t) exp(-w t). A pointer moves in
+  steps, one per mouse event (60-125 a second): followed a block at a time,
+  each step was a 2 ms velocity pulse, and the pulses' harmonics filled the
+  stability monitor's 50-400 Hz band and the contact microphone's sound at
+  F_max 0 ("broken" with no friction, a buzz that was the mouse's: issue 31).
+  A bowing hand's motion lies below about 10 Hz (strokes of 0.5 to 3 Hz), so
+  the glide keeps the gesture (a lag of 2 / w, 32 ms) and takes the steps out
+  (-12 dB per octave above LIVE_HZ: -31 dB at 60 Hz).
 - ``Hold``: the handle held at 0 (the hand at rest), with physiological tremor.
 
 Stroke amplitudes and speeds are in calibration.py with their reasons.
@@ -24,6 +36,8 @@ import numpy as np
 from numba import njit
 
 from studyapp.errors import ParameterError
+
+LIVE_HZ = 10.0  # the live gesture's glide: corner frequency (Hz)
 
 
 @njit(cache=True)
@@ -118,18 +132,24 @@ class Playback:
 
 
 class Live:
-    """A target set at block boundaries; moves linearly to it across the next block."""
+    """A target set at block boundaries, followed by a critically damped glide (see the module docstring)."""
 
-    def __init__(self, position=0.0):
+    def __init__(self, position=0.0, hz=None):
         self.current = float(position)
+        self.velocity = 0.0
         self.target = float(position)
+        self.w = 2.0 * math.pi * (LIVE_HZ if hz is None else float(hz))
 
     def set(self, x):
         self.target = float(x)
 
     def block(self, start, n, rate):
-        frac = np.arange(1, n + 1) / n
-        pos = self.current + (self.target - self.current) * frac
-        vel = np.full(n, (self.target - self.current) * rate / n)
-        self.current = self.target
-        return pos, vel, np.zeros(n)
+        w, e0, v0 = self.w, self.current - self.target, self.velocity
+        t = np.arange(1, n + 1) / rate
+        decay = np.exp(-w * t)
+        c = v0 + w * e0
+        pos = self.target + (e0 + c * t) * decay
+        vel = (v0 - w * c * t) * decay
+        acc = (w * w * c * t - 2.0 * w * v0 - w * w * e0) * decay
+        self.current, self.velocity = float(pos[-1]), float(vel[-1])
+        return pos, vel, acc

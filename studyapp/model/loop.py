@@ -210,12 +210,18 @@ class ClosedLoop:
     def set_fmax(self, fmax):
         self.fmax = check_fmax(fmax)
         self._ctl[C_GAIN] = self.fmax / self.string.peak_friction()
+        self._engage()
 
     def set_force_scale(self, g):
         g = float(g)
         if not np.isfinite(g):
             raise ParameterError(f"force scale = {g!r}: allowed is a number from 0 to 1")
         self._ctl[C_FORCE_SCALE] = min(max(g, 0.0), 1.0)
+        self._engage()
+
+    def _engage(self):
+        """The monitor judges only a loop with friction: at F_max 0 (or no force) it cannot break (stability.py)."""
+        self.monitor.engaged = self.fmax * self._ctl[C_FORCE_SCALE] > 0.0
 
     def set_bowing(self, on):
         self._ctl[C_BOWING] = 1.0 if on else 0.0

@@ -43,6 +43,24 @@ random envelope (cv 0.2-0.35, Rayleigh-like). VIBRATION_MIN therefore scales
 with the moving mass: IMPULSE / m, 1 mm/s for 1 kg (the rigid handle it was set
 for), 10 mm/s for the 0.1 kg end-effector. The verdict lags an onset by a few
 tenths of a second (cv must fall).
+
+No friction, no breakdown. With F_max = 0 (or the force ramped to 0) the loop
+feeds nothing back to the handle: whatever it does is the hand's own motion,
+and it cannot be unstable. So ``engaged`` (the loop sets it: F_max x force
+scale > 0) False means not broken, whatever the band holds: a pointer's jerky
+bowing fills the band at F_max 0 (its target jumps at each mouse event, tens
+of times a second) and was called "broken" there (issue 31).
+
+Hysteresis. A verdict changes only when the evidence is clear, so a level
+hovering at the threshold does not flip it back and forth within a trial:
+broken is entered at the thresholds above and left only below lower ones,
+
+    bowing:   enter  band > RISE x reference,          leave  band < RELEASE x reference,  RELEASE = sqrt(2) (3 dB)
+    holding:  enter  level > VIBRATION_MIN, cv < CV_MAX,  leave  level < VIBRATION_MIN or cv > CV_RELEASE = 0.25
+
+A breakdown's onset is judged exactly as before (``studyapp breakdown`` and
+the simulated participant stop at the first "broken"); only the return to
+"stable" comes later, once the level has fallen 3 dB below the onset's.
 """
 
 import math
@@ -64,6 +82,8 @@ HIGHPASS_FRACTION = 0.5  # of f0
 IMPULSE = 1e-3  # kg m/s: VIBRATION_MIN times the mass that moves at audio rates
 VIBRATION_MIN = IMPULSE / calibration.DEVICE_MASS  # m/s
 CV_MAX = 0.15
+RELEASE = math.sqrt(2.0)  # bowing: a broken verdict holds until the band falls below this x TRUE's (3 dB)
+CV_RELEASE = 0.25  # holding: ... until the envelope's cv rises above this (or the level falls below VIBRATION_MIN)
 
 # parameter vector: high-pass section (5), long and short smoothing factors, band sections (2 x 5), band smoothing
 MP_HP, MP_LONG, MP_SHORT, MP_BAND, MP_BAND_LONG = 0, 5, 6, 7, 17
@@ -142,6 +162,7 @@ class StabilityMonitor:
         self.params[MP_BAND_LONG] = 1.0 - np.exp(-1.0 / (BOW_WINDOW * rate))
         self.state = np.zeros(N_STATE)
         self.reference = reference
+        self.engaged = True  # friction on: F_max x force scale > 0 (the loop sets it)
         self.reset()
 
     def reset(self):
@@ -160,10 +181,15 @@ class StabilityMonitor:
         """Update ``level``, ``cv``, ``band`` and ``broken`` from the state (the loop calls this after each block)."""
         self.level, self.cv = verdict(self.state)
         self.band = math.sqrt(max(self.state[MS_BAND_MS], 0.0))
-        if self.reference is None:
-            self.broken = bool(self.level > VIBRATION_MIN and self.cv < CV_MAX)
+        if not self.engaged:
+            self.broken = False
+        elif self.reference is None:
+            enter = self.level > VIBRATION_MIN and self.cv < CV_MAX
+            leave = self.level < VIBRATION_MIN or self.cv > CV_RELEASE
+            self.broken = bool(enter or (self.broken and not leave))
         else:
-            self.broken = bool(self.band > RISE * self.reference())
+            reference = self.reference()
+            self.broken = bool(self.band > RISE * reference or (self.broken and self.band >= RELEASE * reference))
         return self.broken
 
     def measure(self, velocity):

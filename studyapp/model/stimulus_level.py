@@ -18,6 +18,27 @@ tests/engine check it against the signal chain's output).
 
 A sine's RMS is its peak / sqrt(2), so a tone of that RMS has its peak
 3.01 dB higher (``tone_peak_dbfs``).
+
+The stimulus gain. The loop's audio is in its own unit (the body filter's
+output, model/body.py, plus the handle's buzz, model/contact_mic.py); the
+signal chain (engine/signal_chain.py) scales it by one fixed gain G before
+anything else, so that the stimulus stays linear, under the output
+limiter's knee (-18 dBFS), over every F_max a protocol's knob reaches below
+1.25 x LVT's bowing breakdown (8.29 N, ``studyapp breakdown --source LVT``,
+docs/breakdown.md: 10.4 N). The string gets louder with F_max: bowed with
+the strokes, its peaks rise from about -11 dB (re the audio's unit) at 1 N to
+at most LOUDEST_DB = +11 dB up to 10.4 N for any of sinclair2014's nine
+conditions (seed 0: +6.9 to +10.8 dB at 10.4 N; a knob sweep reaches +11.8 dB
+over 10.4-12 N); so
+
+    G = KNEE - HEADROOM_DB - LOUDEST_DB = -18 - 4 - 11 = -33 dB,
+
+4 dB of headroom under the knee at 1.25 x LVT's breakdown, and the rating
+task's 1 N about -55 dBFS RMS, -44 dBFS peak. Above that F_max (broken loops
+buzzing at +-F_max) the limiter bends what passes the knee, and counts it.
+The volume (-40 to 0 dB) only attenuates: the listener sets the headphones'
+comfort with the level check, heard at this gain (``typical_rms_dbfs``
+includes it). docs/engine.md ("Levels") has the figures.
 """
 
 import math
@@ -31,6 +52,13 @@ WINDOW_S = 0.1  # short-term RMS window
 SETTLE_S = 1.0  # the start of bowing left out (the string building up)
 SECONDS = 6.0  # bowed per condition (several strokes)
 SINE_CREST_DB = 20.0 * math.log10(math.sqrt(2.0))  # 3.01 dB: a sine's peak over its RMS
+LVT_BREAKDOWN_N = 8.29  # LVT's bowing breakdown (N, median of 5 seeds; docs/breakdown.md, 2026-11-25)
+LINEAR_UP_TO_N = 1.25 * LVT_BREAKDOWN_N  # 10.4 N: the stimulus is linear (under the knee) up to here
+LOUDEST_DB = 11.0  # the loudest bowed peak up to 1.25 x LVT's breakdown, dB re the audio's unit (above)
+HEADROOM_DB = 4.0  # under the limiter's knee there
+KNEE_DBFS = -18.0  # the output limiter's knee: the stimulus stays under it (engine/signal_chain.py's limiter)
+STIMULUS_GAIN_DB = KNEE_DBFS - HEADROOM_DB - LOUDEST_DB  # -33 dB: the loop's audio -> the output (above)
+STIMULUS_GAIN = 10.0 ** (STIMULUS_GAIN_DB / 20.0)
 
 
 def short_term_rms_dbfs(audio, rate, window_s=WINDOW_S):
@@ -53,7 +81,7 @@ def _typical(rate, gesture, fmax, conditions, seed, seconds):
         loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=name, fmax=fmax,
                                      gesture=gesture, seed=seed, audio=True))
         audio = loop.run(int(round(seconds * rate)))["audio"][int(round(SETTLE_S * rate)):]
-        levels.append(short_term_rms_dbfs(audio, rate))
+        levels.append(short_term_rms_dbfs(STIMULUS_GAIN * audio, rate))
     return float(np.median(levels))
 
 

@@ -1,5 +1,6 @@
 """The headphone check's reference tone: a sine of the asked frequency and peak level in place of the string,
-phase-continuous across blocks, ramped on and off, not scaled by the volume knob; checked against closed forms."""
+phase-continuous across blocks, ramped on and off, scaled by the volume in force like the string; checked
+against closed forms."""
 
 import time
 
@@ -82,7 +83,7 @@ def test_the_null_sink_refuses_the_tone_and_the_worker_says_so():
         worker.status.close()
 
 
-def test_the_wav_sink_replaces_the_string_and_ignores_the_volume_knob(tmp_path):
+def test_the_wav_sink_replaces_the_string_and_plays_the_tone_at_the_volume_in_force(tmp_path):
     path = tmp_path / "tone.wav"
     sink = open_sink(f"wav:{path}", 5000.0)
     sink.set_volume(0.25)
@@ -93,7 +94,7 @@ def test_the_wav_sink_replaces_the_string_and_ignores_the_volume_knob(tmp_path):
     sink.close()
     fs, pcm = wavfile.read(path)
     steady = pcm[int(0.1 * fs):int(1.9 * fs)] / 32767.0
-    assert np.max(np.abs(steady)) == pytest.approx(10 ** (-20 / 20), abs=2e-4)  # the level asked, not x 0.25
+    assert np.max(np.abs(steady)) == pytest.approx(0.25 * 10 ** (-20 / 20), abs=2e-4)  # the level asked, x 0.25
     spectrum = np.abs(np.fft.rfft(steady * np.hanning(steady.size)))
     freqs = np.fft.rfftfreq(steady.size, 1 / fs)
     assert spectrum[np.argmin(np.abs(freqs - 196.0))] < 1e-4 * spectrum.max()  # the string is gone
@@ -119,12 +120,12 @@ def test_the_engine_plays_the_tone_at_the_asked_frequency_and_level(tmp_path):
     x = pcm / 32767.0
     # the tone's middle second: after its ramp, before it was turned off
     envelope = np.convolve(np.abs(x), np.ones(480) / 480, mode="same")
-    on = np.abs(envelope - 0.1 * 2 / np.pi) < 0.002  # a sine's mean |x| is 2/pi of its peak
+    on = np.abs(envelope - 0.3 * 0.1 * 2 / np.pi) < 0.0006  # a sine's mean |x| is 2/pi of its peak (x the volume)
     edges = np.flatnonzero(np.diff(np.concatenate([[0], on.astype(int), [0]])))
     starts, ends = edges[::2], edges[1::2]
     longest = np.argmax(ends - starts)
     assert ends[longest] - starts[longest] > 0.8 * fs
     middle = x[starts[longest] + 2400:ends[longest] - 2400]
     peak_db = 20 * np.log10(np.max(np.abs(middle)))
-    assert peak_db == pytest.approx(-20.0, abs=0.1)
+    assert peak_db == pytest.approx(-20.0 + 20 * np.log10(0.3), abs=0.1)  # the level asked, at the volume in force
     assert _peak_hz(middle, fs) == pytest.approx(440.0, abs=1.0)

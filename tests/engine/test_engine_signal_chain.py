@@ -10,7 +10,7 @@ from scipy.signal import resample_poly
 
 from studyapp.engine.signal_chain import CEILING, CEILING_DBFS, FADE_S, KNEE_DB, Gate, SignalChain, soft_limit
 from studyapp.model.loop import ClosedLoop, LoopConfig
-from studyapp.model.stimulus_level import short_term_rms_dbfs, typical_rms_dbfs
+from studyapp.model.stimulus_level import STIMULUS_GAIN, short_term_rms_dbfs, typical_rms_dbfs
 
 RATE = 5000.0
 FS = 48000.0
@@ -71,12 +71,12 @@ def test_the_chain_is_the_faded_stream_resampled_gained_and_limited():
     window = np.ones(x.size)
     window[:F] = _rise(F)
     window[-F:] = _rise(F)[::-1]
-    expected = 2.0 * resample_poly(np.concatenate([np.zeros(F), x * window]), 48, 5)
+    expected = 2.0 * STIMULUS_GAIN * resample_poly(np.concatenate([np.zeros(F), x * window]), 48, 5)
     np.testing.assert_allclose(out, expected, atol=1e-12)
 
 
 def test_a_block_is_heard_at_the_frame_the_chain_names():
-    chain = SignalChain(RATE, FS)
+    chain = SignalChain(RATE, FS, gain=1.0)
     out = [chain.process(np.zeros(10), False) for _ in range(20)]
     at = chain.next_frame()
     out += [chain.process(np.full(10, 0.1), True) for _ in range(20)]

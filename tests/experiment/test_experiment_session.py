@@ -199,18 +199,19 @@ def test_export_carries_each_trials_engine_health_and_leaves_it_empty_headless(t
     run_simulated(session).finish()
     counts = {"deadline_misses": 2, "underruns": 1, "faults": 0, "events_dropped": 4}
     for step, scale in ((0, 1), (3, 1), (3, 2)):  # step 3 ran twice (an engine lost): both attempts count
+        limited = {} if step == 0 else {"limited": 7 * scale}  # step 0's record as logged before it was counted
         session.log.append({"type": "trial_health", "step": step, "task": "x", "trial": 1,
-                            **{k: scale * v for k, v in counts.items()}})
+                            **{k: scale * v for k, v in counts.items()}, **limited})
     session.close()
     headless = Session.create(protocol, "H02", tmp_path, seed=2)
     run_simulated(headless).finish()
     headless.close()
     frame = export_responses(tmp_path)
-    columns = ["deadline_misses", "underruns", "faults", "events_dropped"]
-    assert columns == COLUMNS[COLUMNS.index("deadline_misses"):][:4]
+    columns = ["deadline_misses", "underruns", "faults", "events_dropped", "limited"]
+    assert columns == COLUMNS[COLUMNS.index("deadline_misses"):][:5]
     logged = frame[frame.participant == "H01"].set_index(["step", "knob"])[columns]
-    assert logged.loc[0].to_numpy().tolist() == [[2, 1, 0, 4]] * 3  # the rating: one row per condition
-    assert logged.loc[3].to_numpy().tolist() == [[6, 3, 0, 12]]
+    assert logged.loc[0].to_numpy().tolist() == [[2, 1, 0, 4, 0]] * 3  # the rating: one row per condition
+    assert logged.loc[3].to_numpy().tolist() == [[6, 3, 0, 12, 21]]
     assert logged.drop(index=[0, 3], level="step").isna().all().all()
     assert frame.loc[frame.participant == "H02", columns].isna().all().all()
     save_responses(export_responses(tmp_path), tmp_path, tmp_path / "r.csv")

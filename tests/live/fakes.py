@@ -52,7 +52,8 @@ class FakeEngine:
         self.fmax = 0.0
         self.samples = 0
         self.broken = 0.0
-        self.counters = {"deadline_misses": 0, "audio_underruns": 0, "faults": 0, "events_dropped": 0}
+        self.counters = {"deadline_misses": 0, "audio_underruns": 0, "faults": 0, "events_dropped": 0,
+                         "audio_limited": 0}
         self._controls = []
 
     def send(self, command):

@@ -129,7 +129,7 @@ def scripted_session(tmp_path):
     c.host.play(0.05)
     c.poll()
     engine.latched, engine.broken = False, 0.0
-    engine.counters.update(deadline_misses=2, audio_underruns=1)
+    engine.counters.update(deadline_misses=2, audio_underruns=1, audio_limited=3)
     c.emergency_stop()
     c.host.engine.latched = True
     c.clear_emergency()

@@ -384,21 +384,21 @@ def test_each_trial_logs_the_engine_faults_counted_while_it_ran(controller):
     c = controller
     start(c)
     engine = c.host.engine
-    engine.counters.update(deadline_misses=5, audio_underruns=1, faults=0, events_dropped=7)  # before the trial
+    engine.counters.update(deadline_misses=5, audio_underruns=1, faults=0, events_dropped=7, audio_limited=4)  # before
     up(c)
     c.knob(0, 100)
     c.knob(1, 20)
-    engine.counters.update(deadline_misses=8, audio_underruns=3, events_dropped=7)
+    engine.counters.update(deadline_misses=8, audio_underruns=3, events_dropped=7, audio_limited=10)
     c.pad(0)
     c.poll()
-    engine.counters.update(deadline_misses=9, faults=1, events_dropped=10)
+    engine.counters.update(deadline_misses=9, faults=1, events_dropped=10, audio_limited=12)
     c.abort()
     health = [e for e in log(c) if e["type"] == "trial_health"]
     assert health == [
         {"step": 0, "task": "rating", "type": "trial_health", "trial": 1,
-         "deadline_misses": 3, "underruns": 2, "faults": 0, "events_dropped": 0},
+         "deadline_misses": 3, "underruns": 2, "faults": 0, "events_dropped": 0, "limited": 6},
         {"step": 1, "task": "adjustment", "type": "trial_health", "trial": 1,
-         "deadline_misses": 1, "underruns": 0, "faults": 1, "events_dropped": 3},
+         "deadline_misses": 1, "underruns": 0, "faults": 1, "events_dropped": 3, "limited": 2},
     ]
 
 

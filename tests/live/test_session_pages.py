@@ -121,11 +121,13 @@ def test_the_level_check_plays_its_tone_until_the_experimenter_confirms_it(c):
     assert page(c) == "calibration"
     assert c.seen["refused"] == [{"reason": "the experimenter confirms this page"}] * 2
     assert "confirm refused: the experimenter confirms this page" in [m["text"] for m in c.seen["message"]]
+    c.set_volume(-10.0)  # the experimenter turns the headphones down during the check
     c.acknowledge_page("experimenter")
     assert tones(engine) == [cmd.ReferenceTone(440.0, -20.0), cmd.ReferenceTone(level_dbfs=None)]
     assert page(c) == "instructions"
     (confirmed,) = [e for e in log(c) if e["type"] == "response" and e["kind"] == "calibration"]
     assert (confirmed["by"], confirmed["tone_hz"], confirmed["level_dbfs"]) == ("experimenter", 440.0, -20.0)
+    assert confirmed["volume_db"] == -10.0  # the record keeps both: the tone's level and the volume in force
 
 
 def test_the_tone_stops_on_pause_and_at_an_abort_and_resume_skips_acknowledged_pages(c):

@@ -19,7 +19,13 @@ silence once the writer catches up, so the file's timeline stays the engine's.
 
 Besides the steps' ``start`` and ``end`` the cues mark where the bow was put
 on the string and lifted (``bow_on``, ``bow_off``: the output is silent from
-a ``bow_off`` on, signal_chain.py) and every ``underrun``.
+a ``bow_off`` on, signal_chain.py) and every ``underrun``. Each row's
+``limited`` is the number of the file's samples the output limiter bent
+between the row before it (or the file's start) and this row: the samples
+above the limiter's knee (signal_chain.KNEE; a bent sample is always above
+it, an untouched one never), so a step's count is the sum of its rows after
+its ``start`` up to its ``end``. A cue that arrives for audio written before
+the last write (rare: cues name a position ahead) counts up to that write's start.
 
 Files are never overwritten (``free_names.claim``): ``audio.wav`` is reserved with an
 exclusive create, else ``audio-2.wav``, ``audio-3.wav``, ...: one file per
@@ -49,11 +55,12 @@ import threading
 import numpy as np
 
 from studyapp.engine.audio.wav import open_wav, pcm16
+from studyapp.engine.signal_chain import KNEE
 from studyapp.io.free_names import claim, create
 
 QUEUE_SECONDS = 10.0  # of audio the writer may fall behind before blocks are dropped
 CUES_FILE = "audio_cues.csv"
-CUE_COLUMNS = ("file", "sample", "seconds", "step", "task", "trial", "event")
+CUE_COLUMNS = ("file", "sample", "seconds", "step", "task", "trial", "event", "limited")
 
 
 class AudioRecorder:
@@ -76,6 +83,8 @@ class AudioRecorder:
         self._pending = []  # the writer's cues waiting for the audio at their position
         self._where = None  # the writer's last (file frame, stream position) pair
         self._context = {"step": "", "task": "", "trial": ""}  # the last cue's trial, for underrun rows
+        self._above = (0, 0, np.zeros(0, dtype=np.int64))  # the writer's (frame, count before it, running count)
+        self._counted = 0  # samples above the knee up to the last row
         self._thread = threading.Thread(target=self._run, name="studyapp-audio-recorder", daemon=True)
         self._thread.start()
 
@@ -140,6 +149,7 @@ class AudioRecorder:
                 elif item[0] == "audio":
                     _, frame, start, got, underflow, samples = item
                     chunks.append(bytes(2 * (frame - written)) + pcm16(samples))  # dropped frames: silence
+                    self._count_above(frame, samples)
                     written = frame + samples.shape[0]
                     self._taken += samples.shape[0]
                     self._where = (frame, start, start + got)
@@ -175,8 +185,23 @@ class AudioRecorder:
             rows.append(self._row(max(frame + at - start, 0), fields))
         return rows
 
+    def _count_above(self, frame, samples):
+        """Note the samples above the knee in the write at ``frame`` (its running count, for the rows within it)."""
+        start, before, running = self._above
+        total = before + (int(running[-1]) if running.size else 0)
+        self._above = (frame, total, np.cumsum(np.abs(samples) > KNEE))
+
+    def _above_before(self, sample):
+        """Samples above the knee in the file before frame ``sample`` (as far as the writes so far tell)."""
+        start, before, running = self._above
+        k = min(max(sample - start, 0), running.size)
+        return before + (int(running[k - 1]) if k else 0)
+
     def _row(self, sample, fields):
-        return {"file": self.path.name, "sample": sample, "seconds": f"{sample / self.rate:.6f}", **fields}
+        upto = self._above_before(sample)
+        limited, self._counted = max(upto - self._counted, 0), max(upto, self._counted)
+        return {"file": self.path.name, "sample": sample, "seconds": f"{sample / self.rate:.6f}", **fields,
+                "limited": limited}
 
     def _append_cue(self, row):
         new = not self.cues_path.exists() or self.cues_path.stat().st_size == 0

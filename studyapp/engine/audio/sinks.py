@@ -1,10 +1,10 @@
 """Audio sinks for the string's sound: a PortAudio device, a WAV file, or nothing.
 
 The closed loop renders audio at the haptic rate; a sink passes it through
-the signal chain (``signal_chain.SignalChain``: silence while the bow is
-lifted and fades at every start, stop and cut, the resampler to the sink's
-rate, volume and mute, the headphone check's reference tone, and a soft
-limiter under ``CEILING_DBFS``), and plays or stores it. The session's
+the signal chain (``signal_chain.SignalChain``: the fixed stimulus gain,
+silence while the bow is lifted and fades at every start, stop and cut, the
+resampler to the sink's rate, the headphone check's reference tone, volume
+and mute, and a soft limiter under ``CEILING_DBFS`` that counts what it bends), and plays or stores it. The session's
 recorder (``recorder.AudioRecorder``), if one is attached, gets what reached
 the device: a device sink tees it in its callback (``DeviceSink.play``), gaps
 included (an underrun is silence in the file, and marked in audio_cues.csv),
@@ -108,6 +108,11 @@ class Sink:
     @property
     def description(self):
         return "null"
+
+    @property
+    def limited(self):
+        """Output samples the limiter bent so far (signal_chain.py); none without a chain."""
+        return self.chain.limited if self.chain else 0
 
     def start(self):
         pass

@@ -12,7 +12,9 @@ A page is done when it is acknowledged: by the participant with its ``pad``
 (``calibration``) is the experimenter's alone: a participant's press is
 logged and refused. The acknowledgement is logged as a ``response`` of task
 ``page`` (``kind``, ``title``, ``by``, and for a calibration page
-``tone_hz`` and ``level_dbfs``), so a resumed session never shows an
+``tone_hz``, ``level_dbfs`` and ``volume_db``: the tone's level before the
+volume, and the volume in force when the level was confirmed, so the level
+heard is their sum), so a resumed session never shows an
 acknowledged page again; how long it was read is the time between its
 ``trial_start`` and this record. It is not a response row: ``export_rows`` is empty
 and ``measure`` None (the log keeps when each page was acknowledged).
@@ -59,8 +61,9 @@ class PageTrial:
             return [{**record, "accepted": False, "reason": REFUSED}]
         return [{**record, "accepted": True}, self._acknowledged("participant")]
 
-    def acknowledge(self, by):
-        """The participant's Continue button or the experimenter's confirm; returns the records to log."""
+    def acknowledge(self, by, volume_db=0.0):
+        """The participant's Continue button or the experimenter's confirm, at the master volume ``volume_db``
+        (dB, the console's; 0 without one); returns the records to log."""
         if by not in WHO:
             raise ValueError(f"by = {by!r}: allowed is one of {', '.join(WHO)}")
         if self.done:
@@ -68,13 +71,13 @@ class PageTrial:
         record = records.acknowledge(by)
         if by == "participant" and self.page.by != "participant":
             return [{**record, "accepted": False, "reason": REFUSED}]
-        return [{**record, "accepted": True}, self._acknowledged(by)]
+        return [{**record, "accepted": True}, self._acknowledged(by, volume_db)]
 
-    def _acknowledged(self, by):
+    def _acknowledged(self, by, volume_db=0.0):
         p = self.page
         self.response = records.response(self.task, trial=self.trial, fmax=0.0, kind=p.kind, title=p.title, by=by)
         if p.kind == "calibration":
-            self.response.update(tone_hz=p.tone_hz, level_dbfs=p.level_dbfs)
+            self.response.update(tone_hz=p.tone_hz, level_dbfs=p.level_dbfs, volume_db=float(volume_db))
         return self.response
 
     def tick(self, dt, bowing=False):
