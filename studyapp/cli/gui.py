@@ -75,10 +75,12 @@ def run(args):
     check_experimenter(args.experimenter)
     check_session_number(args.session_number)
     check_notes(args.notes)
+    protocol = None
     if args.protocol:  # a bad protocol (a FIFO, a device, a bad field) is one line before any window opens
         from studyapp.experiment.protocol import load_protocol
 
-        load_protocol(args.protocol)
+        protocol = load_protocol(args.protocol)
+    _check_before_the_console(args, protocol)
     require_display()
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")
@@ -97,3 +99,25 @@ def run(args):
     except ImportError as exc:
         raise UserError(f"the GUI cannot start: {exc} (install PySide6-Essentials and pyqtgraph)") from None
     return main(args)
+
+
+def _check_before_the_console(args, protocol):
+    """``--results``, ``--audio`` and ``--order-row`` checked before any window opens (issue 33, item 6: the
+    console opened instead, and with ``--screenshot`` never exited)."""
+    from pathlib import Path
+
+    from studyapp.engine.audio.sinks import parse as parse_audio
+    from studyapp.errors import UserError
+    from studyapp.experiment.session_info import check_order_row
+
+    results = Path(args.results)
+    if results.exists() and not results.is_dir():
+        raise UserError(f"--results {args.results}: not a folder: allowed is a results folder (made if missing)")
+    parse_audio(args.audio)
+    if args.order_row is None:
+        return
+    if protocol is not None:
+        check_order_row(protocol, args.order_row)
+    elif not str(args.order_row).strip().isdigit():
+        raise UserError(f"--order-row {args.order_row}: allowed is a whole number from 0 "
+                        "(below the protocol's number of orders)")
