@@ -18,7 +18,8 @@ Every ``POLL`` seconds it
 
 3. looks at its owner, the process that started the engine (the console, ``live``):
    when the owner is stopped (SIGSTOP, Ctrl-Z, a debugger: ``/proc/<pid>/stat``
-   state ``T`` or ``t``) or gone (killed: the guard's parent is no longer it), it
+   state ``T`` or ``t``) or gone (a SIGKILL pending, exiting, or the guard's parent
+   no longer it: a killed process of a few hundred MB takes 50-360 ms to die), it
    clears ``force_enable`` at once (reason "owner"): no force runs on without
    the program that shows and logs it (issue 33, item 4). On main a stopped
    console left the force on for good and a killed one for 151-429 ms.
@@ -43,6 +44,8 @@ POLL = 0.002  # s between rounds
 WATCHED = "running"  # the worker's state in which its heartbeat must keep coming
 DONE = ("stopped", "failed")
 ALIVE, STOPPED, GONE = "alive", "stopped", "gone"  # the owner's states
+PF_EXITING = 0x4  # /proc/<pid>/stat field 9 (flags): the process has begun to exit
+SIGKILL_BIT = 1 << (signal.SIGKILL - 1)  # /proc/<pid>/stat field 31: its pending signals
 
 
 def main(status_name, hang_timeout, priority=None):
@@ -79,8 +82,11 @@ class Owner:
             data = os.pread(self._stat, 512, 0)
         except OSError:
             return GONE
-        end = data.rfind(b")")  # the state follows the command name, which may hold anything
-        return STOPPED if data[end + 2: end + 3] in (b"T", b"t") else ALIVE
+        fields = data[data.rfind(b")") + 2:].split()  # after the command name, which may hold anything
+        state, flags, pending = fields[0], int(fields[6]), int(fields[28])
+        if state in (b"Z", b"X") or flags & PF_EXITING or pending & SIGKILL_BIT:
+            return GONE  # killed: dying takes a big process 50-360 ms before its children see it gone
+        return STOPPED if state in (b"T", b"t") else ALIVE
 
     def close(self):
         if self._stat is not None:
