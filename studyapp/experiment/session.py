@@ -291,7 +291,8 @@ class Session:
         try:
             folder = session_folders(participant_folder)[-1]
             # the log's own lock before anything is read: a writer that got past a deleted .lock is refused here
-            log_lock = LogLock(folder / EVENTS_FILE)
+            if os.path.lexists(folder / EVENTS_FILE):  # a missing log is created (and locked) only once checked
+                log_lock = LogLock(folder / EVENTS_FILE)
             log = read_log(folder / EVENTS_FILE)
             info, rebuild = read_description(folder, log)
             _check_owner(info, participant, participant_folder, folder)
