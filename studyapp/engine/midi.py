@@ -71,6 +71,7 @@ QUEUE = 2**15  # rtmidi's queue, messages: seconds at 10,000/s, beyond any stall
 RESCAN = 2.0  # s between two looks for a controller plugged in (or out), midi_hotplug.py
 FLUSH = 0.02  # s between two lone F7 to our own port (JACK): a SysEx left open holds messages at most this long
 ENDS_SYSEX = [0xF7]
+FLUSH_PORT = "studyapp SysEx end"  # the output port that sends it
 
 
 def _key(kind, channel, number):
@@ -287,7 +288,9 @@ class MidiInput:
 
 
 def match_port(spec, names):
-    """The port ``spec`` picks among ``names`` ("first": the first one), or ``None``."""
+    """The port ``spec`` picks among ``names`` ("first": the first one), or ``None``; never a ``FLUSH_PORT``
+    (an engine's own output to its own input, not a controller)."""
+    names = [n for n in names if not n.endswith(f":{FLUSH_PORT}")]
     if spec == "first":
         return names[0] if names else None
     return next((n for n in names if spec.lower() in n.lower()), None)
@@ -353,7 +356,7 @@ def _flush_output(rtmidi, api, client):
     if own not in names:
         out.delete()
         return None
-    out.open_port(names.index(own), "flush")
+    out.open_port(names.index(own), FLUSH_PORT)
     return out
 
 

@@ -202,3 +202,10 @@ def test_raw_bytes_resynchronise_after_an_unterminated_or_cut_message():
         [0xF0, 1, 2, 0xF7], [0xC0, 5], [0xB0, 1, 2], [0xB0, 3, 4]]  # a note cut short, running status, junk
     got = coalesce([(held, 1.0, 3)])
     assert [(m.type, m.value) for m, _, _ in got if m.type == "control_change"] == [("control_change", 30)]
+
+
+def test_an_engines_own_sysex_end_port_is_never_taken_for_a_controller():
+    from studyapp.engine.midi import FLUSH_PORT, match_port
+
+    names = [f"studyapp-12:{FLUSH_PORT}", "LPD8:out"]
+    assert match_port("first", names) == "LPD8:out" and match_port("studyapp", names) is None
