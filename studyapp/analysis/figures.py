@@ -73,7 +73,7 @@ def draw_scatter(figure, study):
     ax.grid(True, alpha=0.3)
     _footnote(figure, "points: medians; bars: quartiles; top left is better")
     labels = [
-        ax.annotate(name, (xi, yi), xytext=(5, 4), textcoords="offset points", fontsize=9, va="bottom")
+        ax.annotate(plain(name), (xi, yi), xytext=(5, 4), textcoords="offset points", fontsize=9, va="bottom")
         for name, xi, yi in zip(common, x, y)
     ]
     _place_labels(figure, ax, labels)
@@ -115,7 +115,7 @@ def _draw_box_plot(figure, task, study, ylabel, title):
     names = task.conditions
     data = [task.groups[c] for c in names]
     positions = np.arange(1, len(names) + 1)
-    ax.boxplot(data, positions=positions, widths=0.55, tick_labels=names, showfliers=False,
+    ax.boxplot(data, positions=positions, widths=0.55, tick_labels=[plain(n) for n in names], showfliers=False,
                medianprops={"color": "C3", "linewidth": 1.8})
     jitter = np.random.default_rng(0)
     for x, values in zip(positions, data):
@@ -154,8 +154,14 @@ def letters_footnote(study, task, source):
             f"then Wilcoxon signed-rank,\nHolm-corrected, p < {study.alpha:g})")
 
 
+def plain(text):
+    """``text`` shown as written: a condition named ``$\\frac$`` is not matplotlib's maths (it crashed the
+    report: issue 33, item 6), so every ``$`` is escaped."""
+    return str(text).replace("$", r"\$")
+
+
 def _footnote(figure, text):
-    figure.supxlabel(text, x=0.01, ha="left", fontsize=8, color="0.35")
+    figure.supxlabel(plain(text), x=0.01, ha="left", fontsize=8, color="0.35")
 
 
 # Label positions tried around a point, nearest first: (dx, dy) in points from the point to the

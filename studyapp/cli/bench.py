@@ -42,8 +42,9 @@ def register(sub):
     p = kinds.add_parser("force-cut", help="time from a stopped worker to its force cut, with the parent busy")
     p.add_argument("--tries", type=int, default=20, metavar="N", help="tries per mode (default 20)")
     p.add_argument("--busy", type=float, default=2.0, help="seconds the parent stays busy (default 2)")
-    p.add_argument("--mode", choices=("python", "gil", "both"), default="both",
-                   help="python: a pure-Python loop; gil: one C call holding the interpreter's lock (default both)")
+    p.add_argument("--mode", choices=("python", "gil", "both", "owner-stop", "owner-kill", "owner"), default="both",
+                   help="python: a pure-Python loop; gil: one C call holding the interpreter's lock (default both); "
+                        "owner-stop, owner-kill (owner: both): stop or kill the process that started the engine")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.force_cut_benchmark"))
 

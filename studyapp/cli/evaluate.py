@@ -57,8 +57,8 @@ def run(args):
     delay_option.check_max_lag(args.max_lag)
     output = Path(args.output) if args.output else None
     if output is not None:
-        output_paths.check_folder(output, inputs=[*args.recordings, *(args.params or []),
-                                                         *filter(None, [args.validation])])
+        inputs = [*args.recordings, *(args.params or []), *filter(None, [args.validation])]  # --params: a list
+        output_paths.check_folder(output, inputs=inputs)
     if args.compare_paper and output is None:
         raise UserError("--compare-paper: needs -o DIR, the folder its two tables are written to")
     params_files = args.params or [None]

@@ -77,13 +77,15 @@ def run(args):
     check_experimenter(args.experimenter)
     check_session_number(args.session_number)
     check_notes(args.notes)
+    protocol = None
     if args.protocol:  # a bad protocol (a FIFO, a device, a bad field) is one line before any window opens
         from studyapp.experiment.protocol import load_protocol
 
-        load_protocol(args.protocol)
+        protocol = load_protocol(args.protocol)
     output_paths.check_audio(args.audio, inputs=[args.protocol] if args.protocol else [])
-    if not args.results.strip():  # Path("") would be the working folder; the rest is checked when a session starts
+    if args.results is not None and not args.results.strip():  # Path("") would be the working folder
         raise UserError("--results '': empty: allowed is a results folder")
+    _check_before_the_console(args, protocol)
     require_display()
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")
@@ -102,3 +104,25 @@ def run(args):
     except ImportError as exc:
         raise UserError(f"the GUI cannot start: {exc} (install PySide6-Essentials and pyqtgraph)") from None
     return main(args)
+
+
+def _check_before_the_console(args, protocol):
+    """``--results``, ``--audio`` and ``--order-row`` checked before any window opens (issue 33, item 6: the
+    console opened instead, and with ``--screenshot`` never exited)."""
+    from pathlib import Path
+
+    from studyapp.engine.audio.sinks import parse as parse_audio
+    from studyapp.errors import UserError
+    from studyapp.experiment.session_info import check_order_row
+
+    results = Path(args.results) if args.results is not None else None
+    if results is not None and results.exists() and not results.is_dir():
+        raise UserError(f"--results {args.results}: not a folder: allowed is a results folder (made if missing)")
+    parse_audio(args.audio)
+    if args.order_row is None:
+        return
+    if protocol is not None:
+        check_order_row(protocol, args.order_row)
+    elif not str(args.order_row).strip().isdigit():
+        raise UserError(f"--order-row {args.order_row}: allowed is a whole number from 0 "
+                        "(below the protocol's number of orders)")

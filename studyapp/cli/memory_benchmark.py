@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from studyapp.cli.estimate import BLOCK_MAX
-from studyapp.errors import ParameterError
+from studyapp.errors import ParameterError, UserError
 
 ROWS_MAX = 10**9  # samples per input: ~70 GB of CSV, the most a disk here is asked to hold
 
@@ -89,6 +89,12 @@ def run_cli(args):
         raise ParameterError(f"--rows {args.rows}: allowed is an integer from 1 to {ROWS_MAX}")
     if not 1 <= args.block <= BLOCK_MAX:
         raise ParameterError(f"--block {args.block}: allowed is an integer from 1 to {BLOCK_MAX}")
+    if args.dir is not None:  # it writes and deletes there: never in a session folder (issue 33, item 6)
+        from studyapp.cli import output_paths
+
+        if not Path(args.dir).is_dir():
+            raise UserError(f"--dir {args.dir}: no such folder: allowed is an existing folder")
+        output_paths.check_folder(args.dir, "--dir")
     rate = 5000.0
     results = []
     with tempfile.TemporaryDirectory(prefix="studyapp-bench-memory-", dir=args.dir) as folder:

@@ -75,6 +75,7 @@ def run(args):
     from pathlib import Path
 
     from studyapp.errors import UserError
+    from studyapp.evaluation import checkpoint as checkpoints
     from studyapp.evaluation import params_file
     from studyapp.evaluation.dataset import (
         RawObjectives, RecordingFiles, estimator_names, expand_paths, load_takes, warm_up,
@@ -118,12 +119,17 @@ def run(args):
         if not args.recordings:
             raise UserError("no recordings given: --objective paper needs RECORDING files or directories")
         paths = expand_paths(args.recordings)
+        # the files a folder holds are inputs too: --checkpoint DIR/b.npz overwrote a recording (issue 33)
+        output_paths.check_file(output, inputs=paths)
+        output_paths.check_file(checkpoint, "--checkpoint", inputs=[*paths, output])
         takes = load_takes(paths, args.reference)  # checks every file before any work starts
         rate = min(t.rate for t in takes)
     ranges = parse_ranges(args.range)
     spaces = {name: Space(name, rate, args.tune, ranges=ranges.get(name)) for name in names}
     if args.resume and not checkpoint.is_file():
         raise UserError(f"--resume: no checkpoint at {checkpoint}")
+    if not args.resume:
+        _refuse_an_unfinished_checkpoint(checkpoint)
 
     if perceptual:
         from studyapp.evaluation import perceptual_scores
@@ -175,6 +181,7 @@ def run(args):
         comment="Estimator parameters tuned by studyapp optimise (paper Sec. 6.3; our Table 1).\n"
                 "Use with: studyapp evaluate RECORDINGS... --params " + output.name,
     )
+    checkpoints.write(checkpoint, {**checkpoints.read(checkpoint), "complete": True})
     if not args.quiet:
         print(f"studyapp optimise: wrote {output} ({result.iterations} iterations, "
               f"{result.evaluated} parameter sets, {result.seconds:.1f} s)", file=sys.stderr)
@@ -200,3 +207,21 @@ def parse_ranges(items):
             raise UserError(f"--range {item!r}: expected NAME.PARAM=LOW:HIGH, e.g. FOAW.window=2:128")
         ranges.setdefault(spec(name).name, {})[param] = pair
     return ranges
+
+
+def _refuse_an_unfinished_checkpoint(checkpoint):
+    """A new run (no ``--resume``) writes over a checkpoint only when it is a finished run's: an interrupted
+    run's was overwritten after 30 s (issue 33, item 6)."""
+    from studyapp.errors import UserError
+    from studyapp.evaluation import checkpoint as checkpoints
+
+    if not checkpoint.exists():
+        return
+    try:
+        state = checkpoints.read(checkpoint)
+    except (UserError, OSError):
+        raise UserError(f"--checkpoint {checkpoint}: exists and is not a checkpoint of studyapp optimise: "
+                        "allowed is another --checkpoint file") from None
+    if state.get("complete") is not True:
+        raise UserError(f"--checkpoint {checkpoint}: the checkpoint of an interrupted run: allowed is --resume to "
+                        "continue it, or to remove it (or another --checkpoint) to start anew")

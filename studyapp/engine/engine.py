@@ -34,7 +34,7 @@ import time
 
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
-from studyapp.engine import guard, midi_hotplug
+from studyapp.engine import guard, midi_hotplug, shm_names
 from studyapp.engine.audio.sinks import parse as parse_audio
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.event_ring import EventRing
@@ -107,6 +107,8 @@ class Engine(Watchdog):
 
         c = self.config
         capacity = max(int(c.telemetry_seconds * c.rate), 4 * c.block_size())
+        shm_names.remove_stale()  # what a killed run (its resource tracker killed too) left in /dev/shm
+        shm_names.name_semaphores()
         self.ring = Ring.create(channels_for(self.names), capacity)
         self.status_block = StatusBlock.create()
         ctx = multiprocessing.get_context("spawn")

@@ -23,6 +23,7 @@ from multiprocessing import shared_memory
 import numpy as np
 
 from studyapp.engine.events import Notice
+from studyapp.engine.shm_names import new_name
 
 _HEADER = 3
 SLOTS = 256
@@ -43,7 +44,7 @@ class EventRing:
 
     @classmethod
     def create(cls, slots=SLOTS, slot_size=SLOT_SIZE):
-        shm = shared_memory.SharedMemory(create=True, size=_HEADER * 8 + slots * slot_size)
+        shm = shared_memory.SharedMemory(name=new_name("events"), create=True, size=_HEADER * 8 + slots * slot_size)
         np.ndarray((_HEADER,), dtype=np.int64, buffer=shm.buf)[:] = (0, slots, slot_size)
         return cls(shm, owner=True)
 

@@ -58,6 +58,7 @@ import time
 
 import mido
 
+from studyapp.engine.midi_bytes import split
 from studyapp.engine.native_stderr import captured_native_stderr
 from studyapp.errors import ParameterError
 from studyapp.model.controls import knob_value
@@ -68,6 +69,9 @@ APIS = ("UNIX_JACK", "LINUX_ALSA")
 CONTROL_CHANGE = 0xB0  # status byte's high nibble
 QUEUE = 2**15  # rtmidi's queue, messages: seconds at 10,000/s, beyond any stall the watchdog lets pass
 RESCAN = 2.0  # s between two looks for a controller plugged in (or out), midi_hotplug.py
+FLUSH = 0.02  # s between two lone F7 to our own port (JACK): a SysEx left open holds messages at most this long
+ENDS_SYSEX = [0xF7]
+FLUSH_PORT = "studyapp SysEx end"  # the output port that sends it
 
 
 def _key(kind, channel, number):
@@ -158,11 +162,13 @@ def coalesce(received):
     every other message stay, each one, in order: a press is an event, not a
     level. A flood of control changes then costs the loop at most one action
     per controller per block, and the event ring at most one control event.
-    Messages mido cannot parse are left out.
+    Each raw item is first split into whole messages (``midi_bytes.split``:
+    an unterminated SysEx ends at the next status byte); messages mido cannot
+    parse are left out.
     """
     kept = []
     slot = {}
-    for item in received:
+    for item in ((message, arrived, block) for raw, arrived, block in received for message in split(raw)):
         raw = item[0]
         if raw and raw[0] & 0xF0 == CONTROL_CHANGE and len(raw) > 1:
             key = (raw[0], raw[1])
@@ -216,8 +222,9 @@ class MidiInput:
         self.received = 0
         self.overflows = 0
         self.block = 0
-        self._block_time = self._polled = time.monotonic()
+        self._block_time = self._polled = self._flushed = time.monotonic()
         self._rt = rt
+        self.flush = None  # JACK: an output to our own port that ends a SysEx left open (``FLUSH``)
 
     def new_block(self, k, at):
         """Block ``k`` starts counting at time ``at``: later messages arrived in it."""
@@ -232,8 +239,12 @@ class MidiInput:
             message = get()
             if message is None:
                 break
-            messages.append(message)
+            if message[0] != ENDS_SYSEX:  # our own flush, come back with nothing before it
+                messages.append(message)
         polled, previous = time.monotonic(), self._polled
+        if self.flush is not None and polled - self._flushed >= FLUSH:
+            self._flushed = polled
+            self.flush.send_message(ENDS_SYSEX)  # a ring buffer write: no request to the JACK server
         self._polled = polled
         if not messages:
             return []
@@ -266,6 +277,10 @@ class MidiInput:
         return f"{self.port} ({api})"
 
     def close(self):
+        if self.flush is not None:
+            self.flush.close_port()
+            self.flush.delete()
+            self.flush = None
         if self._rt is not None:
             self._rt.close_port()
             self._rt.delete()
@@ -273,7 +288,9 @@ class MidiInput:
 
 
 def match_port(spec, names):
-    """The port ``spec`` picks among ``names`` ("first": the first one), or ``None``."""
+    """The port ``spec`` picks among ``names`` ("first": the first one), or ``None``; never a ``FLUSH_PORT``
+    (an engine's own output to its own input, not a controller)."""
+    names = [n for n in names if not n.endswith(f":{FLUSH_PORT}")]
     if spec == "first":
         return names[0] if names else None
     return next((n for n in names if spec.lower() in n.lower()), None)
@@ -293,13 +310,15 @@ def _open(spec, api, client):
     rtapi = getattr(rtmidi, f"API_{api}")
     if rtapi not in rtmidi.get_compiled_api():
         raise MidiUnavailable(f"python-rtmidi was built without {api}")
-    # sysex, clock and active sensing stay filtered out
     rt = rtmidi.MidiIn(rtapi=rtapi, name=client, queue_size_limit=QUEUE)
+    # clock and active sensing stay filtered out; SysEx is kept, for midi_bytes.split to end an open one
+    rt.ignore_types(sysex=False, timing=True, active_sense=True)
     try:
         midi = MidiInput(None, api, queue_size=QUEUE)
         if spec == "virtual":
             rt.open_virtual_port(VIRTUAL_PORT)
             midi.port = f"{client}:{VIRTUAL_PORT}" if api == "UNIX_JACK" else VIRTUAL_PORT
+            midi.flush = _flush_output(rtmidi, api, client)
         else:
             names = rt.get_ports()
             match = match_port(spec, names)
@@ -310,9 +329,11 @@ def _open(spec, api, client):
                     raise MidiUnavailable(reason)
                 rt.open_virtual_port(VIRTUAL_PORT)
                 midi._rt, midi.inlet = rt, f"{client}:{VIRTUAL_PORT}"
+                midi.flush = _flush_output(rtmidi, api, client)
                 raise NoPortYet(reason, midi)
-            rt.open_port(names.index(match))
+            rt.open_port(names.index(match), VIRTUAL_PORT)
             midi.port = match
+            midi.flush = _flush_output(rtmidi, api, client)
     except NoPortYet:
         raise
     except BaseException:
@@ -320,6 +341,23 @@ def _open(spec, api, client):
         raise
     midi._rt = rt
     return midi
+
+
+def _flush_output(rtmidi, api, client):
+    """JACK: an output connected to our own input port ``client:VIRTUAL_PORT``, for ``FLUSH`` (else None).
+
+    rtmidi's JACK input appends every event after an unterminated SysEx to it until an event ends in
+    ``F7`` (midi_bytes.py); a lone ``F7`` sent now and then ends it, and what was held comes back."""
+    if api != "UNIX_JACK":
+        return None  # the ALSA sequencer hands over a SysEx whole: nothing is held
+    out = rtmidi.MidiOut(rtapi=getattr(rtmidi, f"API_{api}"), name=f"{client}-flush")
+    own = f"{client}:{VIRTUAL_PORT}"
+    names = out.get_ports()
+    if own not in names:
+        out.delete()
+        return None
+    out.open_port(names.index(own), FLUSH_PORT)
+    return out
 
 
 def open_input(spec, say=print, client=CLIENT):

@@ -36,6 +36,8 @@ knob, or 7.6 % of F_max above its bottom). Before issue 31 it waited for exactly
 the level, and a knob at the bottom never acted.
 """
 
+import math
+
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine.midi import coalesce
@@ -76,6 +78,11 @@ def _step(fraction):
     return min(max(knob_step(fraction), 0), KNOB_MAX)
 
 
+def _valid_control(control, value):
+    return (isinstance(control, str) and isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(value) and 0.0 <= value <= 1.0)
+
+
 class ControlRouting:
     """The worker's side of the controls (mixed into ``worker.Worker``, whose loop, sink, MIDI input,
     control map and events it uses).
@@ -113,7 +120,14 @@ class ControlRouting:
             self.control(control, value, arrived, block)
 
     def control(self, control, value, arrived, block, origin="midi"):
-        """A control moved (MIDI, or on screen): apply its action, tell the parent."""
+        """A control moved (MIDI, or on screen): apply its action, tell the parent.
+
+        A value that is not a number in [0, 1] (``Control("knob1", inf)``) is refused with a notice: on main
+        it killed the worker (OverflowError in ``knob_step``)."""
+        if not _valid_control(control, value):
+            self.notice(f"control {control!r} = {value!r} ignored: allowed is a control name and a value from "
+                        "0 to 1", "warning", "controls")
+            return
         action = self.actions.get(control)
         step = knob_step(value)
         target = self._pickup_target(control, action, step) if origin == "midi" else None

@@ -25,6 +25,8 @@ from multiprocessing import shared_memory
 
 import numpy as np
 
+from studyapp.engine.shm_names import new_name
+
 _HEADER = 4
 _STARTED, _COMMITTED, _CAPACITY, _CHANNELS = range(_HEADER)
 
@@ -68,7 +70,7 @@ class Ring:
         if capacity < 2:
             raise ValueError(f"capacity: need at least 2 samples, got {capacity}")
         size = _HEADER * 8 + len(channels) * int(capacity) * 8
-        shm = shared_memory.SharedMemory(create=True, size=size)
+        shm = shared_memory.SharedMemory(name=new_name("ring"), create=True, size=size)
         ring = cls(shm, channels, capacity, owner=True)
         ring._header[:] = (0, 0, capacity, len(channels))
         ring._data[:] = 0.0

@@ -71,6 +71,9 @@ def force_off_text(reason, silence=0.0):
     if reason == "guard":
         return (f"watchdog: the force guard stopped answering for {1e3 * silence:.0f} ms; force switched off for "
                 "safety — restart the engine")
+    if reason == "owner":
+        return ("watchdog: the program that runs the engine was stopped or ended; force switched off for safety "
+                "— restart the engine")
     return WATCHDOG
 
 

@@ -33,6 +33,8 @@ from multiprocessing import shared_memory
 
 import numpy as np
 
+from studyapp.engine.shm_names import new_name
+
 NUMBERS = (
     "heartbeat",  # time.monotonic() at the end of the last block
     "state",  # one of STATES
@@ -64,8 +66,9 @@ _HEARTBEAT, _STATE = NUMBERS.index("heartbeat"), NUMBERS.index("state")
 
 STATES = ("starting", "running", "stopping", "stopped", "failed")
 # "parent": cleared without a reason given; "guard": the worker found the force guard silent; "operator" and
-# "participant": the emergency stop, by the experimenter's controls or by Esc on the participant's window
-FORCE_OFF_REASONS = ("parent", "operator", "watchdog", "guard", "participant")
+# "participant": the emergency stop, by the experimenter's controls or by Esc on the participant's window;
+# "owner": the guard found the engine's owning process stopped or gone
+FORCE_OFF_REASONS = ("parent", "operator", "watchdog", "guard", "participant", "owner")
 
 _SEQ = 8
 SPINS = 100  # yields before a reader of the whole record starts sleeping
@@ -104,7 +107,7 @@ class StatusBlock:
 
     @classmethod
     def create(cls):
-        shm = shared_memory.SharedMemory(create=True, size=cls.size())
+        shm = shared_memory.SharedMemory(name=new_name("status"), create=True, size=cls.size())
         block = cls(shm, owner=True)
         block._seq[0] = 0
         block._enable[:] = (1.0, 0.0, 0.0, 0.0, 0.0)

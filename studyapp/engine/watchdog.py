@@ -12,7 +12,9 @@ the worker or the guard ends (it waits on their sentinels), so:
 - a worker whose heartbeat is older than ``hang_timeout`` is called hung: the
   guard's cut (``force_off_time``) is reported, or the thread's own finding
   if it comes first (both clear the same word);
-- a guard that dies is a fault too: only a restart brings supervision back.
+- a guard that dies is a fault too: only a restart brings supervision back;
+- a force the guard cut because this program was stopped (reason "owner",
+  engine/guard.py) is reported as a fault once the program runs again.
 
 Either way the fault is reported (``faults``, ``on_fault``), the
 ``force_enable`` word is cleared, with the reason "watchdog" and how long the
@@ -80,6 +82,10 @@ class Watchdog:
                            "for safety: restart the engine", now)
                 continue
             block = self.status_block
+            if not block.force_enable and block.force_off_reason == "owner":  # this program was stopped, now runs
+                self._trip("watchdog: this program was stopped (SIGSTOP, Ctrl-Z or a debugger); the force guard "
+                           "switched the force off for safety: restart the engine", block.force_off_time)
+                continue
             if not block.force_enable and block.force_off_reason == "watchdog":
                 self.process.join(0.05)  # a killed worker's exit can lag its silence: say it died if it did
                 if self.process.exitcode is not None:

@@ -21,6 +21,8 @@ Folders that exist already (a results folder made by hand) keep their modes.
 import os
 from pathlib import Path
 
+from studyapp.io.own_files import NotOurFile, open_own  # noqa: F401 - NotOurFile: the error open_file raises
+
 SHARED_VARIABLE = "STUDYAPP_GROUP_SHARED"
 PRIVATE = (0o700, 0o600)
 GROUP_SHARED = (0o770, 0o660)
@@ -60,11 +62,6 @@ def make_folders(path):
 
 
 def open_file(path, flags):
-    """``os.open`` of ``path``; a file it creates gets ``file_mode()`` (not masked by the umask)."""
-    mode = file_mode()
-    try:
-        fd = os.open(path, flags | os.O_CREAT | os.O_EXCL, mode)
-    except FileExistsError:
-        return os.open(path, flags)
-    os.fchmod(fd, mode)
-    return fd
+    """``os.open`` of ``path``, never through a link (``own_files.open_own``: ``NotOurFile`` for a link, FIFO
+    or device); a file it creates gets ``file_mode()`` (not masked by the umask)."""
+    return open_own(path, flags, file_mode())[0]

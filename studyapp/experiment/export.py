@@ -49,7 +49,10 @@ order_row, simulated``.
 Incomplete sessions are exported too: every confirmed response is data. A
 session that cannot be read is skipped, and a damaged line of a log left out
 (the valid lines after it are kept); each is reported, naming the file and
-line (``studyapp export`` prints them as warnings, and with ``--strict``
+line. The description comes from the log's CRC-checked ``session_created``
+copy where there is one, a field session.json differs in reported
+(``session_description``); a session in another participant's folder (a
+copied folder) is exported under its own participant, with a warning (``studyapp export`` prints them as warnings, and with ``--strict``
 refuses to write anything). A session whose log two programs wrote at once (a
 step with two responses, a repeated ``seq``: ``written_twice``) is skipped the
 same way: which answer counts cannot be told. A complete session is exported
@@ -85,8 +88,15 @@ def _session_rows(folder, problems):
     not a well-formed event is bad input (``InputDataError``).
     """
     path = folder / SESSION_FILE
+    events_file = folder / EVENTS_FILE
     try:
-        info, notes = read_description(folder)
+        log = read_log(events_file)
+    except (UserError, OSError) as exc:  # a folder, FIFO, device or a file over the limit: not a log
+        reason = str(exc) if isinstance(exc, UserError) else f"{events_file}: {exc.strerror or exc}"
+        problems.append(f"{folder}: skipped, {reason}")
+        return []
+    try:
+        info, notes = read_description(folder, log)
         common = {
             "participant": info["participant"],
             "session": info["session"],
@@ -103,8 +113,9 @@ def _session_rows(folder, problems):
         problems.append(f"{folder}: skipped, {path}: not a readable session file (no {exc})")
         return []
     problems.extend(notes)
-    events_file = folder / EVENTS_FILE
-    log = read_log(events_file)
+    if folder.parent.name != info["participant"]:
+        problems.append(f"{folder}: a session of participant {info['participant']!r} (its log says so) in the "
+                        f"folder of {folder.parent.name!r} (copied or renamed?): exported as {info['participant']!r}")
     problems.extend(log.messages(str(events_file)))
     if log.torn:
         problems.append(f"{events_file}: a torn last line ({len(log.torn)} bytes, never confirmed) left out")

@@ -71,7 +71,7 @@ from studyapp.experiment.session_info import (
     order_rows,
 )
 from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
-from studyapp.experiment.session_log import LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
+from studyapp.experiment.session_log import LogLock, LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
 from studyapp.io.free_names import first_free
 
 CREATED = records.SESSION_CREATED
@@ -120,13 +120,16 @@ class Session:
     Opened by ``create`` or ``resume``, which hold the participant's lock; ``close`` releases it.
     """
 
-    def __init__(self, folder, lock=None):
+    def __init__(self, folder, lock=None, log_lock=None):
         self.folder = Path(folder)
         self.lock = lock
+        self._log_lock = log_lock  # the log's own lock (session_log.LogLock) when the opener took it first
         self.notes = []  # what opening it found or repaired, one line each, for the program to show
         try:
             self._open()
         except BaseException:
+            if log_lock is not None and not hasattr(self, "log"):
+                log_lock.release()
             self._release()
             raise
 
@@ -137,7 +140,7 @@ class Session:
         self.notes.extend(notes)
         self.protocol = parse_protocol(self.info["protocol"]["text"], self.info["protocol"]["path"])
         self.schedule = [Trial.from_dict(d) for d in self.info["schedule"]]
-        self.log = SessionLog(self.folder / EVENTS_FILE)
+        self.log = SessionLog(self.folder / EVENTS_FILE, self._log_lock)
         self.notes.extend(self.log.notes)
 
     @property
@@ -285,9 +288,15 @@ class Session:
         if not _lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
             read_description(session_folders(participant_folder)[-1])
         lock = ParticipantLock(participant_folder, participant)
+        log_lock = None
         try:
             folder = session_folders(participant_folder)[-1]
-            info, rebuild = read_description(folder)
+            # the log's own lock before anything is read: a writer that got past a deleted .lock is refused here
+            if os.path.lexists(folder / EVENTS_FILE):  # a missing log is created (and locked) only once checked
+                log_lock = LogLock(folder / EVENTS_FILE)
+            log = read_log(folder / EVENTS_FILE)
+            info, rebuild = read_description(folder, log)
+            _check_owner(info, participant, participant_folder, folder)
             stored = info["protocol"]["sha256"]
             if stored != protocol.sha256:
                 raise UserError(f"{protocol.path}: differs from the protocol of session {folder} "
@@ -298,7 +307,6 @@ class Session:
             if order_row is not None and check_order_row(protocol, order_row) != info.get("order_row"):
                 raise UserError(f"order row {order_row}: session {folder} has order row {info.get('order_row')}: "
                                 "allowed is to leave it out when resuming")
-            log = read_log(folder / EVENTS_FILE)
             twice = written_twice(log)
             if twice:  # export skips such a log whole: what is added to it would be lost too
                 raise UserError(f"{folder / EVENTS_FILE}: {twice}: two programs wrote this log at once, so it "
@@ -314,15 +322,31 @@ class Session:
                     _rebuild_description(folder, info)
                     repaired.append("its session.json rebuilt from events.jsonl")
                 if not any(e.get("type") == SESSION_END for e in events):
-                    with SessionLog(folder / EVENTS_FILE) as log:
+                    with SessionLog(folder / EVENTS_FILE, log_lock) as log:
+                        log_lock = None  # the log owns it now
                         log.append(records.session_end(recovered=True))
                     repaired.append(f"its missing {SESSION_END} event written")
                 said = f" ({'; '.join(repaired)})" if repaired else ""
                 raise UserError(f"session {folder} is already complete{said}: nothing to resume")
         except BaseException:
+            if log_lock is not None:
+                log_lock.release()
             lock.release()
             raise
-        return cls(folder, lock)
+        return cls(folder, lock, log_lock)
+
+
+def _check_owner(info, participant, participant_folder, folder):
+    """Refuse to continue a session that is not ``participant``'s own: a participant folder copied or linked
+    under another ID (its log names the session's participant; its real path, the folder's)."""
+    real = Path(os.path.realpath(participant_folder))
+    if real.name != participant:
+        raise UserError(f"{participant_folder}: a link to {real}, the folder of participant {real.name!r}: "
+                        f"allowed is to resume {real.name!r} by its own ID")
+    if info["participant"] != participant:
+        raise UserError(f"{folder}: holds a session of participant {info['participant']!r} (its log says so), not "
+                        f"of {participant!r}: a participant folder copied or renamed is not resumed: allowed is "
+                        f"to resume {info['participant']!r} in its own folder, or to start {participant!r} anew")
 
 
 def _lock_taken(participant_folder):

@@ -13,6 +13,20 @@ flock is advisory and local: it holds between programs on one machine, and
 on NFS only where the server supports it (Linux NFSv4 does). Keep a results
 folder shared between machines on one machine's disk.
 
+The participant's lock is a file beside the sessions, and a file can be
+deleted: a start after that takes a fresh lock on a new file while the
+first program still writes. So every writer of a session's log (``run``,
+``--resume``, ``notes --add``, the console) also holds ``session_log.LogLock``, a flock
+on the log itself (``events.jsonl``), through the descriptor it appends
+with: it lives as long as that descriptor, the file's name plays no part,
+and it is the same lock whatever path (a symbolic link to the folder, a
+copy of its path) led to the file. A second writer is refused before it
+writes a byte (issue 33, item 2).
+
+Every lock file and log is opened without following a link
+(``data_modes.open_file``): a ``.lock`` or ``events.jsonl`` planted as a link
+is refused, never written through.
+
 ``StudyLock(folder)`` is the same lock held on a study folder for the moment
 it takes to enrol a participant, so two participants started at once get
 different enrolment indices (and Latin-square rows).
@@ -32,9 +46,10 @@ import time
 from pathlib import Path
 
 from studyapp.errors import UserError
-from studyapp.experiment.data_modes import open_file
+from studyapp.experiment.data_modes import NotOurFile, open_file
 from studyapp.experiment.session_files import LOCK_FILE
 from studyapp.experiment.session_log import wall_time
+from studyapp.io.small_files import read_regular
 
 
 def _acquire(path, blocking):
@@ -64,9 +79,11 @@ def remove_if_free(folder):
     """Remove ``folder``'s lock file if no program holds it (taken for the moment); False if one does."""
     path = Path(folder) / LOCK_FILE
     try:
-        fd = os.open(path, os.O_RDWR)
+        fd = os.open(path, os.O_RDWR | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
     except FileNotFoundError:
         return True
+    except OSError:
+        return False  # a link or a special file: not the app's to remove
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
@@ -85,7 +102,7 @@ def _holder(path):
     deadline = time.monotonic() + 1.0
     while True:
         try:
-            holder = json.loads(Path(path).read_text(encoding="utf-8"))
+            holder = json.loads(read_regular(path, "lock", 4096))
             return f"PID {holder['pid']} on host {holder['host']} since {holder['started']}"
         except (OSError, ValueError, KeyError, TypeError):
             if time.monotonic() > deadline:
@@ -100,6 +117,8 @@ class ParticipantLock:
         self.path = Path(folder) / LOCK_FILE
         try:
             self._fd = _acquire(self.path, blocking=False)
+        except NotOurFile:
+            raise
         except OSError as exc:
             raise UserError(f"{self.path}: cannot lock the participant's folder ({exc.strerror or exc}): "
                             "allowed is a writable results folder") from None
@@ -138,3 +157,4 @@ class StudyLock:
 
     def __exit__(self, *exc):
         os.close(self._fd)
+

@@ -22,11 +22,14 @@ and never lets one bad line hide the others. Opening the log for appending
   logged; a last confirmed event that lacks its newline gets one.
 
 Every such finding is also a line in ``SessionLog.notes`` for the program to
-show. A write that fails (disk full, file too large, I/O error) is undone by
+show. The log is written only under its ``LogLock`` (a flock on the file itself,
+held through the descriptor it appends with; session_lock.py says why), and
+never through a link (``data_modes.open_file``). A write that fails (disk full, file too large, I/O error) is undone by
 truncating the file back to its last complete line, and raises
 ``LogWriteError``: the file stays valid, and resuming continues it.
 """
 
+import fcntl
 import json
 import os
 import time
@@ -38,8 +41,8 @@ from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, open_file
-from studyapp.experiment.log_scan import LOG_LIMIT, read_events, read_log, scan  # noqa: F401 - the log's readers, here too
 from studyapp.io.small_files import read_regular
+from studyapp.experiment.log_scan import LOG_LIMIT, read_events, read_log, scan  # noqa: F401 - the log's readers, here too
 
 DAMAGED_SUFFIX = ".damaged"
 TORN_SUFFIX = ".torn-"
@@ -75,6 +78,29 @@ def fsync_directory(path):
         os.close(fd)
 
 
+def _read_all(fd, path):
+    """The bytes of the open log ``fd`` (the file locked, not whatever its name points to now)."""
+    size = os.fstat(fd).st_size
+    if size > LOG_LIMIT:
+        raise UserError(f"{path}: larger than {LOG_LIMIT >> 20} MB: allowed is a session log (events.jsonl) "
+                        "file up to that size")
+    chunks, done = [], 0
+    while done < size:
+        chunk = os.pread(fd, size - done, done)
+        if not chunk:
+            break
+        chunks.append(chunk)
+        done += len(chunk)
+    return b"".join(chunks)
+
+
+def _read_or_none(path):
+    try:
+        return read_regular(path, "set-aside copy", LOG_LIMIT)
+    except (OSError, UserError):
+        return None
+
+
 def _write_copy(path, data):
     with atomic_open(path, "wb", permissions=file_mode()) as f:
         f.write(data)
@@ -82,24 +108,53 @@ def _write_copy(path, data):
         os.fsync(f.fileno())
 
 
-class SessionLog:
-    """Appends events to ``path``, each one on disk before ``append`` returns."""
+class LogLock:
+    """The exclusive lock on a session's log, held through the descriptor the log is appended with.
+
+    ``fd``: ``events.jsonl`` opened for appending (created if missing, never through a link).
+    ``UserError`` when another program holds it: that program writes the session now."""
 
     def __init__(self, path):
         self.path = Path(path)
+        self.fd = open_file(self.path, os.O_RDWR | os.O_APPEND)
+        try:
+            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(self.fd)
+            self.fd = None
+            raise UserError(f"{self.path}: another program is writing this session now (its log is locked, "
+                            "whatever became of the participant's .lock): allowed is to wait until it ends") from None
+        except BaseException:
+            os.close(self.fd)
+            raise
+
+    def release(self):
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+
+class SessionLog:
+    """Appends events to ``path``, each one on disk before ``append`` returns.
+
+    ``lock``: the ``LogLock`` of ``path`` when the caller took it already (then the log owns it)."""
+
+    def __init__(self, path, lock=None):
+        self.path = Path(path)
         self.notes = []
-        existed = self.path.exists()
-        self._fd = open_file(self.path, os.O_WRONLY | os.O_APPEND)
+        existed = os.path.lexists(self.path)
+        self._lock = LogLock(self.path) if lock is None else lock
+        self._fd = self._lock.fd
         try:
             self._open(existed)
         except BaseException:
-            os.close(self._fd)
+            self._lock.release()
             raise
 
     def _open(self, existed):
         if not existed:
             fsync_directory(self.path.parent)
-        data = read_regular(self.path, "session log (events.jsonl)", LOG_LIMIT)
+        data = _read_all(self._fd, self.path)
         log = scan(data)
         self._size = len(data) - len(log.cut)
         self.seq = max((e["seq"] for e in log.events if isinstance(e.get("seq"), int)), default=-1) + 1
@@ -123,7 +178,7 @@ class SessionLog:
         if bad:
             side = self.path.with_name(self.path.name + DAMAGED_SUFFIX)
             quarantined = b"".join(raw for _, _, raw in bad)
-            first_time = not side.exists() or side.read_bytes() != quarantined
+            first_time = _read_or_none(side) != quarantined
             if first_time:
                 self._guard(lambda: _write_copy(side, quarantined))
                 repairs.append(records.log_damaged([n for n, _, _ in bad], side.name))
@@ -163,7 +218,7 @@ class SessionLog:
 
     def close(self):
         if self._fd is not None:
-            os.close(self._fd)
+            self._lock.release()
             self._fd = None
 
     def __enter__(self):

@@ -10,8 +10,10 @@ these are the ones added as things happen, and after.
 - During a session: the console's note box (``SessionController.add_note``)
   appends to the open log.
 - After it (finished, aborted, or a crash): ``add_note(folder, text)`` takes
-  the participant's lock (``session_lock``: refused, naming the holder, while
-  a session of theirs runs in another program), appends, and lets go;
+  the participant's lock of the session's real folder (``session_lock``:
+  refused, naming the holder, while a session of theirs runs in another
+  program; a link to the folder leads to the same lock) and the log's own
+  lock (``session_log.LogLock``), appends, and lets go;
   ``studyapp notes SESSION_DIR --add TEXT`` and the console (its last
   session) use it. The log is read first, without the lock: one that is
   refused (a FIFO, a device, a folder, too large or sparse, or holding no
@@ -27,6 +29,7 @@ at most 2000 characters, line breaks and tabs but no other control
 characters); an empty note is refused.
 """
 
+import os
 from pathlib import Path
 
 import pandas as pd
@@ -68,7 +71,8 @@ def session_folder_of(path):
 def add_note(folder, text):
     """Append a note to the session in ``folder`` that no program has open; returns the stamped event."""
     event = note_event(text)
-    folder = session_folder_of(folder)
+    # the real folder: a link's own parent is not the participant's folder, and its lock not theirs
+    folder = Path(os.path.realpath(session_folder_of(folder)))
     info, _ = read_description(folder)
     # read-only, before the lock: a log that is refused (a FIFO, a device, a folder, too large) is refused
     # with the participant's folder, its .lock included, unchanged

@@ -1,6 +1,7 @@
 """Files in and out: written whole or not at all, read with checks, one line naming what is wrong.
 
     atomic.atomic_open / atomic_path     write a file whole or not at all (temporary file, fsync, rename)
+    own_files.open_own                   write in a data folder only a file the app made (no links)
     small_files.open_regular             read a small text file a person wrote, refusing devices and FIFOs
     small_files.read_json                a small JSON file, its size and nesting bounded
     bounded_json.loads                   JSON with its nesting depth bounded before it is parsed

@@ -41,7 +41,7 @@ def _whole_file(kind):
     return struct.pack("@hhqqi4x", kind, os.SEEK_SET, 0, 0, 0)
 
 
-def _lock(fd):
+def hold(fd):
     """Hold an open-file-description write lock (``F_OFD_SETLKW``) on ``fd`` until it is closed.
 
     Not ``flock``: HDF5 flocks the files it writes and would find ours taken. An OFD
@@ -140,7 +140,7 @@ def _temporary(target, mode, named):
         if fd is None:
             fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent)
             tmp = Path(name)
-        _lock(fd)  # ours while we live: remove_stale leaves it alone
+        hold(fd)  # ours while we live: remove_stale leaves it alone
         # mkstemp and O_TMPFILE make the file private (0600); an output gets the usual permissions unless told
         os.fchmod(fd, default_mode() if mode is None else mode)
         if named and tmp is None:

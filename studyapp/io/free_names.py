@@ -4,8 +4,15 @@ Outputs that must never replace an earlier one (a WAV take, the recording of
 what a participant heard, a session's folder) take the first free name of
 ``numbered_names``. Where two writers may race for it, ``claim`` reserves the
 name with an exclusive create (``O_EXCL``), so each keeps its own.
+
+A file that must appear whole or not at all (a WAV file: a 0-byte one is
+unreadable) is made without a name first (``unnamed``: Linux ``O_TMPFILE``,
+nothing is left if the program is killed), its header written, and only then
+linked under the first free name (``name_unnamed``: ``linkat``, which fails
+rather than replace a file that exists).
 """
 
+import errno
 import itertools
 import os
 from pathlib import Path
@@ -41,3 +48,35 @@ def claim(path, mode=0o600):
             return create(name, mode), name
         except FileExistsError:
             continue
+
+
+def unnamed(folder, mode=0o600):
+    """An fd of a new file without a name in ``folder`` (``O_TMPFILE``), permissions ``mode``; None where the
+    filesystem does not support that."""
+    flag = getattr(os, "O_TMPFILE", None)
+    if flag is None:
+        return None
+    try:
+        fd = os.open(folder, flag | os.O_RDWR | os.O_CLOEXEC, mode)
+    except OSError as exc:
+        if exc.errno in (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL):
+            return None
+        raise
+    os.fchmod(fd, mode)
+    return fd
+
+
+def name_unnamed(fd, path):
+    """Link the unnamed file ``fd`` under the first free numbered name of ``path``; return that name."""
+    path = Path(path)
+    folder = os.open(path.parent, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+    try:
+        for name in numbered_names(path):
+            try:
+                # linkat(AT_SYMLINK_FOLLOW) of /proc/self/fd/N: the way to name an O_TMPFILE file
+                os.link(f"/proc/self/fd/{fd}", name.name, src_dir_fd=folder, dst_dir_fd=folder, follow_symlinks=True)
+                return name
+            except FileExistsError:
+                continue
+    finally:
+        os.close(folder)

@@ -133,3 +133,41 @@ def test_a_knob_left_high_at_a_trial_start_raises_fmax_only_once_turned_down_thr
         assert tel["start"] + int(np.flatnonzero(tel["trial"] == 2)[first]) == controls[3].block * engine.info["block"]
     finally:
         engine.stop()
+
+
+SYSEX_THEN_KNOB = SENDER.replace("    for value in sys.argv[1:]:",
+                                 "    out.send_message([0xF0, 0x7E, 0x01])   # a SysEx never terminated\n"
+                                 "    time.sleep(0.15)\n"
+                                 "    for value in sys.argv[1:]:")
+
+
+def test_an_unterminated_sysex_does_not_silence_midi(jack_server):
+    # issue 33, item 4: on main one F0 7E 01 silenced MIDI for good (rtmidi's JACK input held every later
+    # event as part of that SysEx, and SysEx was ignored): knob 1 no longer moved F_max, without a notice
+    engine = Engine(EngineConfig(rate=RATE, source="LVT", fmax=0.0, midi="virtual")).start()
+    try:
+        sender = subprocess.run([sys.executable, "-c", SYSEX_THEN_KNOB, "0", "100"], capture_output=True, text=True,
+                                timeout=60)
+        assert sender.returncode == 0, sender.stderr
+        controls = wait_for_controls(engine, 2)
+        assert [c.value for c in controls] == [0.0, pytest.approx(100 / 127)]
+        time.sleep(0.05)
+        assert engine.status()["fmax"] == pytest.approx(fmax_from_knob(100, *LIVE_RANGE))
+    finally:
+        engine.stop()
+
+
+def test_a_control_value_that_is_not_a_number_in_range_is_refused_with_a_notice():
+    # issue 33, item 4: on main Control("knob1", inf) killed the worker with an OverflowError
+    notices = []
+    engine = Engine(EngineConfig(rate=RATE, source="LVT", fmax=1.0, midi="none"),
+                    on_notice=notices.append).start()
+    try:
+        for value in (float("inf"), float("nan"), -1.0, 2.0, "x"):
+            engine.send(cmd.Control("knob1", value))
+        engine.send(cmd.Control("knob1", 0.5))
+        controls = wait_for_controls(engine, 1)
+        assert controls[0].value == 0.5 and engine.alive
+        assert sum("ignored: allowed is a control name and a value from 0 to 1" in n.text for n in notices) == 5
+    finally:
+        engine.stop()

@@ -190,3 +190,22 @@ def test_without_a_backend_one_line_says_so_and_nothing_leaks_to_stderr(capfd, m
     assert "on-screen knobs" in lines[0]
     assert capfd.readouterr().err == ""
     assert open_input("none", say=lines.append) is None and len(lines) == 1
+
+
+def test_raw_bytes_resynchronise_after_an_unterminated_or_cut_message():
+    # issue 33, item 4: the next status byte ends an unterminated SysEx, and what follows it counts
+    from studyapp.engine.midi_bytes import split
+
+    held = [0xF0, 0x7E, 0x01, 0xB0, 1, 20, 0xF8, 0xB0, 1, 30, 0xF7]  # what rtmidi's JACK input hands over
+    assert split(held) == [[0xB0, 1, 20], [0xF8], [0xB0, 1, 30]]
+    assert split([0xF0, 1, 2, 0xF7, 0x90, 60, 0xC0, 5, 0xB0, 1, 2, 3, 4, 0xF4, 7, 0xF7]) == [
+        [0xF0, 1, 2, 0xF7], [0xC0, 5], [0xB0, 1, 2], [0xB0, 3, 4]]  # a note cut short, running status, junk
+    got = coalesce([(held, 1.0, 3)])
+    assert [(m.type, m.value) for m, _, _ in got if m.type == "control_change"] == [("control_change", 30)]
+
+
+def test_an_engines_own_sysex_end_port_is_never_taken_for_a_controller():
+    from studyapp.engine.midi import FLUSH_PORT, match_port
+
+    names = [f"studyapp-12:{FLUSH_PORT}", "LPD8:out"]
+    assert match_port("first", names) == "LPD8:out" and match_port("studyapp", names) is None

@@ -237,12 +237,12 @@ def two_writers(results, protocol, participant):
 
     session = Session.create(protocol, participant, results, seed=1)
     run_simulated(session, trials=2).finish("interrupted")
+    session.close()  # the log's own lock now refuses a second writer at once: it writes after the first
     second = SessionLog(session.folder / "events.jsonl")
     second.seq -= 5  # it opened the log a few events ago
     answered = [e for e in read_log(session.folder / "events.jsonl").events if e["type"] == "response"]
     second.append({**{k: v for k, v in answered[-1].items() if k not in ("seq", "mono", "wall")}, "fmax": 9.0})
     second.close()
-    session.close()
     return session.folder
 
 

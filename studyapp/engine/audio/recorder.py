@@ -27,9 +27,14 @@ it, an untouched one never), so a step's count is the sum of its rows after
 its ``start`` up to its ``end``. A cue that arrives for audio written before
 the last write (rare: cues name a position ahead) counts up to that write's start.
 
-Files are never overwritten (``free_names.claim``): ``audio.wav`` is reserved with an
-exclusive create, else ``audio-2.wav``, ``audio-3.wav``, ...: one file per
-engine run of a session (a resumed session, a restarted engine). The WAV file
+Files are never overwritten: ``audio.wav`` is taken only if no file of that name
+exists, else ``audio-2.wav``, ``audio-3.wav``, ...: one file per engine run of a
+session (a resumed session, a restarted engine). A file appears under its name
+with its header already written (made without a name, then linked:
+``free_names.name_unnamed``), so a kill never leaves an empty, unreadable WAV
+file. ``audio_cues.csv`` is opened without following a link
+(``own_files.open_own``): a link planted under its name is refused, never
+written through, and the cues are then left out with a warning. The WAV file
 and ``audio_cues.csv`` are created with the permissions ``mode`` (the session's
 files' mode, 0600 or 0660: participant data), whatever the umask.
 
@@ -51,25 +56,49 @@ import csv
 import os
 import queue
 import threading
+from pathlib import Path
 
 import numpy as np
 
 from studyapp.engine.audio.wav import open_wav, pcm16
 from studyapp.engine.signal_chain import KNEE
-from studyapp.io.free_names import claim, create
+from studyapp.io.free_names import claim, name_unnamed, unnamed
+from studyapp.io.own_files import NotOurFile, open_own
 
 QUEUE_SECONDS = 10.0  # of audio the writer may fall behind before blocks are dropped
 CUES_FILE = "audio_cues.csv"
 CUE_COLUMNS = ("file", "sample", "seconds", "step", "task", "trial", "event", "limited")
 
 
+def _whole_wav(path, rate, mode):
+    """(file, wave writer, name) of a new WAV file under the first free name of ``path``, its header written.
+
+    The file is made without a name (``free_names.unnamed``) and named only once its header is
+    on disk, so no kill leaves an empty, unreadable ``audio.wav``."""
+    fd = unnamed(path.parent, mode)
+    name = None
+    if fd is None:  # a filesystem without O_TMPFILE: reserved by name, its header written at once
+        fd, name = claim(path, mode)
+    file = open(fd, "w+b")  # noqa: SIM115 - the writer thread closes it
+    try:
+        wav = open_wav(file, rate)
+        wav.writeframes(b"")  # the header, for 0 frames
+        file.flush()
+        if name is None:
+            name = name_unnamed(fd, path)
+    except BaseException:
+        file.close()
+        raise
+    return file, wav, Path(name)
+
+
 class AudioRecorder:
     def __init__(self, path, rate, mode=0o600):
         self.rate = float(rate)
         self.mode = mode
-        fd, self.path = claim(path, mode)
-        self._file = open(fd, "wb")  # noqa: SIM115 - the writer thread closes it
+        self._file, self._wav, self.path = _whole_wav(Path(path), self.rate, mode)
         self.cues_path = self.path.parent / CUES_FILE
+        self.cues_refused = None  # why audio_cues.csv could not be written (a link planted there), or None
         self.capacity = int(QUEUE_SECONDS * self.rate)
         self.frames = 0  # frames of the file's timeline so far, dropped ones included
         self.stream = None  # the stream position after the last write (None: nothing written yet)
@@ -127,7 +156,7 @@ class AudioRecorder:
         with contextlib.suppress(OSError, AttributeError):  # leave the worker's real-time priority
             os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
         try:
-            with self._file, open_wav(self._file, self.rate) as wav:
+            with self._file, self._wav as wav:
                 self._write_all(wav)
         except OSError as exc:
             self.error = f"{self.path}: {exc.strerror or exc}"
@@ -204,12 +233,16 @@ class AudioRecorder:
                 "limited": limited}
 
     def _append_cue(self, row):
-        new = not self.cues_path.exists() or self.cues_path.stat().st_size == 0
-        with contextlib.suppress(FileExistsError):
-            os.close(create(self.cues_path, self.mode))
-        with open(self.cues_path, "a", newline="", encoding="utf-8") as f:
+        if self.cues_refused is not None:
+            return
+        try:
+            fd, created = open_own(self.cues_path, os.O_WRONLY | os.O_APPEND, self.mode)  # never through a link
+        except OSError as exc:
+            self.cues_refused = f"{exc}" if isinstance(exc, NotOurFile) else f"{self.cues_path}: {exc.strerror or exc}"
+            return
+        with open(fd, "a", newline="", encoding="utf-8") as f:
             writer = csv.DictWriter(f, fieldnames=CUE_COLUMNS)
-            if new:
+            if created or os.fstat(fd).st_size == 0:
                 writer.writeheader()
             writer.writerow(row)
 
@@ -261,6 +294,8 @@ class Recordings:
                 self.notice(f"audio: {recorder.path}: the writer did not finish within {timeout:g} s", "warning", "audio")
             if recorder.error:
                 self.notice(f"audio: recording stopped: {recorder.error}", "warning", "audio")
+            if recorder.cues_refused:
+                self.notice(f"audio: no cues written: {recorder.cues_refused}", "warning", "audio")
             if recorder.dropped:
                 self.notice(f"audio: {recorder.path}: {recorder.dropped} frames dropped (the disk fell behind), "
                             "written as silence", "warning", "audio")

@@ -38,13 +38,13 @@ import threading
 
 import numpy as np
 
-from studyapp.io.atomic import default_mode
+from studyapp.io.atomic import default_mode, hold, remove_stale
 from studyapp.engine.audio.fifo import Fifo
 from studyapp.engine.audio.wav import open_wav, pcm16
 from studyapp.engine.native_stderr import captured_native_stderr
 from studyapp.engine.signal_chain import Gain, SignalChain
 from studyapp.errors import ParameterError
-from studyapp.io.free_names import claim, first_free
+from studyapp.io.free_names import claim, first_free, name_unnamed, unnamed
 
 DEVICE_RATE = 48_000.0
 WAV_RATE = 48_000.0
@@ -177,6 +177,9 @@ class WavSink(Sink):
     Never over an existing file: the name is the first free one of FILE, FILE-2, ... when the
     sink opens (``say`` tells which, if not FILE) and again when it closes, reserved by an
     exclusive create (two engines writing the same FILE at once both keep their take).
+    Until then the file has no name (``O_TMPFILE``), so a killed program leaves nothing behind;
+    a named temporary ``.FILE.XXXXXXXX.wav`` that a killed run left (older versions, or a
+    filesystem without ``O_TMPFILE``) is removed by the next sink of the same FILE.
     """
 
     render = True
@@ -188,11 +191,16 @@ class WavSink(Sink):
         if self.path != str(path):
             say(f"audio: {path} exists; writing {self.path} (never over an earlier file)")
         self.rate = float(rate)
-        folder, name = os.path.split(os.path.abspath(self.path))
-        fd, self._tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".wav", dir=folder)
-        os.fchmod(fd, default_mode())  # an output's usual permissions, not mkstemp's private ones
-        os.close(fd)
-        self._wav = open_wav(str(self._tmp), self.rate)
+        folder = os.path.dirname(os.path.abspath(self.path))
+        remove_stale(self.path)  # a named temporary an earlier, killed run left (before O_TMPFILE was used)
+        fd = unnamed(folder, default_mode())  # no name until complete: a kill leaves nothing
+        self._tmp = None
+        if fd is None:  # a filesystem without O_TMPFILE: a named temporary, held so the next run removes it
+            fd, self._tmp = tempfile.mkstemp(prefix=f".{os.path.basename(self.path)}.", suffix=".wav", dir=folder)
+            os.fchmod(fd, default_mode())  # an output's usual permissions, not mkstemp's private ones
+            hold(fd)
+        self._file = open(fd, "w+b")  # noqa: SIM115 - closed in close()
+        self._wav = open_wav(self._file, self.rate)
         self.frames = 0
 
     @property
@@ -213,7 +221,12 @@ class WavSink(Sink):
         self._wav.close()
         self._wav = None
         chosen = self.path
-        self.path = str(_move_free(self._tmp, self.path))
+        if self._tmp is None:
+            self._file.flush()
+            self.path = str(name_unnamed(self._file.fileno(), self.path))
+        else:
+            self.path = str(_move_free(self._tmp, self.path))
+        self._file.close()
         if self.path != chosen:
             self.say(f"audio: {chosen} appeared meanwhile; wrote {self.path} (never over an earlier file)")
 
