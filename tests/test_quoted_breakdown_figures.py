@@ -24,7 +24,7 @@ from studyapp.model import breakdown
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "breakdown.md"
 PRECISION = math.sqrt(1.02) - 1.0
-REDONE = {"strokes": ("TRUE", "LVT", "LOWPASS", "KALLEV"), "hold": ("LVT",)}
+REDONE = {"strokes": ("TRUE", "LVT", "LOWPASS", "KALLEV"), "hold": ("LVT", "KALPOS")}
 
 
 def number(cell):
