@@ -2,6 +2,7 @@
 
     PYTHONPATH=. python scripts/model_figures.py [--png docs/breakdown_strokes.png] [--source LVT] [--seeds 3]
     PYTHONPATH=. python scripts/model_figures.py --only-png --png docs/breakdown_strokes_lowpass.png --source LOWPASS
+    PYTHONPATH=. python scripts/model_figures.py --only-signals
 
 Prints, for the model as calibration.py sets it, with sinclair2014's Table 1 parameters:
 
@@ -20,7 +21,10 @@ Prints, for the model as calibration.py sets it, with sinclair2014's Table 1 par
   FOAW (Table 1) at its maximum window at 7.7 N;
 - the string's pitch on the strokes with LVT at 2 N at 5, 20 and 48 kHz;
 
-and with ``--png``, a spectrogram of the audio while ``--source`` steps through 0.5, 0.75, 1, 1.25 and
+``--only-signals`` prints only the last two (a few seconds); tests/test_quoted_model_figures.py
+recomputes them through ``paper_signals`` and ``loop_pitch`` and compares them with docs/model.md.
+
+With ``--png``, a spectrogram of the audio while ``--source`` steps through 0.5, 0.75, 1, 1.25 and
 1.5 x its bowing breakdown on strokes, 3 s each (the steps' band levels printed beside it).
 """
 
@@ -127,31 +131,65 @@ def hearing(source, seed):
     return level, [hi - lo for lo, hi in zip(*rows)]
 
 
+BANDS = ((0, 20), (20, 50), (50, 100), (100, 400), (400, 2500))  # Hz
+PAPER_SIGNALS = ((12.1, 14), (7.7, 12))  # (F_max N, the training set's recording index)
+PITCH_RATES = (5000.0, 20000.0, 48000.0)
+
+
+def buzz_hz(source, fmax):
+    """The handle's velocity's spectral peak above 50 Hz (after 1 s) over 5 s of strokes at ``fmax``."""
+    b = loop(source, min(fmax, 200.0), "strokes").run(int(5 * RATE))
+    return peak_hz(b["velocity_true"][int(RATE):], fmin=50.0)
+
+
+def band_rms(source, fmax):
+    """The handle's velocity per BANDS (mm/s RMS, after 0.25 s) over 5 s of strokes at ``fmax``, seed 0."""
+    v = loop(source, fmax, "strokes").run(int(5 * RATE))["velocity_true"][int(0.25 * RATE):]
+    f, p = signal.welch(v, fs=RATE, nperseg=2048)
+    return [1e3 * np.sqrt(np.sum(p[(f >= lo) & (f < hi)]) * (f[1] - f[0])) for lo, hi in BANDS]
+
+
+def paper_signals(fmax, index):
+    """(max |dv/dt| m/s^2, mm/s RMS above 100 Hz, % of samples at FOAW's maximum window) of ``velocity_lvt``
+    on the training set's recording ``index`` (LVT in the loop at ``fmax`` N, 7 s)."""
+    rec = simulate(fmax, rate=RATE, duration=7.0, source="LVT", seed=TRAINING["seed"] * 1000 + index)
+    v = rec.columns["velocity_lvt"]
+    hp = signal.sosfilt(signal.butter(2, 100.0, "high", fs=RATE, output="sos"), v)
+    window = window_sizes(rec.columns["position"], TABLE1["FOAW"]["window"], TABLE1["FOAW"]["margin"])
+    return (float(np.max(np.abs(np.diff(v))) * RATE), float(1e3 * np.sqrt(np.mean(hp ** 2))),
+            float(100 * np.mean(window == TABLE1["FOAW"]["window"])))
+
+
+def loop_pitch(rate):
+    """The string's pitch (Hz, after 0.25 s) with LVT at 2 N on 5 s of strokes at ``rate``."""
+    b = loop("LVT", 2.0, "strokes", rate).run(int(5 * rate))
+    return pitch(b["string_velocity"][int(0.25 * rate):], rate)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--png", help="write the spectrogram here")
     parser.add_argument("--source", default="LVT")
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--only-png", action="store_true", help="only the spectrogram")
+    parser.add_argument("--only-signals", action="store_true", help="only the paper's signals and the pitches")
     args = parser.parse_args(argv)
     if args.only_png:
         return png(args.source, args.png, {})
+    if args.only_signals:
+        return signals()
     print(f"f0 {calibration.F0:g} Hz, beta {calibration.BOW_POSITION:g}, velocity scale "
           f"{calibration.VELOCITY_SCALE:g}, end-effector {calibration.DEVICE_MASS:g} kg on a grip of "
           f"{calibration.GRIP_STIFFNESS:g} N/m, {calibration.GRIP_DAMPING:g} N s/m")
     levels = {}
     for source in ("LVT", "LOWPASS", "KALPOS", "LEVANT", "FOAW", "TRUE"):
         levels[source] = breakdown_fmax(source, tolerance=0.05, estimators=estimators(source))
-        b = loop(source, min(1.25 * levels[source], 200.0), "strokes").run(int(5 * RATE))
         print(f"{source}: bowing breakdown {levels[source]:.3g} N (seed 0); handle's buzz at 1.25 x: "
-              f"{peak_hz(b['velocity_true'][int(RATE):], fmin=50.0):.0f} Hz")
+              f"{buzz_hz(source, 1.25 * levels[source]):.0f} Hz")
     for source, fmax in (("TRUE", 4.0), ("TRUE", 1.25 * levels["LVT"]), ("LVT", 1.25 * levels["LVT"]),
                          ("LOWPASS", 1.25 * levels["LOWPASS"]), ("KALPOS", 1.25 * levels["KALPOS"])):
-        v = loop(source, fmax, "strokes").run(int(5 * RATE))["velocity_true"][int(0.25 * RATE):]
-        f, p = signal.welch(v, fs=RATE, nperseg=2048)
-        bands = ((0, 20), (20, 50), (50, 100), (100, 400), (400, 2500))
         print(f"{source} at {fmax:.3g} N, handle's velocity per band (mm/s RMS): " + ", ".join(
-            f"{lo}-{hi} Hz {1e3 * np.sqrt(np.sum(p[(f >= lo) & (f < hi)]) * (f[1] - f[0])):.1f}" for lo, hi in bands))
+            f"{lo}-{hi} Hz {rms:.1f}" for (lo, hi), rms in zip(BANDS, band_rms(source, fmax))))
     for source in ("LVT", "LOWPASS", "KALPOS", "LEVANT", "FOAW", "LEVANTLP", "KALLEV", "KALFOAW", "LEASTSQ"):
         rises = [hearing(source, seed)[1] for seed in range(args.seeds)]
         lo = np.min(rises, axis=0)
@@ -159,19 +197,18 @@ def main(argv=None):
         names = ("100-400 Hz", "50-400 Hz", "inharmonic", "distance from TRUE")
         print(f"{source} rise 0.8 -> 1.25 x, seeds 0-{args.seeds - 1} (dB): "
               + ", ".join(f"{n} {a:.1f}..{b:.1f}" for n, a, b in zip(names, lo, hi)))
-    for fmax, index in ((12.1, 14), (7.7, 12)):
-        rec = simulate(fmax, rate=RATE, duration=7.0, source="LVT", seed=TRAINING["seed"] * 1000 + index)
-        v = rec.columns["velocity_lvt"]
-        hp = signal.sosfilt(signal.butter(2, 100.0, "high", fs=RATE, output="sos"), v)
-        window = window_sizes(rec.columns["position"], TABLE1["FOAW"]["window"], TABLE1["FOAW"]["margin"])
-        print(f"data set at {fmax:g} N: max |dv/dt| {np.max(np.abs(np.diff(v))) * RATE:.0f} m/s^2, above 100 Hz "
-              f"{1e3 * np.sqrt(np.mean(hp ** 2)):.2f} mm/s RMS, FOAW at its maximum window "
-              f"{100 * np.mean(window == TABLE1['FOAW']['window']):.1f} % of samples")
-    for rate in (5000.0, 20000.0, 48000.0):
-        b = loop("LVT", 2.0, "strokes", rate).run(int(5 * rate))
-        print(f"pitch at {rate:g} Hz, LVT at 2 N on strokes: {pitch(b['string_velocity'][int(0.25 * rate):], rate):.1f} Hz")
+    signals()
     if args.png:
         png(args.source, args.png, levels)
+
+
+def signals():
+    for fmax, index in PAPER_SIGNALS:
+        dvdt, high, at_max = paper_signals(fmax, index)
+        print(f"data set at {fmax:g} N: max |dv/dt| {dvdt:.0f} m/s^2, above 100 Hz "
+              f"{high:.2f} mm/s RMS, FOAW at its maximum window {at_max:.1f} % of samples")
+    for rate in PITCH_RATES:
+        print(f"pitch at {rate:g} Hz, LVT at 2 N on strokes: {loop_pitch(rate):.1f} Hz")
 
 
 def png(source, path, levels):

@@ -156,6 +156,9 @@ CASES = {
     "simulate-set-duration-nan": [*SET, "--duration", "nan", "-o", "{out}/set"],
     # breakdown
     "breakdown-seeds-negative": [*BREAKDOWN, "--seeds", "-1"],
+    "breakdown-first-seed-negative": [*BREAKDOWN, "--first-seed", "-1"],
+    "breakdown-first-seed-fraction": [*BREAKDOWN, "--first-seed", "0.5"],
+    "breakdown-first-seed-past-the-end": [*BREAKDOWN, "--first-seed", "999999", "--seeds", "2"],
     "breakdown-rate-nan": [*BREAKDOWN, "--rate", "nan"],
     "breakdown-duration-nan": [*BREAKDOWN, "--duration", "nan"],
     "breakdown-out-dir": [*BREAKDOWN, "-o", "{in}/adir.csv"],

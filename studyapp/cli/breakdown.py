@@ -1,11 +1,11 @@
-"""``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--gesture strokes|hold] [--latency S]
-[--packet S] [--jitter S] [--json] [-o FILE]``.
+"""``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--first-seed K] [--gesture strokes|hold]
+[--latency S] [--packet S] [--jitter S] [--json] [-o FILE]``.
 
 Breakdown F_max (studyapp.model.breakdown) for one source or every source,
-over seeds 0..N-1. Prints a table (or with ``--json`` one JSON object for
+over seeds K..K+N-1 (K = 0 by default). Prints a table (or with ``--json`` one JSON object for
 ``--source``, a list of them for ``--all``); ``-o`` also writes it, by suffix:
 ``.csv`` (one row per source, the seeds' values ';'-joined in
-``fmax_per_seed``), ``.md`` (the same table, headed by the date and the
+``fmax_per_seed``, the seeds in the same order in ``seeds_used``), ``.md`` (the same table, headed by the date and the
 command that regenerates it) or ``.json``. Stable up to the search's 200 N is
 ``inf`` in CSV, ``null`` in JSON and "> 200" in Markdown; broken already at
 0.05 N is 0.05, "<= 0.05" in Markdown. Progress goes to stderr.
@@ -18,7 +18,8 @@ the CSV their columns (after today's), the Markdown a sentence naming them.
 from studyapp.cli import link_options
 
 SUFFIXES = (".csv", ".md", ".json")
-COLUMNS = ("source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed")
+COLUMNS = ("source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed", "first_seed",
+           "seeds_used")
 LINK_COLUMNS = ("latency", "packet", "jitter")  # s, the link's (studyapp.model.link.NAMES)
 
 
@@ -27,13 +28,15 @@ def register(subparsers):
         "breakdown",
         help="breakdown F_max of velocity sources over seeds (the adjustment task's measure, Fig. 7)",
         description="Find the largest F_max at which each velocity source keeps the simulated loop stable, "
-                    "for seeds 0..N-1.",
+                    "for seeds K..K+N-1.",
     )
     which = p.add_mutually_exclusive_group(required=True)
     which.add_argument("--source", metavar="NAME", help="an estimator name, LVT (the tachometer) or TRUE")
     which.add_argument("--all", action="store_true", help="every estimator, LVT and TRUE")
     p.add_argument("--rate", type=float, default=5000.0, metavar="HZ", help="sample rate in Hz, 1000..96000 and at least 6 x f0 (default 5000)")
-    p.add_argument("--seeds", type=int, default=5, metavar="N", help="seeds 0..N-1, N at most 100 (default 5)")
+    p.add_argument("--seeds", type=int, default=5, metavar="N", help="how many seeds (K..K+N-1), N at most 100 (default 5)")
+    p.add_argument("--first-seed", type=int, default=0, metavar="K",
+                   help="the first seed: seeds K..K+N-1, K a whole number >= 0, K+N at most 1000000 (default 0)")
     p.add_argument("--gesture", default="strokes", metavar="strokes|hold",
                    help="strokes (bowing, judged against TRUE's sound and feel) or hold (the hand at rest, with "
                         "tremor) (default strokes)")
@@ -62,7 +65,8 @@ def command_line(args):
     import shlex
 
     which = "--all" if args.all else f"--source {shlex.quote(args.source)}"
-    words = f"studyapp breakdown {which} --rate {args.rate:g} --seeds {args.seeds} --gesture {args.gesture}"
+    words = (f"studyapp breakdown {which} --rate {args.rate:g} --seeds {args.seeds} --first-seed {args.first_seed}"
+             f" --gesture {args.gesture}")
     words += f" --duration {args.duration:g}" + link_options.words(args)
     if args.output:
         words += f" -o {shlex.quote(str(args.output))}"
@@ -80,6 +84,7 @@ def run(args):
     names = breakdown.sources() if args.all else [breakdown.check_source(args.source, "--source")]
     check_playable(validate_rate(args.rate, "--rate"), calibration.F0)
     breakdown.check_seeds(args.seeds, "--seeds")
+    breakdown.check_first_seed(args.first_seed, args.seeds, "--first-seed")
     breakdown.check_gesture(args.gesture, "--gesture")
     breakdown.check_duration(args.duration, "--duration")
     link = link_options.spec(args)
@@ -92,15 +97,17 @@ def run(args):
 
         def progress(seed, trial, fmax, verdict, prefix=prefix):
             # one line per seed; the trials overwrite each other on it
+            count = f"seed {seed - args.first_seed + 1}/{args.seeds}"
             if verdict == "result":
-                line = f"{prefix}: seed {seed + 1}/{args.seeds}: F_max {_number(fmax)} N ({trial} trials)"
+                line = f"{prefix}: {count}: F_max {_number(fmax)} N ({trial} trials)"
                 print("\r" + line.ljust(72), file=sys.stderr, flush=True)
             else:
-                line = f"{prefix}: seed {seed + 1}/{args.seeds}, trial {trial}: {fmax:.3g} N {verdict}"
+                line = f"{prefix}: {count}, trial {trial}: {fmax:.3g} N {verdict}"
                 print("\r" + line.ljust(72), end="", file=sys.stderr, flush=True)
 
         results.append(breakdown.breakdown_over_seeds(name, rate=args.rate, seeds=args.seeds, gesture=args.gesture,
-                                                      duration=args.duration, progress=progress, link=link))
+                                                      duration=args.duration, progress=progress, link=link,
+                                                      first_seed=args.first_seed))
 
     if args.json:
         json.dump(_json(results if args.all else results[0]), sys.stdout, indent=1, allow_nan=False)
@@ -161,13 +168,14 @@ def _cells(result, fmt):
     """A result as the row of ``COLUMNS``, F_max values written with ``fmt``."""
     return [result["source"], f"{result['rate']:g}", result["gesture"], str(result["seeds"]),
             fmt(result["fmax_median"]), fmt(result["fmax_min"]), fmt(result["fmax_max"]),
-            ";".join(fmt(v) for v in result["fmax"])]
+            ";".join(fmt(v) for v in result["fmax"]), str(result["first_seed"]),
+            ";".join(str(s) for s in result["seeds_used"])]
 
 
 def text_table(results):
     rows = [COLUMNS] + [_cells(r, _number) for r in results]
-    widths = [max(len(row[i]) for row in rows) for i in range(len(COLUMNS) - 1)]
-    return "".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[-1] + "\n" for row in rows)
+    widths = [max(len(row[i]) for row in rows) for i in range(len(COLUMNS))]
+    return "".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip() + "\n" for row in rows)
 
 
 def markdown(results, command):
@@ -180,7 +188,8 @@ def markdown(results, command):
         "",
         "The largest F_max (N) at which each velocity source keeps the simulated loop stable, judged by the "
         "stability monitor (`studyapp.model.breakdown`; see [model.md](model.md)). One search per seed (the sensors' "
-        "noise and the hand's tremor); median, min and max over the seeds, then each seed's value. "
+        "noise and the hand's tremor); median, min and max over the seeds, then each seed's value, the first seed and "
+        "the seeds in the order of the values. "
         f"\"{_number(float('inf'))}\": stable up to the search's top; \"{_number(0.0)}\": broken at its bottom.",
         "",
         _link_sentence(results[0]),

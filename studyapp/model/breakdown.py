@@ -32,9 +32,10 @@ arrived (link.py). The reference stays TRUE on an ideal link: a rig's delay
 is judged against the world without it, as the participant would judge it.
 The link's draws are seeded by the trial's seed.
 
-Over seeds, ``breakdown_over_seeds``: seed k (k = 0..N-1) draws the sensors'
-noise and the hand's tremor, so each seed is one run of the same world, like
-one trial of the paper's six per participant. The result gives every seed's
+Over seeds, ``breakdown_over_seeds``: seed k (k = K..K+N-1, K = 0 unless
+``first_seed`` says otherwise) draws the sensors' noise and the hand's tremor,
+so each seed is one run of the same world, like one trial of the paper's six
+per participant; a seed's value does not depend on K or N. The result gives every seed's
 F_max and their median (for even N the mean of the middle two, numpy.median),
 minimum and maximum; inf (stable to 200 N) counts as the largest value.
 It also says the link it ran with (``LINK_KEYS``, seconds).
@@ -62,7 +63,9 @@ HIGH = FMAX_LIMIT  # N, the search's highest F_max
 MAX_SEEDS = 100  # a source's search takes about 0.3 s per seed at 5 kHz; --all with 100 seeds about 10 min
 DURATION_RANGE = (0.5, 60.0)  # s per trial; below about 2 s a late onset is missed (the verdict lags ~1 s)
 DURATION = 5.0  # s per trial by default: about ten strokes
-KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max") + LINK_KEYS
+MAX_SEED_END = 1_000_000  # K + N at most this: seeds stay small whole numbers wherever they are derived from
+KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max", "first_seed",
+        "seeds_used") + LINK_KEYS
 
 
 def sources():
@@ -81,6 +84,15 @@ def check_seeds(n, label="seeds"):
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= MAX_SEEDS:
         raise ParameterError(f"{label} {n!r}: allowed is a whole number from 1 to {MAX_SEEDS}")
     return int(n)
+
+
+def check_first_seed(k, n, label="first seed"):
+    """``k`` if seeds ``k``..``k`` + ``n`` - 1 are allowed: ``k`` a whole number >= 0, ``k`` + ``n`` <= MAX_SEED_END."""
+    if (isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k
+            or k + check_seeds(n) > MAX_SEED_END):
+        raise ParameterError(f"{label} {k!r}: allowed is a whole number from 0 to {MAX_SEED_END - n} "
+                             f"(first seed + seeds at most {MAX_SEED_END})")
+    return int(k)
 
 
 def check_gesture(name, label="gesture"):
@@ -181,11 +193,12 @@ def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, lo
 
 
 def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", duration=DURATION, tolerance=0.02, progress=None,
-                         link=None, estimators=None):
-    """Breakdown F_max for seeds 0..``seeds``-1: a dict with exactly the keys ``KEYS``.
+                         link=None, estimators=None, first_seed=0):
+    """Breakdown F_max for seeds ``first_seed``..``first_seed`` + ``seeds`` - 1: a dict with exactly the keys ``KEYS``.
 
-    ``fmax`` lists the seeds' values (N; inf when stable up to 200 N);
-    ``fmax_median``, ``fmax_min`` and ``fmax_max`` summarise them.
+    ``fmax`` lists the seeds' values (N; inf when stable up to 200 N), in the
+    order of ``seeds_used``; ``fmax_median``, ``fmax_min`` and ``fmax_max``
+    summarise them.
     ``progress(seed, trial, fmax, verdict)`` is called after each trial with
     verdict "stable" or "broken" (trial counts from 1 within the seed), and
     once per seed with verdict "result", ``fmax`` the seed's breakdown F_max
@@ -197,10 +210,12 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
     check_source(source)
     rate = validate_rate(rate)
     seeds = check_seeds(seeds)
+    first_seed = check_first_seed(first_seed, seeds)
     check_gesture(gesture)
     duration = check_duration(duration)
+    used = list(range(first_seed, first_seed + seeds))
     values = []
-    for seed in range(seeds):
+    for seed in used:
         trials = []
 
         def on_trial(fmax, broken, seed=seed, trials=trials):
@@ -215,4 +230,5 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
             progress(seed, len(trials), value, "result")
     return {"source": source, "rate": rate, "gesture": gesture, "seeds": seeds, "fmax": values,
             "fmax_median": float(np.median(values)), "fmax_min": min(values), "fmax_max": max(values),
+            "first_seed": first_seed, "seeds_used": used,
             **{name: getattr(link or IDEAL, name) for name in LINK_KEYS}}

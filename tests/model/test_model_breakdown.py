@@ -57,6 +57,7 @@ def test_over_seeds_summarises_every_seed(monkeypatch):
     assert result["fmax_median"] == pytest.approx(statistics.median(fmax))  # even count: mean of the middle two
     assert result["fmax_min"] == min(fmax) and result["fmax_max"] == math.inf
     assert {seed for seed, _ in calls} == {0, 1, 2, 3}
+    assert (result["first_seed"], result["seeds_used"]) == (0, [0, 1, 2, 3])
     results = [e for e in events if e[3] == "result"]
     assert [(e[0], e[2]) for e in results] == list(enumerate(fmax))
     trials = [e for e in events if e[3] != "result"]
@@ -87,6 +88,10 @@ def test_sources_are_every_estimator_and_true():
     (dict(gesture="strokes-validation"), "gesture 'strokes-validation': allowed are hold, strokes"),
     (dict(duration=0.1), "duration 0.1: allowed is a number of seconds from 0.5 to 60"),
     (dict(rate=500.0), "rate = 500"),
+    (dict(first_seed=-1), "first seed -1: allowed is a whole number from 0 to 999999"),
+    (dict(first_seed=1.0), "first seed 1.0"),
+    (dict(first_seed=True), "first seed True"),
+    (dict(first_seed=999_999, seeds=2), "first seed 999999: allowed is a whole number from 0 to 999998"),
 ])
 def test_bad_settings_are_refused_before_any_trial(monkeypatch, kwargs, words):
     fake, calls = threshold({0: 1.0})
@@ -94,3 +99,16 @@ def test_bad_settings_are_refused_before_any_trial(monkeypatch, kwargs, words):
     with pytest.raises(ParameterError, match=words):
         breakdown.breakdown_over_seeds(**{"source": "LVT", "seeds": 1, **kwargs})
     assert calls == []
+
+
+def test_over_seeds_from_a_first_seed_runs_those_seeds(monkeypatch):
+    edges = {5: 6.0, 6: 2.0, 7: 3.0}
+    fake, calls = threshold(edges)
+    monkeypatch.setattr(breakdown, "is_broken", fake)
+    events = []
+    result = breakdown.breakdown_over_seeds("KALPOS", seeds=3, first_seed=5, progress=lambda *e: events.append(e))
+    assert tuple(result) == breakdown.KEYS
+    assert (result["seeds"], result["first_seed"], result["seeds_used"]) == (3, 5, [5, 6, 7])
+    assert {seed for seed, _ in calls} == {5, 6, 7}
+    assert result["fmax"] == pytest.approx([6.0, 2.0, 3.0], rel=math.sqrt(1.02) - 1)
+    assert [(e[0], e[2]) for e in events if e[3] == "result"] == list(zip([5, 6, 7], result["fmax"]))

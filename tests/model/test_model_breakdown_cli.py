@@ -1,4 +1,4 @@
-"""``studyapp breakdown``: JSON keys and types, progress, the --all CSV and Markdown, bad input."""
+"""``studyapp breakdown``: JSON keys and types, progress, the --all CSV and Markdown, --first-seed, bad input."""
 
 import csv
 import datetime
@@ -11,8 +11,9 @@ import pytest
 from studyapp.cli import main
 from studyapp.model import breakdown
 
-KEYS = ["source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max"]
-COLUMNS = ["source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed"]
+KEYS = ["source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max", "first_seed", "seeds_used"]
+COLUMNS = ["source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed", "first_seed",
+           "seeds_used"]
 LINK = ["latency", "packet", "jitter"]  # issue 29: the link the device ran behind, after today's keys and columns
 
 
@@ -29,6 +30,7 @@ def test_json_for_one_source_with_progress(capsys):
     assert list(doc) == KEYS + LINK and [doc[k] for k in LINK] == [0.0, 0.0, 0.0]
     # issue 20: breakdown is judged while bowing by default
     assert (doc["source"], doc["rate"], doc["gesture"], doc["seeds"]) == ("LOWPASS", 5000.0, "strokes", 2)
+    assert (doc["first_seed"], doc["seeds_used"]) == (0, [0, 1])
     assert len(doc["fmax"]) == 2 and all(isinstance(v, float) and v > 0 for v in doc["fmax"])
     assert doc["fmax_median"] == pytest.approx(statistics.median(doc["fmax"]))
     assert (doc["fmax_min"], doc["fmax_max"]) == (min(doc["fmax"]), max(doc["fmax"]))
@@ -74,18 +76,48 @@ def test_markdown_is_headed_by_date_and_command(never_broken, tmp_path, capsys):
     lines = out.read_text().splitlines()
     header = next(line for line in lines if line.startswith("Generated on"))
     assert datetime.date.today().isoformat() in header
-    assert (f"`studyapp breakdown --all --rate 5000 --seeds 2 --gesture strokes --duration 5 -o {out}`"
+    assert (f"`studyapp breakdown --all --rate 5000 --seeds 2 --first-seed 0 --gesture strokes --duration 5 -o {out}`"
             in header)
     table = [line for line in lines if line.startswith("|")]
     assert table[0] == "| " + " | ".join(COLUMNS) + " |"
     assert [row.split(" | ")[0].strip("| ") for row in table[2:]] == breakdown.sources()
     assert all("> 200" in row for row in table[2:])
+    assert all(row.endswith(" | 0 | 0; 1 |") for row in table[2:])
+
+
+def test_first_seed_gives_the_same_seeds_the_same_values(tmp_path, capsys):
+    """Seeds 1..2 of a run from seed 1 are seeds 1..2 of a run from seed 0: each seed's search is its own."""
+    common = ["breakdown", "--source", "LOWPASS", "--duration", "1.5"]
+    assert main([*common, "--seeds", "3", "--json"]) == 0
+    from_zero = json.loads(capsys.readouterr().out)
+    out_json, out_csv, out_md = tmp_path / "b.json", tmp_path / "b.csv", tmp_path / "b.md"
+    assert main([*common, "--seeds", "2", "--first-seed", "1", "--json", "-o", str(out_json)]) == 0
+    from_one = json.loads(capsys.readouterr().out)
+    assert from_one == json.loads(out_json.read_text())
+    assert (from_zero["first_seed"], from_zero["seeds_used"]) == (0, [0, 1, 2])
+    assert (from_one["first_seed"], from_one["seeds_used"]) == (1, [1, 2])
+    assert from_one["fmax"] == from_zero["fmax"][1:] and all(0.05 < v < 200 for v in from_zero["fmax"])
+    assert from_one["fmax_median"] == pytest.approx(statistics.median(from_zero["fmax"][1:]))
+    assert main([*common, "--seeds", "2", "--first-seed", "1", "-o", str(out_csv)]) == 0
+    (row,) = csv.DictReader(out_csv.open())
+    assert (row["first_seed"], row["seeds_used"]) == ("1", "1;2")
+    assert [float(v) for v in row["fmax_per_seed"].split(";")] == from_one["fmax"]
+    assert main([*common, "--seeds", "2", "--first-seed", "1", "-o", str(out_md)]) == 0
+    text = out_md.read_text()
+    assert "--seeds 2 --first-seed 1 --gesture strokes" in text and text.rstrip().endswith(" | 1 | 1; 2 |")
+    err = capsys.readouterr().err
+    assert "seed 2/2: F_max" in err and "seed 3/2" not in err  # progress counts the run's seeds
 
 
 @pytest.mark.parametrize("argv, words", [
     (["--source", "NOPE"], "--source 'NOPE': allowed are BDIFF"),
     (["--source", "LVT", "--seeds", "0"], "--seeds 0: allowed is a whole number from 1 to 100"),
     (["--source", "LVT", "--seeds", "1000000"], "--seeds 1000000"),
+    (["--source", "LVT", "--first-seed", "-1"], "--first-seed -1: allowed is a whole number from 0 to 999995"),
+    (["--source", "LVT", "--first-seed", "999996"], "--first-seed 999996: allowed is a whole number from 0 to 999995"),
+    (["--source", "LVT", "--seeds", "10", "--first-seed", "999991"], "first seed + seeds at most 1000000"),
+    (["--source", "LVT", "--first-seed", "2.5"], "argument --first-seed: invalid int value: '2.5'"),
+    (["--source", "LVT", "--first-seed", "two"], "argument --first-seed: invalid int value: 'two'"),
     (["--all", "--rate", "500"], "--rate 500: allowed is a number from 1000 to 96000 Hz"),
     (["--source", "LVT", "--gesture", "wiggle"], "--gesture 'wiggle': allowed are hold, strokes"),
     (["--source", "LVT", "--duration", "0"], "--duration 0.0: allowed is a number of seconds from 0.5 to 60"),
