@@ -32,6 +32,8 @@ import multiprocessing
 import threading
 import time
 
+from studyapp.device.link_device import probe_link
+from studyapp.device.link_open import is_link
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine import guard, midi_hotplug
@@ -97,6 +99,8 @@ class Engine(Watchdog):
             raise ParameterError(f"gesture {c.gesture!r}: allowed are {', '.join(live)}")
         parse_audio(c.audio)
         c.check_sizes()
+        if is_link(c.device):
+            probe_link(c.device, c.rate, c.link_options())
         return names
 
     def start(self, timeout=START_TIMEOUT):
