@@ -3,7 +3,7 @@
 DESIGN.md: dependencies point down only, and only studyapp.gui imports Qt. The
 contracts live in .importlinter at the repository root:
 
-- ``layers``: cli > gui > analysis > session > engine | evaluation | experiment > model > estimators
+- ``layers``: cli > gui > analysis > session > engine | evaluation | experiment > device > model > estimators
   > io | stats, indirect imports included (import-linter's default), so no module reaches a
   higher layer through any chain; engine, evaluation and experiment are
   independent; experiment, below analysis, never imports it; io and stats use no other layer;

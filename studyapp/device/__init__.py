@@ -1,0 +1,10 @@
+"""A real device behind a byte link: the protocol's codec, the device-side safety core and the emulator.
+
+docs/device-protocol.md is the protocol a lab implements in firmware. The
+files, one idea each: ``cobs.py`` and ``crc.py`` (the byte stuffing and the
+check), ``frames.py`` (payload <-> wire bytes, a streaming reader),
+``messages.py`` (the message types), ``streams.py`` (sequence numbers and
+counters of one direction), ``device_side.py`` (the safety core a firmware
+must have), ``emulator.py`` (a device on a pty). No module here is compiled
+by numba.
+"""
