@@ -47,6 +47,28 @@ def check_latency(latency):
     return value
 
 
+def check_packet(packet):
+    """The samples per sensor frame (1..255), or ``ParameterError``."""
+    try:
+        value = int(packet)
+    except (TypeError, ValueError):
+        value = 0
+    if value != packet or not 1 <= value <= 255:
+        raise ParameterError(f"device packet = {packet!r}: allowed is a whole number of samples from 1 to 255")
+    return value
+
+
+def check_ramp(ramp_ms):
+    """The ramp after ARM in ms (0..65535), or ``ParameterError``."""
+    try:
+        value = int(ramp_ms)
+    except (TypeError, ValueError):
+        value = -1
+    if value != ramp_ms or not 0 <= value <= 0xFFFF:
+        raise ParameterError(f"device ramp = {ramp_ms!r}: allowed is a whole number of ms from 0 to 65535")
+    return value
+
+
 class Scales:
     """Raw channel values to SI (x m, a m/s^2, v m/s), with where the calibration came from (``source``)."""
 

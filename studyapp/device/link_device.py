@@ -45,6 +45,7 @@ from studyapp.device import messages as msg
 from studyapp.device.errors import ProtocolError
 from studyapp.device.frames import FrameReader, encode
 from studyapp.device.link_open import open_link
+from studyapp.errors import ParameterError
 from studyapp.model.device import DeviceLimits, HapticDevice
 
 SILENCE = 0.020  # s without a device frame, while waiting for one, that makes a device fault
@@ -72,9 +73,9 @@ class LinkDevice(HapticDevice):
         self.spec = str(spec)
         self.rate = float(rate)
         self.latency = handshake.check_latency(latency)
-        self.packet = int(packet)
+        self.packet = handshake.check_packet(packet)
         self.calibration_path = calibration
-        self.ramp_ms = int(ramp_ms)
+        self.ramp_ms = handshake.check_ramp(ramp_ms)
         self.motor_limits = limits
         self.pings = int(pings)
         self.timing = bool(timing)
@@ -112,6 +113,10 @@ class LinkDevice(HapticDevice):
             self.health = health
             self._send(msg.Start(packet=self.packet, latency=self.latency))
             self._streaming = True
+        except (OSError, EOFError) as exc:
+            self.link.close()
+            self.link = None
+            raise ParameterError(f"device at {self.spec}: the link failed during the handshake ({_why(exc)})") from None
         except BaseException:
             self.link.close()
             self.link = None
@@ -334,12 +339,3 @@ def _why(exc):
     text = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
     return text.splitlines()[0]
 
-
-def probe_link(spec, rate, options):
-    """Open the link ``spec``, shake hands (two pings) and close it: ``ParameterError`` (one line) if it is no
-    device for a loop at ``rate``; its ``info`` otherwise. The engine checks a link so before its worker starts."""
-    device = LinkDevice(spec, rate, **{**options, "pings": 2})
-    try:
-        return device.info
-    finally:
-        device.close()

@@ -32,7 +32,7 @@ import multiprocessing
 import threading
 import time
 
-from studyapp.device.link_device import probe_link
+from studyapp.device.link_probe import probe as probe_link
 from studyapp.device.link_open import is_link
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
@@ -100,7 +100,7 @@ class Engine(Watchdog):
         parse_audio(c.audio)
         c.check_sizes()
         if is_link(c.device):
-            probe_link(c.device, c.rate, c.link_options())
+            probe_link(c.device, c.rate, c.device_packet, c.device_calibration, c.device_latency, c.device_ramp_ms)
         return names
 
     def start(self, timeout=START_TIMEOUT):
