@@ -82,6 +82,7 @@ class LinkDevice(HapticDevice):
         self.turnarounds = []  # s, per force frame, when ``timing``
         self.health = dict.fromkeys(HEALTH, 0)
         self.fault = None
+        self.link_lost = False  # the link itself failed (closed, errored): a re-arm reopens it
         self.armed = False
         self.link = None
         self._open()
@@ -215,7 +216,7 @@ class LinkDevice(HapticDevice):
             try:
                 data = self.link.read()
             except (OSError, EOFError) as exc:
-                self._device_fault(f"the link failed ({_why(exc)})")
+                self._link_failed(exc)
                 return None
             if data:
                 self._read_at = time.perf_counter()
@@ -243,7 +244,7 @@ class LinkDevice(HapticDevice):
                 chunk = self._forces[start:start + msg.MAX_FORCES]
                 self._send(msg.Force(sample=tag + start, forces=tuple(chunk)))
         except OSError as exc:
-            self._device_fault(f"the link failed ({_why(exc)})")
+            self._link_failed(exc)
         if self.timing:
             self.turnarounds.append(time.perf_counter() - self._read_at)
         self._forces = []
@@ -290,7 +291,11 @@ class LinkDevice(HapticDevice):
             self._send(message)
         except OSError as exc:
             if not quiet:
-                self._device_fault(f"the link failed ({_why(exc)})")
+                self._link_failed(exc)
+
+    def _link_failed(self, exc):
+        self.link_lost = True
+        self._device_fault(f"the link failed ({_why(exc)})")
 
     def _device_fault(self, text):
         if self.fault is None:
@@ -298,14 +303,17 @@ class LinkDevice(HapticDevice):
             self.disarm(DISARM_FAULT)
 
     def rearm(self, ramp_ms=None):
-        """The experimenter's reset after a device fault: reopen the link if it is gone, shake hands, arm.
+        """The experimenter's reset after a device fault: reopen the link if it failed (and shake hands again),
+        drop the frames that piled up, arm.
 
         ``ParameterError`` (one line) when the device is still not there; the fault stays latched then.
         """
-        if self.fault is not None:
+        if self.fault is not None and self.link_lost:
             self.close()
             self._open()
-            self.fault = None
+            self.link_lost = False
+        self.fault = None
+        self.resync()
         self.arm(ramp_ms)
 
     def resync(self):
@@ -314,12 +322,28 @@ class LinkDevice(HapticDevice):
             try:
                 data = self.link.read()
             except (OSError, EOFError) as exc:
-                self._device_fault(f"the link failed ({_why(exc)})")
+                self._link_failed(exc)
                 break
             self._take(data)
             if not data:
                 break
         self._pending.clear()
+        self._forces = []
+        self._first = None
+
+    def stop_stream(self, timeout=0.2):
+        """STOP the stream and wait for the device's STATE (its own counters: late, lost, corrupt); None if none came."""
+        self.device_state = None
+        self._guarded(msg.Stop(), quiet=True)
+        end = time.monotonic() + timeout
+        while self.device_state is None and self.fault is None and (left := end - time.monotonic()) > 0:
+            if self.link.wait(left):
+                try:
+                    self._take(self.link.read())
+                except (OSError, EOFError) as exc:
+                    self._link_failed(exc)
+        self._streaming = False
+        return self.device_state
 
     def close(self):
         """STOP the stream (force 0) and close the link."""
