@@ -7,8 +7,9 @@ decide:
 - the run starts (after the worker's priming): frames that piled up while the
   worker was busy are dropped (``resync``), then ARM(ramp): the force ramps up
   from 0 (the device's ramp, ``EngineConfig.device_ramp_ms``);
-- a trial starts (``ResetString``): DISARM(0) then ARM(ramp): each trial's
-  force ramps up from 0 again, and the trial's health is reported;
+- a trial starts (``ResetString``): ARM(ramp) again, so each trial's force
+  ramps up from 0 (the device restarts its ramp), and the trial's health is
+  reported;
 - ``force_enable`` cleared (the emergency stop: DISARM(1); the guard or the
   parent's watchdog: DISARM(2)) before the block runs;
 - the experimenter clears the fault (``ClearFault``): a device fault (the link
@@ -68,8 +69,7 @@ class DeviceLink:
         """A trial (re)starts: the last one's health, and the force ramps up from 0 again."""
         self.report(trial)
         if self.device.armed:
-            self.device.disarm()
-            self.device.arm()
+            self.device.arm()  # an ARM while armed restarts the device's ramp from 0
 
     def report(self, trial=None):
         now = dict(self.device.health)
