@@ -18,7 +18,7 @@ import sys
 
 from studyapp import __version__
 from studyapp.cli import (
-    analyse, bench, breakdown, compile_kernels, demo, estimate, estimators, evaluate, export, gui, live, notes, optimise, plan, run,
+    analyse, bench, breakdown, compile_kernels, demo, device_emulator, estimate, estimators, evaluate, export, gui, live, notes, optimise, plan, run,
     simulate, simulate_set, tradeoff,
 )
 from studyapp.cli.number_options import finite_float, integer
@@ -26,7 +26,7 @@ from studyapp.errors import EngineError, UserError
 
 # the sub-commands' modules, in the order shown by --help
 COMMANDS = [gui, demo, estimators, estimate, simulate, simulate_set, breakdown, optimise, evaluate, tradeoff, live, run,
-            plan, notes, export, analyse, bench, compile_kernels]
+            plan, notes, export, analyse, bench, compile_kernels, device_emulator]
 
 
 class UsageError(UserError):

@@ -143,6 +143,8 @@ class Start(_Fixed):
     def check(self):
         super().check()
         _check(self.packet >= 1, "START.packet", self.packet, "1..255 samples")
+        # the force for sample j answers the frame holding sample j - latency, sent once its last sample is in
+        _check(self.latency >= self.packet - 1, "START.latency", self.latency, f"at least packet - 1 = {self.packet - 1}")
 
 
 @dataclass(frozen=True)

@@ -175,6 +175,7 @@ def test_info_round_trip(name, serial, rate, watchdog):
     (b"\x84\x00\x07", "DISARM.reason"),
     (b"\x83\x00\x01", "ARM body"),
     (b"\x85\x00\x00\x01\x00", "START.packet"),
+    (b"\x85\x00\x05\x03\x00", "START.latency"),
     (b"\x99\x00", "type 0x99"),
     (b"\x02\x00" + struct.pack("<IBB", 0, 1, 0), "SENSORS body length"),
     (b"\x04\x00" + struct.pack("<BII", 9, 0, 0), "FAULT.code"),

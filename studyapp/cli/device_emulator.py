@@ -1,0 +1,78 @@
+"""``studyapp device-emulator``: a device that speaks the device protocol on a pty, for hosts and tests.
+
+    studyapp device-emulator --link PATH [--rate HZ] [--seed N] [--gesture strokes|hold]
+        [--latency S] [--jitter S] [--loss P] [--corrupt P] [--disconnect-after S] [--lockstep]
+        [--format f64|counts] [--core auto|c|python] [--watchdog-ms MS]
+
+Makes PATH a link to the device end of a new pty (as socat does) and prints
+``ready: PATH`` once it exists; runs until SIGTERM / Ctrl-C (or
+``--disconnect-after``), removes the link and prints ``stats: {json}``.
+studyapp/device/emulator.py says what it simulates; docs/device-protocol.md
+what it speaks. A bad option: one line, exit 2, no link made.
+"""
+
+from studyapp.cli import number_options
+
+RATE_RANGE = (100, 100000)
+
+
+def register(sub):
+    p = sub.add_parser("device-emulator", help="emulate a device speaking the device protocol on a pty link")
+    p.add_argument("--link", required=True, metavar="PATH", help="the path to make a link to the pty's device end")
+    p.add_argument("--rate", type=float, default=5000.0,
+                   help=f"sample rate in Hz, a whole number {RATE_RANGE[0]}..{RATE_RANGE[1]} (default 5000)")
+    p.add_argument("--seed", type=number_options.seed, default=0, help="sensor noise and link faults (default 0)")
+    p.add_argument("--gesture", default="strokes", help="the virtual hand's gesture: strokes | hold (default strokes)")
+    p.add_argument("--latency", type=float, default=0.0, help="seconds the device's received frames are delayed")
+    p.add_argument("--jitter", type=float, default=0.0, help="extra delay, uniform over 0..S seconds")
+    p.add_argument("--loss", type=float, default=0.0, help="probability a frame is lost (either way)")
+    p.add_argument("--corrupt", type=float, default=0.0, help="probability a frame has a bit flipped (either way)")
+    p.add_argument("--disconnect-after", type=float, default=None, metavar="S",
+                   help="close the link after S seconds")
+    p.add_argument("--lockstep", action="store_true",
+                   help="no clock: advance only once the force tagged for the sample is in (tests)")
+    p.add_argument("--format", default="f64", help="sensor channels: f64 (SI) | counts (i32 with a gain)")
+    p.add_argument("--core", default="auto",
+                   help="firmware core: auto (C if it builds) | c | python (default auto)")
+    p.add_argument("--watchdog-ms", type=int, default=1, help="the device's watchdog, 1..1000 ms (default 1)")
+    p.set_defaults(func=run)
+
+
+def config_from(args):
+    from studyapp.device.emulator import CORES, FORMATS, GESTURES, EmulatorConfig
+    from studyapp.device.pty_link import check_path
+    from studyapp.errors import UserError
+
+    def need(ok, text):
+        if not ok:
+            raise UserError(text)
+
+    need(args.rate == int(args.rate) and RATE_RANGE[0] <= args.rate <= RATE_RANGE[1],
+         f"--rate {args.rate:g}: allowed is a whole number of Hz from {RATE_RANGE[0]} to {RATE_RANGE[1]}")
+    need(args.gesture in GESTURES, f"--gesture {args.gesture!r}: allowed are {', '.join(GESTURES)}")
+    need(args.format in FORMATS, f"--format {args.format!r}: allowed are {', '.join(FORMATS)}")
+    need(args.core in CORES, f"--core {args.core!r}: allowed are {', '.join(CORES)}")
+    for name in ("latency", "jitter"):
+        value = getattr(args, name)
+        need(0.0 <= value <= 10.0, f"--{name} {value:g}: allowed is 0 to 10 seconds")
+    for name in ("loss", "corrupt"):
+        value = getattr(args, name)
+        need(0.0 <= value <= 1.0, f"--{name} {value:g}: allowed is a probability from 0 to 1")
+    need(args.disconnect_after is None or args.disconnect_after > 0.0,
+         f"--disconnect-after {args.disconnect_after}: allowed is a number of seconds above 0")
+    need(1 <= args.watchdog_ms <= 1000, f"--watchdog-ms {args.watchdog_ms}: allowed is 1 to 1000")
+    faults = [n for n in ("latency", "jitter", "loss", "corrupt") if getattr(args, n)]
+    need(not (args.lockstep and faults),
+         f"--lockstep with --{faults[0] if faults else ''}: lock-step waits for every force, so it takes no "
+         "link faults (allowed: --disconnect-after)")
+    check_path(args.link)
+    return EmulatorConfig(link=args.link, rate=int(args.rate), seed=args.seed, gesture=args.gesture,
+                          latency=args.latency, jitter=args.jitter, loss=args.loss, corrupt=args.corrupt,
+                          disconnect_after=args.disconnect_after, lockstep=args.lockstep, format=args.format,
+                          core=args.core, watchdog_ms=args.watchdog_ms)
+
+
+def run(args):
+    config = config_from(args)
+    from studyapp.device.emulator import Emulator
+    return Emulator(config).run()
