@@ -1,4 +1,5 @@
-"""``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--gesture strokes|hold] [--json] [-o FILE]``.
+"""``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--gesture strokes|hold] [--latency S]
+[--packet S] [--jitter S] [--json] [-o FILE]``.
 
 Breakdown F_max (studyapp.model.breakdown) for one source or every source,
 over seeds 0..N-1. Prints a table (or with ``--json`` one JSON object for
@@ -8,10 +9,17 @@ over seeds 0..N-1. Prints a table (or with ``--json`` one JSON object for
 command that regenerates it) or ``.json``. Stable up to the search's 200 N is
 ``inf`` in CSV, ``null`` in JSON and "> 200" in Markdown; broken already at
 0.05 N is 0.05, "<= 0.05" in Markdown. Progress goes to stderr.
+
+``--latency``, ``--packet`` and ``--jitter`` (seconds, default 0) put the
+simulated device behind a link (studyapp.model.link); the JSON has their keys,
+the CSV their columns (after today's), the Markdown a sentence naming them.
 """
+
+from studyapp.cli import link_options
 
 SUFFIXES = (".csv", ".md", ".json")
 COLUMNS = ("source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed")
+LINK_COLUMNS = ("latency", "packet", "jitter")  # s, the link's (studyapp.model.link.NAMES)
 
 
 def register(subparsers):
@@ -31,6 +39,7 @@ def register(subparsers):
                         "tremor) (default strokes)")
     p.add_argument("--duration", type=float, default=5.0, metavar="SECONDS",
                    help="length of each trial, 0.5..60 s (default 5; shorter misses late onsets)")
+    link_options.add(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of the table")
     p.add_argument("-o", "--output", metavar="FILE", help="also write the result: .csv, .md or .json")
     p.set_defaults(func=run)
@@ -54,7 +63,7 @@ def command_line(args):
 
     which = "--all" if args.all else f"--source {shlex.quote(args.source)}"
     words = f"studyapp breakdown {which} --rate {args.rate:g} --seeds {args.seeds} --gesture {args.gesture}"
-    words += f" --duration {args.duration:g}"
+    words += f" --duration {args.duration:g}" + link_options.words(args)
     if args.output:
         words += f" -o {shlex.quote(str(args.output))}"
     return words
@@ -72,6 +81,7 @@ def run(args):
     breakdown.check_seeds(args.seeds, "--seeds")
     breakdown.check_gesture(args.gesture, "--gesture")
     breakdown.check_duration(args.duration, "--duration")
+    link = link_options.spec(args)
     if args.output:
         check_output(args.output)
 
@@ -89,7 +99,7 @@ def run(args):
                 print("\r" + line.ljust(72), end="", file=sys.stderr, flush=True)
 
         results.append(breakdown.breakdown_over_seeds(name, rate=args.rate, seeds=args.seeds, gesture=args.gesture,
-                                                      duration=args.duration, progress=progress))
+                                                      duration=args.duration, progress=progress, link=link))
 
     if args.json:
         json.dump(_json(results if args.all else results[0]), sys.stdout, indent=1, allow_nan=False)
@@ -113,8 +123,8 @@ def write(path, results, args):
     with atomic_open(path, "w", newline="", encoding="utf-8") as f:
         if suffix == ".csv":
             writer = csv.writer(f, lineterminator="\n")
-            writer.writerow(COLUMNS)
-            writer.writerows([_cells(r, repr) for r in results])
+            writer.writerow(COLUMNS + LINK_COLUMNS)
+            writer.writerows([_cells(r, repr) + [repr(r[name]) for name in LINK_COLUMNS] for r in results])
         elif suffix == ".md":
             f.write(markdown(results, command_line(args)))
         else:
@@ -172,8 +182,18 @@ def markdown(results, command):
         "noise and the hand's tremor); median, min and max over the seeds, then each seed's value. "
         f"\"{_number(float('inf'))}\": stable up to the search's top; \"{_number(0.0)}\": broken at its bottom.",
         "",
+        _link_sentence(results[0]),
+        "",
         "| " + " | ".join(COLUMNS) + " |",
         "|" + " --- |" * len(COLUMNS),
     ]
     lines += ["| " + " | ".join(_cells(r, _number)).replace(";", "; ") + " |" for r in results]
     return "\n".join(lines) + "\n"
+
+
+def _link_sentence(result):
+    """The link the device ran behind, from a result's ``LINK_COLUMNS`` (seconds)."""
+    if not any(result[name] for name in LINK_COLUMNS):
+        return "The simulated device is on an ideal link (latency, packet and jitter 0: the paper's loop)."
+    times = ", ".join(f"{name} {result[name] * 1000:g} ms" for name in LINK_COLUMNS)
+    return f"The simulated device is behind a link (`studyapp.model.link`): {times}."

@@ -1,6 +1,6 @@
 """``studyapp simulate``: one simulated recording of bowing the string through the closed loop."""
 
-from studyapp.cli import number_options
+from studyapp.cli import link_options, number_options
 
 SOURCES_HELP = "velocity source in the loop: an estimator name, LVT or TRUE (default LVT)"
 
@@ -19,6 +19,7 @@ def register(subparsers):
     p.add_argument("--gesture", default="strokes", help="strokes, strokes-validation or hold (default strokes)")
     p.add_argument("--f0", type=float, default=None, help="string pitch in Hz (default: the model's)")
     p.add_argument("--seed", type=number_options.seed, default=0, help="random seed (default 0)")
+    link_options.add(p)
     p.add_argument("-o", "--output", required=True, help="output file: .h5, .npz or .csv")
     p.set_defaults(func=run)
 
@@ -64,12 +65,13 @@ def run(args):
     check_fmax(args.fmax)
     check_source(args.source)
     check_gesture(args.gesture)
+    link = link_options.spec(args)
 
     def progress(done, total):
         print(f"\rsimulate: {100 * done // total:3d}%", end="", file=sys.stderr, flush=True)
 
     rec = simulate(args.fmax, rate=args.rate, duration=args.duration, source=args.source,
-                   gesture=args.gesture, f0=args.f0, seed=args.seed, progress=progress)
+                   gesture=args.gesture, f0=args.f0, seed=args.seed, progress=progress, link=link)
     print("", file=sys.stderr)
     recording.save(rec, args.output)
     print(f"wrote {args.output} ({len(rec)} samples at {rec.rate:g} Hz, F_max {args.fmax:g} N, source {args.source})",

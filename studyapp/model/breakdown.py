@@ -26,11 +26,18 @@ sqrt(lo hi), within a factor sqrt(1 + tolerance) of the edge. That takes
 2 + ceil(log2(ln(HIGH / LOW) / ln(1 + tolerance))) trials (11 at tolerance
 0.02). It returns LOW when LOW already breaks and inf when HIGH does not.
 
+Behind a link (``link``, a link.LinkSpec: latency, packets, jitter, frame
+loss; issue 29): the simulated device applies the newest command that has
+arrived (link.py). The reference stays TRUE on an ideal link: a rig's delay
+is judged against the world without it, as the participant would judge it.
+The link's draws are seeded by the trial's seed.
+
 Over seeds, ``breakdown_over_seeds``: seed k (k = 0..N-1) draws the sensors'
 noise and the hand's tremor, so each seed is one run of the same world, like
 one trial of the paper's six per participant. The result gives every seed's
 F_max and their median (for even N the mean of the middle two, numpy.median),
 minimum and maximum; inf (stable to 200 N) counts as the largest value.
+It also says the link it ran with (``LINK_KEYS``, seconds).
 """
 
 import functools
@@ -44,6 +51,7 @@ from studyapp.estimators.spec import validate_rate
 from studyapp.model import bowing_reference, stability
 from studyapp.model.calibration import F0
 from studyapp.model.limits import BREAKDOWN_GESTURES, FMAX_LIMIT
+from studyapp.model.link import IDEAL, NAMES as LINK_KEYS
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import is_pseudo, with_pseudo_sources
 
@@ -54,7 +62,7 @@ HIGH = FMAX_LIMIT  # N, the search's highest F_max
 MAX_SEEDS = 100  # a source's search takes about 0.3 s per seed at 5 kHz; --all with 100 seeds about 10 min
 DURATION_RANGE = (0.5, 60.0)  # s per trial; below about 2 s a late onset is missed (the verdict lags ~1 s)
 DURATION = 5.0  # s per trial by default: about ten strokes
-KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max")
+KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max") + LINK_KEYS
 
 
 def sources():
@@ -92,14 +100,16 @@ def check_duration(seconds, label="duration"):
     return value
 
 
-def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, seed=0, estimators=None, f0=None):
-    """Whether ``source`` at ``fmax`` N breaks down within ``duration`` s of ``gesture`` (the module's criteria)."""
+def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, seed=0, estimators=None, f0=None,
+              link=None):
+    """Whether ``source`` at ``fmax`` N breaks down within ``duration`` s of ``gesture`` (the module's criteria),
+    the device behind ``link`` (a link.LinkSpec; None: ideal)."""
     estimators = dict(estimators or {})
     if not is_pseudo(source) and source not in estimators:
         estimators[source] = {}
     f0 = F0 if f0 is None else f0
     loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
-                                 f0=f0, seed=seed, audio=False), judge=False)
+                                 f0=f0, seed=seed, audio=False, link=link), judge=False)
     if gesture == "hold":
         return _broken_holding(loop, duration)
     total = int(round(duration * loop.rate))
@@ -139,16 +149,16 @@ def _true_bowing(rate, f0, gesture, fmax, total, seed):
 
 
 def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, low=LOW, high=HIGH, tolerance=0.02,
-                   seed=0, estimators=None, f0=None, progress=None):
+                   seed=0, estimators=None, f0=None, progress=None, link=None):
     """The largest F_max (N) at which ``source`` stays stable, by bisection on a log scale.
 
     Stable means: ``is_broken`` is False (bowing ``strokes`` by default;
     ``gesture="hold"``: the hand holding the handle, with tremor). Returns ``low`` if even ``low`` breaks down and ``inf`` if
     ``high`` does not; otherwise the geometric midpoint of the final bracket,
     whose width is at most ``tolerance`` (relative). ``progress(fmax, broken)``
-    is called after each trial.
+    is called after each trial. ``link``: the device's link (None: ideal).
     """
-    kwargs = dict(rate=rate, gesture=gesture, duration=duration, seed=seed, estimators=estimators, f0=f0)
+    kwargs = dict(rate=rate, gesture=gesture, duration=duration, seed=seed, estimators=estimators, f0=f0, link=link)
 
     def trial(fmax):
         broken = is_broken(source, fmax, **kwargs)
@@ -170,7 +180,8 @@ def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, lo
     return math.sqrt(lo * hi)
 
 
-def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", duration=DURATION, tolerance=0.02, progress=None):
+def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", duration=DURATION, tolerance=0.02, progress=None,
+                         link=None, estimators=None):
     """Breakdown F_max for seeds 0..``seeds``-1: a dict with exactly the keys ``KEYS``.
 
     ``fmax`` lists the seeds' values (N; inf when stable up to 200 N);
@@ -178,7 +189,10 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
     ``progress(seed, trial, fmax, verdict)`` is called after each trial with
     verdict "stable" or "broken" (trial counts from 1 within the seed), and
     once per seed with verdict "result", ``fmax`` the seed's breakdown F_max
-    and ``trial`` the number of trials it took.
+    and ``trial`` the number of trials it took. ``link`` (a link.LinkSpec; None:
+    ideal) is the device's link, ``latency``, ``packet`` and ``jitter`` its
+    times (s); ``estimators``: name -> params of the estimators in the loop
+    (the source's Table 1 defaults when not given).
     """
     check_source(source)
     rate = validate_rate(rate)
@@ -195,9 +209,10 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
                 progress(seed, len(trials), fmax, "broken" if broken else "stable")
 
         value = breakdown_fmax(source, rate=rate, gesture=gesture, duration=duration, tolerance=tolerance,
-                               seed=seed, progress=on_trial)
+                               seed=seed, progress=on_trial, link=link, estimators=estimators)
         values.append(float(value))
         if progress is not None:
             progress(seed, len(trials), value, "result")
     return {"source": source, "rate": rate, "gesture": gesture, "seeds": seeds, "fmax": values,
-            "fmax_median": float(np.median(values)), "fmax_min": min(values), "fmax_max": max(values)}
+            "fmax_median": float(np.median(values)), "fmax_min": min(values), "fmax_max": max(values),
+            **{name: getattr(link or IDEAL, name) for name in LINK_KEYS}}

@@ -37,6 +37,10 @@ Built only as needed: the default device has no accelerometer (filter,
 noise) when no active estimator reads acceleration (unless
 ``accelerometer=True``), and there is no body filter when ``audio=False``.
 
+The default device's link to the host (``LoopConfig.link``, link.py): ideal
+by default; with a latency, packets, jitter or frame loss the device applies
+the newest command that has arrived, and F[k] acts later than [k, k+1].
+
 Safety: a non-finite value anywhere (sensor, estimate, string, force) latches
 ``fault`` (a one-line description); from that sample on the force is 0 and
 the bow is lifted. A device that reports its own ``fault`` has it latched at
@@ -59,6 +63,7 @@ from studyapp.model.control import (
 from studyapp.model.device import N_LIMIT_STATE, HapticDevice
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
 from studyapp.model.limits import FMAX_LIMIT, GESTURES
+from studyapp.model.link import LinkSpec
 from studyapp.model.simulated_device import SimulatedDevice
 from studyapp.model.sources import LVT_SENSOR, LVT_SENSOR_INDEX, TRUE, TRUE_INDEX, with_pseudo_sources
 from studyapp.model.stability import StabilityMonitor
@@ -80,6 +85,7 @@ class LoopConfig:
     audio: bool = True
     accelerometer: bool | None = None  # None: only when an active estimator reads it
     trajectory: np.ndarray | None = None  # for gesture "playback" (m, at the loop rate)
+    link: LinkSpec | None = None  # the simulated device's link (link.py); None: ideal
 
 
 def make_gesture(name, rate, trajectory=None, position=0.0):
@@ -142,7 +148,7 @@ class ClosedLoop:
         self.reads = set(self.bank.reads)
         if device is None:
             use_acc = ("acceleration" in self.reads) if config.accelerometer is None else bool(config.accelerometer)
-            device = SimulatedDevice(self.rate, seed=config.seed, accelerometer=use_acc)
+            device = SimulatedDevice(self.rate, seed=config.seed, accelerometer=use_acc, link=config.link)
         elif not isinstance(device, HapticDevice):
             raise ParameterError(f"device {type(device).__name__}: expected a studyapp.model.device.HapticDevice "
                                  "(subclass it and implement read_sensors and write_force)")

@@ -6,7 +6,10 @@ with the columns of the paper's recordings (LVDT position, LVT velocity,
 acceleration) plus the simulation's ground truth (true velocity and
 acceleration), the force command, the string velocity at the bow and the audio.
 The accelerometer is always simulated here, so every estimator can later be
-run on the recording.
+run on the recording. ``link`` (a link.LinkSpec) puts the simulated device
+behind a link (latency, packets, jitter, frame loss; link.py); the metadata's
+``link`` says which (seconds and samples), and the ``force`` column is the
+host's command, before the link.
 """
 
 import numpy as np
@@ -15,6 +18,7 @@ from studyapp import __version__
 from studyapp.errors import ParameterError
 from studyapp.io.recording import COLUMNS, Recording
 from studyapp.model import calibration
+from studyapp.model.link import IDEAL
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import LVT_SENSOR, is_pseudo
 
@@ -23,7 +27,7 @@ DURATION_MAX = 3600.0
 
 
 def simulate(fmax, rate=5000.0, duration=7.0, source=LVT_SENSOR, gesture="strokes", f0=None, seed=0,
-             estimators=None, progress=None):
+             estimators=None, progress=None, link=None):
     """A ``Recording`` of ``duration`` s of bowing at ``fmax`` N with ``source`` in the loop.
 
     ``estimators``: the active set (names or name -> params); the source is
@@ -45,7 +49,7 @@ def simulate(fmax, rate=5000.0, duration=7.0, source=LVT_SENSOR, gesture="stroke
         estimators[source] = {}
     f0 = calibration.F0 if f0 is None else f0
     config = LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
-                        f0=f0, seed=seed, audio=True, accelerometer=True)
+                        f0=f0, seed=seed, audio=True, accelerometer=True, link=link)
     loop = ClosedLoop(config)
     total = int(round(duration * loop.rate))
     parts = {name: [] for name in COLUMNS}
@@ -69,5 +73,6 @@ def simulate(fmax, rate=5000.0, duration=7.0, source=LVT_SENSOR, gesture="stroke
         "velocity_scale": loop.velocity_scale, "fault": loop.fault,
         "broken": bool(broken),  # the stability monitor flagged breakdown at some block
         "model": calibration.describe(),
+        "link": (link or IDEAL).describe(loop.rate),
     }
     return Recording(loop.rate, columns, meta)

@@ -20,12 +20,19 @@ gesture. With s = (x, v, x_h, v_h), end-effector then hand,
 The force command F[k] computed from the sensors at sample k is held over
 [k, k+1] (zero-order hold), and so is the arm's force F_arm[k] from the state
 at k; so the position sampled at k+1 is the first to feel F[k]: the one-step
-delay of the paper's Fig. 1 and Sec. 2. Over one step the pair moves exactly
+delay of the paper's Fig. 1 and Sec. 2. Behind a link (``link``, a
+link.LinkSpec: latency, packets, jitter, frame loss; link.py states the maths)
+the device applies instead the link's force u[k], the newest command that has
+arrived: with a fixed latency of L samples u[k] = F[k - L] (0 N before the
+first command arrives). The recorded force is the host's command F[k]; the
+hand and the mechanics feel u[k]. The default link is ideal: u[k] = F[k].
+
+Over one step the pair moves exactly
 (the zero-order-hold discretisation, Phi = exp(A T) and
 Gamma = int_0^T exp(A s) ds B, computed once with scipy.linalg.expm), so the
 stiff grip is stable at every rate:
 
-    s[k+1] = Phi s[k] + Gamma (F[k], F_arm[k]).
+    s[k+1] = Phi s[k] + Gamma (u[k], F_arm[k]).
 
 The end-effector's acceleration is its mean over the step, (v[k+1] - v[k]) / T.
 An end stop is inelastic: the end-effector's position is held at the stop and
@@ -40,8 +47,9 @@ one compiled function that calls the loop's compiled controller
 in the live engine the audio device's callback thread needs it). Python runs
 only at block boundaries there: it draws the block's sensor noise from seeded
 generators (one per sensor, two for the accelerometer's white and
-low-frequency noise, so the stream does not depend on how the run is cut into
-blocks or samples) and computes the gesture's target. A gesture defined per
+low-frequency noise, two for the link's jitter and frame loss, so the stream
+does not depend on how the run is cut into blocks or samples), the link's
+per-packet delays, and the gesture's target. A gesture defined per
 block (``Live``, which ramps to its new target across the next block) ramps
 across one sample when read sample by sample.
 
@@ -59,6 +67,7 @@ from studyapp.estimators.dispatch import step_guarded
 from studyapp.model import calibration, contact_mic, control, hand, sensors, stability
 from studyapp.model.device import DeviceLimits, HapticDevice
 from studyapp.model.gestures import Hold
+from studyapp.model.link import IDEAL, Link, step as link_step
 from studyapp.model.sources import TRUE_INDEX
 
 DP_T, DP_MASS, DP_TRAVEL, DP_ACCELEROMETER, DP_KG, DP_BG = range(6)
@@ -156,7 +165,7 @@ def actuate(dp, ds, hp, f, f_arm):
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, noise_v, noise_a, noise_lf,
-              out, est_out):
+              link_s, delays, out, est_out):
     """``target.shape[0]`` samples of the device and the loop's controller ``c``: control.sample's sequence."""
     ctl, state, lp, ls, kinds, est_s, est_p, sp, ss, bridge, nut, body_p, body_s, mon_p, mon_s, mic_p, mic_s = c
     src = int(ctl[control.C_SOURCE])
@@ -184,7 +193,7 @@ def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, nois
             out[control.O_AUDIO, k] += contact_mic.step(mic_p, mic_s, a)
         f = control.command(state, lp, ls, k, f)
         control.record(out, k, x_m, a_m, v_m, x, v, a, f, f_hand if np.isfinite(f_hand) else 0.0)
-        actuate(dp, ds, hp, f, f_arm)
+        actuate(dp, ds, hp, link_step(link_s, f, delays[k]), f_arm)
 
 
 @njit(cache=True, error_model="numpy")
@@ -203,18 +212,19 @@ def grip_once(dp, ds):
 
 
 @njit(cache=True, error_model="numpy")
-def write_once(dp, ds, hp, f, f_arm):
-    actuate(dp, ds, hp, f, f_arm)
+def write_once(dp, ds, hp, f, f_arm, link_s, delay):
+    actuate(dp, ds, hp, link_step(link_s, f, delay), f_arm)
 
 
 class SimulatedDevice(HapticDevice):
     """The simulated device and the virtual hand holding it (calibration.py documents the constants).
 
-    ``seed`` seeds the sensors' noise; ``accelerometer=False`` leaves the accelerometer out (it reads 0).
+    ``seed`` seeds the sensors' noise and the link's draws; ``accelerometer=False`` leaves the accelerometer out
+    (it reads 0); ``link`` (a link.LinkSpec, default ideal) is the link between the host and the device.
     """
 
     def __init__(self, rate, mass=calibration.DEVICE_MASS, limits=DeviceLimits(), *, hand_impedance=None,
-                 sensor_spec=None, seed=0, accelerometer=True):
+                 sensor_spec=None, seed=0, accelerometer=True, link=None):
         self.rate = float(rate)
         self.mass = float(mass)
         self.limits = limits
@@ -238,9 +248,12 @@ class SimulatedDevice(HapticDevice):
         self._hp = self.hand.params(self.mass + self.hand.mass, self.rate)
         self._snp = self.sensor_spec.params(self.rate)
         self._sns = np.zeros(sensors.N_STATE)
-        # the accelerometer's low-frequency noise is the 4th child, so the first three streams stay as they were
-        streams = np.random.SeedSequence(int(seed)).spawn(4)
-        self._rng_x, self._rng_v, self._rng_a, self._rng_lf = (np.random.default_rng(s) for s in streams)
+        # the accelerometer's low-frequency noise is the 4th child, so the first three streams stay as they were;
+        # the link's two draws are the 5th and 6th (spawn(6)[:4] == spawn(4))
+        streams = np.random.SeedSequence(int(seed)).spawn(6)
+        self._rng_x, self._rng_v, self._rng_a, self._rng_lf = (np.random.default_rng(s) for s in streams[:4])
+        self.link = link or IDEAL
+        self._link = Link(self.link, self.rate, streams[4:])
         self._sample = 0
         self._gesture = Hold()
         self._gesture_start = 0
@@ -281,7 +294,8 @@ class SimulatedDevice(HapticDevice):
     def write_force(self, force):
         target = self._target if self._target is not None else tuple(float(t[0]) for t in self._targets(1))
         f_arm = hand_once(self._hp, self._ds, *target)
-        write_once(self._dp, self._ds, self._hp, float(force), f_arm)
+        write_once(self._dp, self._ds, self._hp, float(force), f_arm, self._link.state,
+                   float(self._link.delays(1)[0]))
         self._target = None
         self._sample += 1
 
@@ -289,5 +303,5 @@ class SimulatedDevice(HapticDevice):
         target, target_v, target_a = self._targets(n)
         nx, nv, na, nl = self._noise(n)
         run_block(control.arrays, self._dp, self._ds, self._hp, self._snp, self._sns, target, target_v, target_a,
-                  nx, nv, na, nl, out, est_out)
+                  nx, nv, na, nl, self._link.state, self._link.delays(n), out, est_out)
         self._sample += n
