@@ -18,7 +18,7 @@ import time
 
 from studyapp.errors import EngineError
 
-READY_TIMEOUT = 60.0  # s: the emulator imports the simulated device (numba's cache) before it is ready
+READY_TIMEOUT = 300.0  # s: the emulator loads the simulated device (compiled on a fresh cache) before it is ready
 
 
 class EmulatorProcess:

@@ -5,8 +5,8 @@ that speaks another protocol version, runs at a rate other than the loop's,
 declares force limits above the motor's (model/limits.py: 200 N impulsive,
 60 N sustained), has no position channel, or sends fewer samples per frame
 than asked. A device that does not answer HELLO within ``HELLO_TIMEOUT`` in
-``HELLO_TRIES`` tries is refused too: the whole handshake is bounded (under
-2 s), never a hang.
+``HELLO_TRIES`` tries is refused too: the whole handshake is bounded (about
+1 s), never a hang.
 
 Calibration: SI = gain * raw + offset per channel, INFO's own or the lab's
 TOML file's (calibration_file.py); a float64 channel with gain 1 and offset 0
@@ -19,16 +19,16 @@ the driver's ``info``. A PONG that does not come within ``PING_TIMEOUT`` is a
 refusal: a link that loses a handshake frame will not stream.
 """
 
+import math
+import statistics
 import time
-
-import numpy as np
 
 from studyapp.device import calibration_file
 from studyapp.device import messages as msg
 from studyapp.errors import ParameterError
 
-HELLO_TIMEOUT = 0.5  # s per HELLO
-HELLO_TRIES = 3
+HELLO_TIMEOUT = 0.4  # s per HELLO
+HELLO_TRIES = 2
 PINGS = 20
 PING_TIMEOUT = 0.2  # s
 CHANNEL_NAMES = calibration_file.CHANNELS  # INFO's channel kinds 0, 1, 2
@@ -150,6 +150,15 @@ def probe(send, receive, link, pings):
                 times.append(time.perf_counter() - started)
                 break
     if not times:
-        return {"median": float("nan"), "p99": float("nan")}
-    ms = 1e3 * np.asarray(times)
-    return {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
+        return {"median": math.nan, "p99": math.nan}
+    ms = sorted(1e3 * t for t in times)
+    return {"median": statistics.median(ms), "p99": percentile(ms, 99)}
+
+
+def percentile(ordered, q):
+    """The ``q``-th percentile of the sorted list ``ordered``, interpolated linearly (numpy's default);
+    here so that the handshake loads no numpy (the probe must answer within seconds on a loaded machine)."""
+    position = (len(ordered) - 1) * q / 100.0
+    low = math.floor(position)
+    high = min(low + 1, len(ordered) - 1)
+    return ordered[low] + (ordered[high] - ordered[low]) * (position - low)

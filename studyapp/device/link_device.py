@@ -82,6 +82,9 @@ class LinkDevice(HapticDevice):
         self.turnarounds = []  # s, per force frame, when ``timing``
         self.health = dict.fromkeys(HEALTH, 0)
         self.fault = None
+        self.fault_time = None  # time.monotonic() when ``fault`` was set
+        self.last_data = None  # time.monotonic() when bytes last came from the device while streaming
+        self.device_faults = []  # (code, sample, detail) of every FAULT frame, oldest first
         self.link_lost = False  # the link itself failed (closed, errored): a re-arm reopens it
         self.armed = False
         self.link = None
@@ -180,6 +183,7 @@ class LinkDevice(HapticDevice):
                 self._sensors(message)
             elif isinstance(message, msg.Fault):
                 self.health["faults"] += 1
+                self.device_faults.append((message.code, message.sample, message.detail))
                 if message.code in LATCHING:
                     self._device_fault(f"the device reported {msg.FAULT_NAMES.get(message.code, message.code)} "
                                        f"at its sample {message.sample}")
@@ -220,6 +224,7 @@ class LinkDevice(HapticDevice):
                 return None
             if data:
                 self._read_at = time.perf_counter()
+                self.last_data = time.monotonic()
                 self._take(data)
                 if self._pending:
                     return self._pending.pop(0)
@@ -300,6 +305,7 @@ class LinkDevice(HapticDevice):
     def _device_fault(self, text):
         if self.fault is None:
             self.fault = text
+            self.fault_time = time.monotonic()
             self.disarm(DISARM_FAULT)
 
     def rearm(self, ramp_ms=None):

@@ -273,8 +273,6 @@ class Worker(ControlRouting):
         gc.collect()
         gc.freeze()
         self.sink.start()
-        if self.link is not None:
-            self.link.started()
 
     def step(self, started):
         """One block; returns (finished, wall-clock compute, CPU time of this thread)."""
@@ -314,6 +312,8 @@ class Worker(ControlRouting):
         }))
         parent = multiprocessing.parent_process()
         pacing = self.pacing = Pacing(self.sink, self.period, self.k, self.loop.device)
+        if self.link is not None:
+            self.link.started()  # fresh frames, ARM: the device's watchdog runs from here
         next_parent_check = pacing.start
         while not self.stopping:
             if pacing.wait(self.k):
