@@ -63,13 +63,16 @@ class LinkDevice(HapticDevice):
     ``latency``: samples ahead the host answers (FORCE tagged sensor sample + latency);
     ``packet``: samples per sensor frame; ``calibration``: a TOML file keyed by serial
     number (None: the device's own); ``ramp_ms``: the force's ramp after each ARM;
-    ``timing``: keep every host turnaround (sensor frame read -> force frame written), for benchmarks.
+    ``timing``: keep every host turnaround (sensor frame read -> force frame written), for benchmarks;
+    ``silence``: the longest wait for a frame before the device counts as lost (a device in lock-step,
+    which has no clock of its own, may take longer on a loaded machine: its tests raise it).
     """
 
     clock = True  # the device's frames pace the worker (engine/pacing.py)
 
     def __init__(self, spec, rate, *, latency=DEFAULT_LATENCY, packet=DEFAULT_PACKET, calibration=None,
-                 ramp_ms=DEFAULT_RAMP_MS, limits=DeviceLimits(), pings=handshake.PINGS, timing=False):
+                 ramp_ms=DEFAULT_RAMP_MS, limits=DeviceLimits(), pings=handshake.PINGS, timing=False,
+                 silence=SILENCE):
         self.spec = str(spec)
         self.rate = float(rate)
         self.latency = handshake.check_latency(latency)
@@ -79,6 +82,7 @@ class LinkDevice(HapticDevice):
         self.motor_limits = limits
         self.pings = int(pings)
         self.timing = bool(timing)
+        self.silence = float(silence)
         self.turnarounds = []  # s, per force frame, when ``timing``
         self.health = dict.fromkeys(HEALTH, 0)
         self.fault = None
@@ -215,7 +219,7 @@ class LinkDevice(HapticDevice):
         if self._pending:
             return self._pending.pop(0)
         self._flush()
-        end = time.monotonic() + SILENCE
+        end = time.monotonic() + self.silence
         while self.fault is None:
             try:
                 data = self.link.read()
@@ -228,11 +232,11 @@ class LinkDevice(HapticDevice):
                 self._take(data)
                 if self._pending:
                     return self._pending.pop(0)
-                end = time.monotonic() + SILENCE  # bytes came: the link is alive
+                end = time.monotonic() + self.silence  # bytes came: the link is alive
                 continue
             left = end - time.monotonic()
             if left <= 0:
-                self._device_fault(f"the link was silent for more than {1e3 * SILENCE:g} ms")
+                self._device_fault(f"the link was silent for more than {1e3 * self.silence:g} ms")
                 return None
             self.link.wait(left)
         return None
@@ -247,7 +251,7 @@ class LinkDevice(HapticDevice):
         try:
             for start in range(0, len(self._forces), msg.MAX_FORCES):
                 chunk = self._forces[start:start + msg.MAX_FORCES]
-                self._send(msg.Force(sample=tag + start, forces=tuple(chunk)))
+                self._send(msg.Force(sample=(tag + start) & 0xFFFFFFFF, forces=tuple(chunk)))  # u32, wraps
         except OSError as exc:
             self._link_failed(exc)
         if self.timing:

@@ -114,8 +114,14 @@ class Transport:
             except BlockingIOError:
                 return b""
             if not data and select.select([self._fd], [], [], 0)[0]:
-                # a tty with VMIN 0 reads b"" when empty; b"" while it polls readable is a port that went away
-                raise EOFError("the link closed")
+                # a tty with VMIN 0 reads b"" when empty, and bytes may have come since: read again; b"" while
+                # it polls readable is a port that went away (hung up)
+                try:
+                    data = os.read(self._fd, READ_CHUNK)
+                except BlockingIOError:
+                    return b""
+                if not data:
+                    raise EOFError("the link closed")
             return data
         if self._sock is not None:
             try:
