@@ -42,6 +42,8 @@ def register(sub):
                    help="samples the host answers ahead of the device's sensor sample (default 5)")
     p.add_argument("--device-packet", type=int, default=None, metavar="SAMPLES",
                    help="samples per sensor frame (default 1)")
+    p.add_argument("--device-silence", type=float, default=None, metavar="SECONDS",
+                   help="a device silent for longer is a device fault (default 0.02)")
     p.add_argument("--calibration", metavar="FILE", default=None,
                    help="calibrations keyed by serial number (TOML; default: the device's own)")
     p.add_argument("--json", action="store_true", help="print one JSON object at exit")
@@ -86,6 +88,10 @@ def _check_device(args):
 
     if not is_link(args.device):
         raise ParameterError(f"--device {args.device}: allowed is a serial port, a pty or a pyserial URL")
+    if args.device_silence is not None:
+        from studyapp.device.handshake import check_silence
+
+        check_silence(args.device_silence)
     options = {"packet": args.device_packet, "latency": args.device_latency}
     probe(args.device, args.rate, calibration=args.calibration,
           **{key: value for key, value in options.items() if value is not None})
@@ -123,11 +129,14 @@ def run(args):
         fmax=args.fmax, gesture=args.gesture, seed=args.seed, block=args.block, audio=args.audio,
         midi=args.midi, device=args.device, device_calibration=args.calibration,
     )
-    if args.device is None and (args.device_latency, args.device_packet, args.calibration) != (None, None, None):
-        raise ParameterError("--device-latency, --device-packet and --calibration need --device PATH_OR_URL")
+    link_options = (args.device_latency, args.device_packet, args.device_silence, args.calibration)
+    if args.device is None and link_options != (None,) * 4:
+        raise ParameterError("--device-latency, --device-packet, --device-silence and --calibration need "
+                             "--device PATH_OR_URL")
     if args.device is not None:
         config.device_latency = config.device_latency if args.device_latency is None else args.device_latency
         config.device_packet = config.device_packet if args.device_packet is None else args.device_packet
+        config.device_silence = config.device_silence if args.device_silence is None else args.device_silence
     if args.protocol is not None:
         from studyapp.engine.safety import SafetyLimits
         from studyapp.experiment.protocol import load_protocol

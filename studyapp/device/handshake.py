@@ -69,6 +69,17 @@ def check_ramp(ramp_ms):
     return value
 
 
+def check_silence(seconds):
+    """The silence bound in seconds (above 0, at most 10), or ``ParameterError``."""
+    try:
+        value = float(seconds)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not 0.0 < value <= 10.0:
+        raise ParameterError(f"device silence = {seconds!r}: allowed is a number of seconds above 0 and up to 10")
+    return value
+
+
 class Scales:
     """Raw channel values to SI (x m, a m/s^2, v m/s), with where the calibration came from (``source``)."""
 

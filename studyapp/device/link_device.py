@@ -82,7 +82,7 @@ class LinkDevice(HapticDevice):
         self.motor_limits = limits
         self.pings = int(pings)
         self.timing = bool(timing)
-        self.silence = float(silence)
+        self.silence = handshake.check_silence(silence)
         self.turnarounds = []  # s, per force frame, when ``timing``
         self.health = dict.fromkeys(HEALTH, 0)
         self.fault = None

@@ -11,7 +11,7 @@ factory is called with the rate in the worker.
 
 from dataclasses import dataclass, field
 
-from studyapp.device.link_device import DEFAULT_LATENCY, DEFAULT_PACKET, DEFAULT_RAMP_MS
+from studyapp.device.link_device import DEFAULT_LATENCY, DEFAULT_PACKET, DEFAULT_RAMP_MS, SILENCE
 from studyapp.engine.safety import SafetyLimits
 from studyapp.errors import ParameterError
 from studyapp.model.sources import LVT_SENSOR, with_pseudo_sources
@@ -50,6 +50,7 @@ class EngineConfig:
     device_packet: int = DEFAULT_PACKET  # samples per sensor frame of a link device
     device_calibration: str | None = None  # a TOML file of calibrations keyed by serial number (calibration_file.py)
     device_ramp_ms: int = DEFAULT_RAMP_MS  # ms over which a link device's force ramps up from 0 after each ARM
+    device_silence: float = SILENCE  # s without a frame from a link device that make it a device fault
     hang_timeout: float = 0.08  # s without a heartbeat before the force guard calls the worker hung
     # s without the force guard's heartbeat before the worker switches its own force off: the guard's
     # failure is the rarer one, so the deadline is looser than hang_timeout, sparing a loaded machine false trips
@@ -79,7 +80,7 @@ class EngineConfig:
     def link_options(self):
         """The keyword arguments of ``LinkDevice`` for a link ``device``."""
         return {"latency": self.device_latency, "packet": self.device_packet, "calibration": self.device_calibration,
-                "ramp_ms": self.device_ramp_ms}
+                "ramp_ms": self.device_ramp_ms, "silence": self.device_silence}
 
     def sources(self):
         """The velocity sources a pad can select, in the scene's order."""
