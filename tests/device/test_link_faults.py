@@ -88,11 +88,22 @@ def test_a_killed_host_leaves_the_device_disarmed_by_its_watchdog(tmp_path, try_
     assert stats["fault"] == messages.WATCHDOG and stats["armed"] == 0
 
 
+def _watch_hangup(fd, gone):
+    try:
+        poller = select.poll()
+        poller.register(fd, select.POLLHUP | select.POLLERR)
+        while not poller.poll(1000):
+            pass
+        gone.append(time.monotonic())
+    finally:
+        os.close(fd)
+
+
 def _loop(device):
     return ClosedLoop(LoopConfig(rate=RATE, estimators={}, source="LVT", fmax=2.0, gesture="strokes"), device=device)
 
 
-def _run_until_fault(device, loop, seconds=5.0):
+def _run_until_fault(device, loop, seconds=30.0):
     forces = []
     end = time.monotonic() + seconds
     while device.fault is None and time.monotonic() < end:
@@ -101,30 +112,42 @@ def _run_until_fault(device, loop, seconds=5.0):
     return forces, after
 
 
+@pytest.fixture
+def prompt_threads():
+    """The hang-up watcher thread gets the interpreter promptly while the loop runs."""
+    before = sys.getswitchinterval()
+    sys.setswitchinterval(0.0005)
+    yield
+    sys.setswitchinterval(before)
+
+
+@pytest.mark.usefixtures("prompt_threads")
 @pytest.mark.parametrize("how", ["killed", "closed"])
 @pytest.mark.parametrize("try_", range(TRIES))
 def test_a_lost_emulator_is_a_host_fault_with_force_zero_within_20ms(tmp_path, how, try_):
     path = tmp_path / "device"
-    options = ("--disconnect-after", 1.0) if how == "closed" else ()
+    options = ("--disconnect-after", 5.0) if how == "closed" else ()
     emulator = EmulatorProcess(path, "--seed", try_, "--watchdog-ms", 1000, *options).start()
     try:
+        # when the link ended: a second descriptor on the pty sees the hang-up as the host's does (the kill's
+        # own time would count the kernel's delay in ending a process on a loaded machine)
+        gone = []
+        watcher = threading.Thread(target=_watch_hangup, args=(os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK),
+                                                               gone), daemon=True)
+        watcher.start()
         device = LinkDevice(path, RATE, latency=LATENCY, ramp_ms=0)
         loop = _loop(device)
         device.arm(0)
-        killed = []
         if how == "killed":
-            timer = threading.Timer(0.5, lambda: (killed.append(time.monotonic()), emulator.process.kill()))
-            timer.start()
+            threading.Timer(0.5, emulator.process.kill).start()
         _, after = _run_until_fault(device, loop)
         device.close()
+        watcher.join(10.0)
     finally:
         emulator.kill()
     assert device.fault is not None and "link" in device.fault
     assert all(np.all(f == 0.0) for f in after)
-    # the link ended after the last bytes came: from then to the latched fault is at most 20 ms
-    assert device.fault_time - device.last_data <= 0.020
-    if killed:
-        assert device.fault_time - killed[0] <= 0.020
+    assert device.fault_time - gone[0] <= 0.020
 
 
 def test_corrupt_and_lost_frames_are_counted_never_applied(tmp_path):
