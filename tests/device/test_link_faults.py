@@ -69,6 +69,7 @@ def test_a_stopped_host_lets_the_device_force_fall_to_zero_within_its_bound(tmp_
     assert "WATCHDOG" in report["fault"]
     code, zero_at, last_frame = next(f for f in report["device_faults"] if f[0] == messages.WATCHDOG)
     took_ms = 1e3 * (zero_at - last_frame) / RATE
+    print(f"figure: watchdog force 0 after {took_ms:.2f} ms")  # docs/devices.md quotes these (pytest -s)
     assert took_ms <= 1e3 * LATENCY / RATE + 2.0
     assert emulator.stats is None or emulator.stats.get("armed", 0) == 0
 
@@ -147,6 +148,7 @@ def test_a_lost_emulator_is_a_host_fault_with_force_zero_within_20ms(tmp_path, h
         emulator.kill()
     assert device.fault is not None and "link" in device.fault
     assert all(np.all(f == 0.0) for f in after)
+    print(f"figure: {how}: host fault {1e3 * (device.fault_time - gone[0]):.2f} ms after the hang-up")
     assert device.fault_time - gone[0] <= 0.020
 
 
