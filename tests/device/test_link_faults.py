@@ -136,7 +136,9 @@ def test_a_lost_emulator_is_a_host_fault_with_force_zero_within_20ms(tmp_path, h
         watcher = threading.Thread(target=_watch_hangup, args=(os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK),
                                                                gone), daemon=True)
         watcher.start()
-        device = LinkDevice(path, RATE, latency=LATENCY, ramp_ms=0)
+        # a silence bound of 1 s: on a loaded machine the emulator may stall for more than 20 ms, and the test is
+        # of the hang-up (the 20 ms silence bound itself is tested with the scripted device)
+        device = LinkDevice(path, RATE, latency=LATENCY, ramp_ms=0, silence=1.0)
         loop = _loop(device)
         device.arm(0)
         if how == "killed":
@@ -146,10 +148,10 @@ def test_a_lost_emulator_is_a_host_fault_with_force_zero_within_20ms(tmp_path, h
         watcher.join(10.0)
     finally:
         emulator.kill()
-    assert device.fault is not None and "link" in device.fault
+    assert device.fault is not None and "the link failed" in device.fault
     assert all(np.all(f == 0.0) for f in after)
     print(f"figure: {how}: host fault {1e3 * (device.fault_time - gone[0]):.2f} ms after the hang-up")
-    assert device.fault_time - gone[0] <= 0.020
+    assert -0.005 <= device.fault_time - gone[0] <= 0.020  # (the watcher thread may see it a little later)
 
 
 def test_corrupt_and_lost_frames_are_counted_never_applied(tmp_path):
