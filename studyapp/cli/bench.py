@@ -1,4 +1,4 @@
-"""``studyapp bench estimators|loop|live|midi|memory|force-cut|heartbeat``: speed and memory, measured, never asserted in tests."""
+"""``studyapp bench estimators|loop|live|midi|memory|force-cut|heartbeat|device``: speed and memory, measured, never asserted in tests."""
 
 
 def register(sub):
@@ -52,6 +52,16 @@ def register(sub):
     p.add_argument("--seconds", type=float, default=60.0, help="run length (default 60)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.heartbeat_benchmark"))
+    p = kinds.add_parser("device", help="the loop over a pty to the device emulator: frames on time, host turnaround")
+    p.add_argument("--seconds", type=float, default=60.0, help="timed run length (default 60)")
+    p.add_argument("--runs", type=int, default=1, help="runs; the figures are their medians (default 1)")
+    p.add_argument("--rate", type=float, default=5000.0, help="the device's rate in Hz (default 5000)")
+    p.add_argument("--latency", type=int, default=5, metavar="SAMPLES",
+                   help="samples the host answers ahead (default 5: 1 ms at 5 kHz)")
+    p.add_argument("--packet", type=int, default=1, metavar="SAMPLES", help="samples per sensor frame (default 1)")
+    p.add_argument("--watchdog-ms", type=int, default=1, help="the emulator's watchdog in ms (default 1)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run("studyapp.device.benchmark"))
 
 
 def _run(module):

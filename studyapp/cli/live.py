@@ -3,12 +3,16 @@
 Prints the engine's status once a second on stderr; with ``--json`` prints one
 JSON object on stdout at exit:
 ``{"rate", "achieved_rate", "deadline_misses", "audio_underruns", "faults", "midi_messages",
-"events_dropped", ...}``; ``events_dropped`` counts the worker's events (MIDI control events, notices)
+"events_dropped", ..., "device"}``; ``device`` is null on the simulated device, else the link device's
+``info`` (docs/engine.md) with its ``health`` and ``fault``; ``events_dropped`` counts the worker's events (MIDI control events, notices)
 that its event ring overwrote before this process read them.
 Stops after ``--seconds`` or on Ctrl-C / SIGTERM, always cleanly (no orphan
 process, no shared memory left behind). With ``--protocol`` the protocol's
 F_max ceiling is the worker's hard clamp (experiment/protocol.py); without it,
-the motors' sustained limit. Every setting is checked before the worker starts:
+the motors' sustained limit. With ``--device PATH_OR_URL`` the loop runs on
+a real device (or ``studyapp device-emulator``) over its link, paced by the
+device; a link that is not a device, or a device that does not fit, is refused
+before the worker starts. Every setting is checked before the worker starts:
 a bad one is one line, exit 2.
 """
 
@@ -31,6 +35,17 @@ def register(sub):
     p.add_argument("--gesture", default="strokes", help="scripted gesture (default strokes)")
     p.add_argument("--block", type=int, default=None, help="samples per block (default: 2 ms worth)")
     p.add_argument("--seed", type=number_options.seed, default=0, help="noise seed (default 0)")
+    p.add_argument("--device", metavar="PATH_OR_URL", default=None,
+                   help="a device speaking docs/device-protocol.md: a serial port, a pty or a pyserial URL "
+                        "(socket://HOST:PORT); default: the simulated device")
+    p.add_argument("--device-latency", type=int, default=None, metavar="SAMPLES",
+                   help="samples the host answers ahead of the device's sensor sample (default 5)")
+    p.add_argument("--device-packet", type=int, default=None, metavar="SAMPLES",
+                   help="samples per sensor frame (default 1)")
+    p.add_argument("--device-silence", type=float, default=None, metavar="SECONDS",
+                   help="a device silent for longer is a device fault (default 0.02)")
+    p.add_argument("--calibration", metavar="FILE", default=None,
+                   help="calibrations keyed by serial number (TOML; default: the device's own)")
     p.add_argument("--json", action="store_true", help="print one JSON object at exit")
     p.set_defaults(func=run)
 
@@ -67,7 +82,33 @@ def _line(snap, elapsed):
             f"faults {snap['faults']}  F_max {snap['fmax']:.2f} N  source {snap['source']}")
 
 
+def _check_device(args):
+    """The link, its handshake and the link options, checked before the engine (and numba) loads: a bad link is
+    one line and exit 2 within seconds."""
+    from studyapp.device.link_open import is_link
+    from studyapp.device.link_probe import probe
+    from studyapp.errors import ParameterError
+
+    if not is_link(args.device):
+        raise ParameterError(f"--device {args.device}: allowed is a serial port, a pty or a pyserial URL")
+    if args.device_silence is not None:
+        from studyapp.device.handshake import check_silence
+
+        check_silence(args.device_silence)
+    options = {"packet": args.device_packet, "latency": args.device_latency}
+    probe(args.device, args.rate, calibration=args.calibration,
+          **{key: value for key, value in options.items() if value is not None})
+
+
+def _device(info, summary):
+    if info is None:
+        return None
+    return {**info, "health": summary.get("device_health"), "fault": summary.get("device_fault")}
+
+
 def run(args):
+    if args.device is not None:
+        _check_device(args)
     import json
     import signal
     import sys
@@ -91,8 +132,16 @@ def run(args):
     config = EngineConfig(
         rate=args.rate, estimators=_estimators(args.estimators, args.source), source=args.source,
         fmax=args.fmax, gesture=args.gesture, seed=args.seed, block=args.block, audio=args.audio,
-        midi=args.midi,
+        midi=args.midi, device=args.device, device_calibration=args.calibration,
     )
+    link_options = (args.device_latency, args.device_packet, args.device_silence, args.calibration)
+    if args.device is None and link_options != (None,) * 4:
+        raise ParameterError("--device-latency, --device-packet, --device-silence and --calibration need "
+                             "--device PATH_OR_URL")
+    if args.device is not None:
+        config.device_latency = config.device_latency if args.device_latency is None else args.device_latency
+        config.device_packet = config.device_packet if args.device_packet is None else args.device_packet
+        config.device_silence = config.device_silence if args.device_silence is None else args.device_silence
     if args.protocol is not None:
         from studyapp.engine.safety import SafetyLimits
         from studyapp.experiment.protocol import load_protocol
@@ -111,6 +160,11 @@ def run(args):
         info = engine.info
         say(f"live: {info['rate']:g} Hz, block {info['block']}, paced by the {info['paced']}, "
             f"audio {info['audio']}, MIDI {info['midi']}, real-time priority {'yes' if info['realtime'] else 'no'}")
+        if info.get("device"):
+            d = info["device"]
+            say(f"live: device {d['name']} serial {d['serial']} (protocol {d['protocol']}, firmware {d['firmware']}) "
+                f"on {d['link']}: latency {d['latency_samples']} samples, round trip {d['round_trip_ms']['median']:.2f} "
+                f"ms (p99 {d['round_trip_ms']['p99']:.2f}), calibration {d['calibration']}")
         started = time.monotonic()
         next_line = started + 1.0
         while engine.alive:
@@ -142,6 +196,7 @@ def run(args):
         "command_latency_max": summary.get("command_latency_max", 0.0),
         "audio": engine.info.get("audio"),
         "midi": engine.info.get("midi"),
+        "device": _device(engine.info.get("device"), summary),
     }
     if args.json:
         print(json.dumps(result))

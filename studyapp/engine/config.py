@@ -1,12 +1,17 @@
 """What the engine runs: the scene's loop settings plus block size, sinks, MIDI and safety.
 
 ``EngineConfig`` crosses the process boundary (pickled for the spawn-context
-worker), so it holds only plain values; a real device driver is named as
-``"module:factory"`` and the factory is called with the rate in the worker.
+worker), so it holds only plain values. A real device is named in ``device``
+either as a link, a path or a pyserial URL (``/dev/ttyACM0``, a pty,
+``socket://127.0.0.1:PORT``) to a device speaking docs/device-protocol.md,
+opened in the worker by studyapp/device/link_device.py with the ``device_*``
+settings below; or as ``"module:factory"``, a driver of one's own whose
+factory is called with the rate in the worker.
 """
 
 from dataclasses import dataclass, field
 
+from studyapp.device.link_device import DEFAULT_LATENCY, DEFAULT_PACKET, DEFAULT_RAMP_MS, SILENCE
 from studyapp.engine.load_margin import hang_timeout_for, load_per_core
 from studyapp.engine.safety import SafetyLimits
 from studyapp.errors import ParameterError
@@ -42,7 +47,12 @@ class EngineConfig:
     safety: SafetyLimits = field(default_factory=SafetyLimits)
     telemetry_seconds: float = 4.0  # history kept in the rings
     realtime: bool = True  # ask for SCHED_FIFO for the worker's loop thread (falls back silently)
-    device: str | None = None  # "module:factory" of a real device driver; None: the simulated device
+    device: str | None = None  # a link (path or URL) or "module:factory" of a driver; None: the simulated device
+    device_latency: int = DEFAULT_LATENCY  # samples a link device's force is answered ahead of its sensor sample
+    device_packet: int = DEFAULT_PACKET  # samples per sensor frame of a link device
+    device_calibration: str | None = None  # a TOML file of calibrations keyed by serial number (calibration_file.py)
+    device_ramp_ms: int = DEFAULT_RAMP_MS  # ms over which a link device's force ramps up from 0 after each ARM
+    device_silence: float = SILENCE  # s without a frame from a link device that make it a device fault
     # s without a heartbeat before the force guard calls the worker hung: HANG_TIMEOUT, more on a busy machine
     hang_timeout: float = field(default_factory=lambda: hang_timeout_for(load_per_core(), HANG_TIMEOUT))
     # s without the force guard's heartbeat before the worker switches its own force off: the guard's
@@ -69,6 +79,11 @@ class EngineConfig:
             raise ParameterError(f"telemetry_seconds = {self.telemetry_seconds}: allowed is above 0 and up to "
                                  f"{TELEMETRY_MAX:g} s")
         return self.block_size()
+
+    def link_options(self):
+        """The keyword arguments of ``LinkDevice`` for a link ``device``."""
+        return {"latency": self.device_latency, "packet": self.device_packet, "calibration": self.device_calibration,
+                "ramp_ms": self.device_ramp_ms, "silence": self.device_silence}
 
     def sources(self):
         """The velocity sources a pad can select, in the scene's order."""

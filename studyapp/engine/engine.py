@@ -32,6 +32,8 @@ import multiprocessing
 import threading
 import time
 
+from studyapp.device.link_probe import probe as probe_link
+from studyapp.device.link_open import is_link
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine import guard, midi_hotplug, shm_names
@@ -100,6 +102,8 @@ class Engine(Watchdog):
             raise ParameterError(f"gesture {c.gesture!r}: allowed are {', '.join(live)}")
         parse_audio(c.audio)
         c.check_sizes()
+        if is_link(c.device):
+            probe_link(c.device, c.rate, c.device_packet, c.device_calibration, c.device_latency, c.device_ramp_ms)
         return names
 
     def start(self, timeout=START_TIMEOUT):

@@ -81,3 +81,24 @@ class Learned:
 class Stopped:
     summary: dict
     level: str = "info"
+
+
+@dataclass(frozen=True)
+class DeviceInfo:
+    """A device on a link was armed (at the start, after a re-arm): its ``info`` (link_device.LinkDevice.info)."""
+
+    info: dict
+    level: str = "info"
+
+
+@dataclass(frozen=True)
+class DeviceHealth:
+    """A link device's frame counts over trial ``trial`` (``health``) and since the link opened (``totals``).
+
+    Keys (link_device.HEALTH): frames, samples, corrupt, lost, missing, late, faults, clamped.
+    """
+
+    trial: int
+    health: dict
+    totals: dict
+    level: str = "info"

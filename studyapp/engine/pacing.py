@@ -3,21 +3,28 @@
 Block k of B samples at rate R (period T = B / R) starts when the pacing
 clock says so: the audio device's FIFO dropping below its lead (the device
 callback is the clock, for a ``paced`` sink), or else the monotonic timer
-reaching t0 + k T. A paced sink that stops calling back (three silent waits of
-50 ms) hands the pacing to the timer for the rest of the run. A timer more
+reaching t0 + k T; or, for a device that owns the sample clock (a link
+device, studyapp/device/link_device.py), the device itself: the worker does
+not wait before a block, the device's ``exchange`` waits for its sensor
+frames, so blocks arrive at the device's rate (a paced audio sink is then fed,
+not followed: its FIFO and the resampler take up the drift between the two
+clocks). A device that faults hands the pacing to the timer until it is
+re-armed. A paced sink that stops calling back (three silent waits of 50 ms)
+hands the pacing to the timer for the rest of the run. A timer more
 than ``RESYNC`` behind restarts its schedule from now instead of running
 blocks back to back to catch up.
 
 A block is a *deadline miss* when it finishes after its deadline: t0 + (k+1) T
 on the timer; on the audio clock, when the device had to play silence while
-the block was being made. The load of a block is its compute time (wall
-clock) over T. A miss is an *overrun* when the block's own compute took longer
-than T on the CPU (the thread's CPU time), a *stall* when it took longer than
-T by the wall clock only (the worker was taken off the CPU mid-block); the
-other misses come from starting late (the OS woke the worker late, or an
-earlier block overran): ``wake_late_max`` says how late.
-Stalls and late starts are the machine's share of the misses, overruns the
-engine's.
+the block was being made; on the device clock, when the device's driver
+counted a force frame late during the block (its ``health["late"]``). The load
+of a block is its compute time (wall clock) over T. A miss is an *overrun*
+when the block's own compute took longer than T on the CPU (the thread's CPU
+time), a *stall* when it took longer than T by the wall clock only (the worker
+was taken off the CPU mid-block); the other misses come from starting late
+(the OS woke the worker late, or an earlier block overran): ``wake_late_max``
+says how late. Stalls and late starts are the machine's share of the misses,
+overruns the engine's.
 """
 
 import time
@@ -33,10 +40,13 @@ IDLE = {"seconds": 0.0, "achieved_rate": 0.0, "load_mean": 0.0, "load_p99": 0.0,
 class Pacing:
     """The clock of a run that starts at block ``k`` (now), for ``sink`` and blocks of ``period`` s."""
 
-    def __init__(self, sink, period, k):
+    def __init__(self, sink, period, k, device=None):
         self.sink = sink
         self.period = period
-        self.audio_clock = sink.paced
+        self.device = device if device is not None and getattr(device, "clock", False) else None
+        self.device_clock = self.device is not None
+        self.device_late = self.device.health["late"] if self.device_clock else 0
+        self.audio_clock = sink.paced and not self.device_clock
         self.start = self.t0 = time.monotonic()
         self.k_start = self.k0 = k
         self.end = None
@@ -49,7 +59,16 @@ class Pacing:
         self._window = (self.start, 0, 0)  # the status's window: its start, samples and blocks so far
 
     def wait(self, k):
-        """Wait until block ``k`` may start; True when the audio clock has just been given up for the timer."""
+        """Wait until block ``k`` may start; True when the audio or device clock has just been given up for the timer."""
+        if self.device is not None and self.device.fault is None and not self.device_clock:
+            self.device_clock = True  # re-armed: the device paces again
+            self.device_late = self.device.health["late"]
+        if self.device_clock:
+            if self.device.fault is None:
+                return False
+            self.device_clock = False
+            self.t0, self.k0 = time.monotonic(), k
+            return True
         if self.audio_clock:
             self.silent_waits = 0 if self.sink.wait(0.05) else self.silent_waits + 1
             if self.silent_waits >= SILENT_WAITS:
@@ -73,7 +92,10 @@ class Pacing:
     def missed(self, deadline, finished, compute, cpu):
         """Count a block just run (wall-clock ``compute``, thread ``cpu`` seconds); True if it missed its deadline."""
         self.loads.append(compute / self.period)
-        if self.audio_clock:
+        if self.device_clock:
+            late = self.device.health["late"] > self.device_late
+            self.device_late = self.device.health["late"]
+        elif self.audio_clock:
             late = self.sink.shortfalls > self.shortfalls
         else:
             late = finished > deadline
@@ -109,3 +131,8 @@ class Pacing:
             "load_max": float(np.max(loads)) if loads else 0.0,
             "wake_late_max": self.wake_late_max, "overruns": self.overruns, "stalls": self.stalls,
         }
+
+    @property
+    def clock(self):
+        """What paces the blocks now: "device", "audio" or "timer"."""
+        return "device" if self.device_clock else "audio" if self.audio_clock else "timer"

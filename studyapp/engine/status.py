@@ -58,6 +58,11 @@ NUMBERS = (
     "command_latency_max",  # largest of those, s
     "midi_messages",  # MIDI messages received
     "audio_paced",  # 1 when the audio clock paces the loop, 0 for the monotonic timer
+    "device_frames",  # a link device's sensor frames received (engine/device_link.py; 0 without one)
+    "device_late",  # force frames it answered too late for their sample
+    "device_missing",  # device samples never received
+    "device_lost",  # device frames lost (sequence gaps)
+    "device_corrupt",  # device frames that did not check (never applied)
 )
 
 TEXTS = {"source": 32, "fault": 200, "audio": 120, "midi": 120}

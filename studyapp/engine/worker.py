@@ -50,10 +50,12 @@ import sys
 import time
 import traceback
 
+from studyapp.device.link_open import is_link
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine.audio.recorder import Recordings
 from studyapp.engine.audio.sinks import open_sink
+from studyapp.engine.device_link import DeviceLink
 from studyapp.engine.event_ring import EventRing
 from studyapp.engine.midi import ControlMap, open_input
 from studyapp.engine.pacing import IDLE, Pacing
@@ -68,12 +70,18 @@ from studyapp.model.controls import as_actions
 REALTIME_PRIORITY = 5  # below JACK's own threads (10 and 9 by default)
 
 
-def make_device(spec, rate):
-    """A real device driver from ``"module:factory"`` (called with the rate), or ``None``."""
+def make_device(config):
+    """The configured device: a link (path or URL, studyapp/device/link_device.py), a driver from
+    ``"module:factory"`` (called with the rate), or ``None`` (the simulated device)."""
+    spec = config.device
     if not spec:
         return None
+    if is_link(spec):
+        from studyapp.device.link_device import LinkDevice
+
+        return LinkDevice(spec, config.rate, **config.link_options())
     module, _, factory = spec.partition(":")
-    return getattr(importlib.import_module(module), factory)(rate)
+    return getattr(importlib.import_module(module), factory)(config.rate)
 
 
 def main(config, ring_spec, status_name, commands, events_name):
@@ -132,7 +140,8 @@ class Worker(ControlRouting):
         )
         if config.f0 is not None:
             loop_config.f0 = config.f0
-        self.loop = ClosedLoop(loop_config, device=make_device(config.device, config.rate))
+        self.loop = ClosedLoop(loop_config, device=make_device(config))
+        self.link = DeviceLink.of(self.loop.device, self.events, self.notice)  # a device that owns the clock
         self.safety = Safety(self.loop, config.safety)
         self.loop.set_fmax(self.safety.clamp_fmax(config.fmax))
         self.loop.set_bowing(config.bowing)  # a session's engine starts silent, before its first step
@@ -179,6 +188,8 @@ class Worker(ControlRouting):
     def _reset_string(self, c):
         self.loop.reset_string()
         self.cut = True
+        if self.link is not None:
+            self.link.trial_started(self.trial)
         self.trial_start = self.k * self.block / self.loop.rate
 
     def _bowing(self, c):
@@ -187,9 +198,9 @@ class Worker(ControlRouting):
         self.loop.set_bowing(bool(c.on))
 
     def _clear_fault(self, c):
-        if self.loop.fault:
+        if self.loop.fault and not (self.link is not None and self.link.device.fault is not None):
             self.notice(f"cannot clear: the loop itself latched '{self.loop.fault}'; restart the engine", "warning")
-        else:
+        elif self.link is None or self.link.clear(self.loop):
             self.safety.clear()
             self.status.set(fault="")
 
@@ -268,6 +279,8 @@ class Worker(ControlRouting):
         cpu_started = time.thread_time()
         enabled, why = self.guard.force()
         self.safety.before_block(enabled, why=why)
+        if self.link is not None:
+            self.link.before_block(enabled, self.status.force_off_reason)
         bowing = self.loop.bowing
         out = self.loop.run(self.block)
         enabled, why = self.guard.force()
@@ -293,15 +306,20 @@ class Worker(ControlRouting):
         self.events.put(ev.Ready({
             "rate": self.loop.rate, "block": self.block, "names": list(self.loop.names),
             "audio": self.sink.description, "midi": self.midi.description if self.midi else "none",
-            "midi_inlet": self.midi.inlet if self.midi else None, "realtime": self.realtime, "paced": "audio" if self.sink.paced else "timer",
+            "midi_inlet": self.midi.inlet if self.midi else None, "realtime": self.realtime,
+            "paced": "device" if self.link is not None else "audio" if self.sink.paced else "timer",
+            "device": self.link.info if self.link is not None else None,
         }))
         parent = multiprocessing.parent_process()
-        pacing = self.pacing = Pacing(self.sink, self.period, self.k)
+        pacing = self.pacing = Pacing(self.sink, self.period, self.k, self.loop.device)
+        if self.link is not None:
+            self.link.started()  # fresh frames, ARM: the device's watchdog runs from here
         next_parent_check = pacing.start
         while not self.stopping:
             if pacing.wait(self.k):
                 status.set(audio_paced=False)
-                self.notice("audio: the device stopped calling back; the timer paces the loop now", "warning", "audio")
+                self.notice(f"{'device: it faulted' if self.link else 'audio: the device stopped calling back'}; "
+                            "the timer paces the loop now", "warning", "device" if self.link else "audio")
             started = time.monotonic()
             self.drain()
             if self.stopping:
@@ -318,7 +336,7 @@ class Worker(ControlRouting):
                 heartbeat=finished, blocks=self.k, samples=self.k * self.block, load=pacing.loads[-1],
                 audio_underruns=self.sink.underruns, audio_xruns=self.sink.xruns, audio_limited=self.sink.limited,
                 fault_latched=self.safety.latched is not None, fmax=self.loop.fmax,
-                force_scale=self.loop.force_scale,
+                force_scale=self.loop.force_scale, **(self.link.status() if self.link is not None else {}),
             )
             status.set(**pacing.window(finished, self.block))
             status.publish(texts=self._texts_changed())
@@ -349,9 +367,10 @@ class Worker(ControlRouting):
             "midi_overflows": self.midi.overflows if self.midi else 0,
             "command_latency_max": float(s.get("command_latency_max")),
             "load_mean": t["load_mean"], "load_p99": t["load_p99"], "load_max": t["load_max"], "realtime": self.realtime,
-            "block": self.block, "paced": "audio" if self.sink.paced else "timer",
+            "block": self.block, "paced": pacing.clock if pacing else "audio" if self.sink.paced else "timer",
             "wake_late_max": t["wake_late_max"], "overruns": t["overruns"], "stalls": t["stalls"],
             "audio_recordings": self.recordings.summary(),
+            **(self.link.summary() if self.link is not None else {}),
         }
 
     def close(self):
@@ -366,6 +385,8 @@ class Worker(ControlRouting):
                             "leaving it open", "warning", "audio")
         if self.midi is not None:
             self.midi.close()
+        if getattr(self, "link", None) is not None:
+            self.link.close()
         if getattr(self, "loop", None) is not None:
             self.events.put(ev.Stopped(self.summary()))
             self.status.set(state="stopped", heartbeat=time.monotonic())

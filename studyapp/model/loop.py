@@ -294,6 +294,18 @@ class ClosedLoop:
         self.monitor.judge()
         return result
 
+    def clear_device_fault(self):
+        """Unlatch a fault the device reported (after the experimenter re-armed it); True if there was one.
+
+        Only a device fault: a non-finite value inside the loop stays latched for good.
+        """
+        if self._state[L_FAULT] != FAULT_DEVICE:
+            return False
+        self._state[L_FAULT] = 0.0
+        self._state[L_FAULT_SAMPLE] = 0.0
+        self._fault_text = None
+        return True
+
     def _describe_fault(self):
         code = int(self._state[L_FAULT])
         t = (self._sample + max(self._state[L_FAULT_SAMPLE], 0)) / self.rate

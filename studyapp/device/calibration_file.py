@@ -1,0 +1,81 @@
+"""A lab's calibration of its devices: a TOML file keyed by serial number.
+
+A device reports a gain and an offset per channel in its INFO frame
+(docs/device-protocol.md), so that SI = gain * raw + offset. A lab that
+calibrates its rig (an LVDT against a gauge block, an accelerometer on a
+shaker) writes what it measured here; an entry overrides the device's own for
+that serial number and channel::
+
+    ["TGR-0001"]                                 # the serial number, as INFO reports it
+    position = { gain = 2.5e-7, offset = -0.011 }    # m per count, m
+    velocity = { gain = 1.0e-5, offset = 0.0 }       # (m/s) per count, m/s
+    acceleration = { gain = 4.9e-3, offset = 0.0 }   # (m/s^2) per count, m/s^2
+
+Channels not named keep the device's calibration. Every value is checked: a
+gain finite and non-zero, an offset finite, no other key; a bad file is one
+line naming the file, the field and what is allowed.
+"""
+
+import math
+import tomllib
+
+from studyapp.errors import ParameterError
+
+CHANNELS = ("position", "acceleration", "velocity")  # INFO's channel kinds 0, 1, 2
+FIELDS = ("gain", "offset")
+
+
+def _number(path, where, value, nonzero):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or \
+            (nonzero and value == 0):
+        allowed = "a finite non-zero number" if nonzero else "a finite number"
+        raise ParameterError(f"{path}: {where} = {value!r}: allowed is {allowed}")
+    return float(value)
+
+
+def load(path):
+    """``{serial: {channel: (gain, offset)}}`` from the TOML file ``path``; ``ParameterError`` if it is bad."""
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except FileNotFoundError:
+        raise ParameterError(f"--calibration {path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"--calibration {path}: cannot be read ({exc})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{path}: not valid TOML ({exc})") from None
+    table = {}
+    for serial, channels in data.items():
+        if not isinstance(channels, dict):
+            raise ParameterError(f"{path}: [{serial!r}] must be a table of channels ({', '.join(CHANNELS)})")
+        entry = {}
+        for channel, values in channels.items():
+            where = f"[{serial!r}].{channel}"
+            if channel not in CHANNELS:
+                raise ParameterError(f"{path}: {where}: unknown channel; allowed are {', '.join(CHANNELS)}")
+            if not isinstance(values, dict) or set(values) != set(FIELDS):
+                raise ParameterError(f"{path}: {where}: allowed is a table {{ gain = G, offset = O }}")
+            entry[channel] = (_number(path, f"{where}.gain", values["gain"], True),
+                              _number(path, f"{where}.offset", values["offset"], False))
+        table[serial] = entry
+    return table
+
+
+def apply(device_channels, serial, path):
+    """The channels' (gain, offset) with the file's entry for ``serial`` in place, and where they came from.
+
+    ``device_channels``: ``{channel: (gain, offset)}`` from INFO. Returns ``(channels, source)``,
+    ``source`` being ``"device"`` or ``"PATH [SERIAL]"``.
+    """
+    channels = dict(device_channels)
+    if path is None:
+        return channels, "device"
+    entry = load(path).get(serial)
+    if entry is None:
+        return channels, "device"
+    for channel, pair in entry.items():
+        if channel not in channels:
+            raise ParameterError(f"{path}: [{serial!r}].{channel}: the device has no {channel} channel; "
+                                 f"it has {', '.join(channels) or 'none'}")
+        channels[channel] = pair
+    return channels, f"{path} [{serial}]"
