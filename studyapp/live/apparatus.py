@@ -75,10 +75,14 @@ class Apparatus:
         return config
 
     def replace(self, config, describe):
-        """Start an engine with ``config``; the old one stops in the background."""
-        old, self.host = self.host, self.make_host(config, describe).start()
-        if old is not None:
-            old.stop(wait=False)
+        """Start an engine with ``config``; the old one stops in the background.
+
+        A device on a link takes one host at a time: the new engine opens it only once the old one has
+        stopped (``EngineHost.start(after=...)``), still without blocking the caller."""
+        old = self.host
+        stopping = old.stop(wait=False) if old is not None else None
+        host = self.make_host(config, describe)
+        self.host = host.start(after=stopping) if config.device and stopping is not None else host.start()
         self._seen = None  # announced, and followed, at the next poll
 
     def state_change(self):

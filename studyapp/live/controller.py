@@ -41,6 +41,7 @@ each logged during a session.
 
 import time
 
+from studyapp.engine.events import DeviceHealth, DeviceInfo
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.protocol import load_protocol
@@ -54,6 +55,7 @@ from studyapp.live.engine_host import EngineHost
 from studyapp.live.evented import EventGroup
 from studyapp.live.hand import Hand
 from studyapp.live.master_sound import MasterSound
+from studyapp.live.rig_check import rig_of
 from studyapp.live.states import REST, TRANSITIONS, State
 from studyapp.live.trial_media import TrialMedia
 
@@ -72,7 +74,7 @@ class SessionController:
         self.clock = clock
         self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing", "gesture",
                                  "telemetry", "status", "message", "response", "pickup", "page", "refused",
-                                 "volume")
+                                 "volume", "device", "device_health")
         self.controls = Controls(self)
         self.media = TrialMedia(self)
         self.hand = Hand(self)
@@ -85,6 +87,7 @@ class SessionController:
         self.trial_serial = 0  # counts steps started (restarts too); tags the step's samples and controls
         self.sound = MasterSound()  # the console's master volume and mute (master_sound.py)
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
+        self.device_info = None  # the link device's latest handshake (DeviceInfo), None on the simulated device
         self._next_status = 0.0
 
     # the state machine (states.py) --------------------------------------------------------------
@@ -135,14 +138,37 @@ class SessionController:
             self._set_state(self.rest)
         return protocol
 
+    def set_device(self, device):
+        """Run on ``device`` (a link's path or URL; None: the simulated device): the preview engine restarts on it."""
+        if self.in_session:
+            raise UserError("a session is in progress: abort it before changing the device")
+        self.apparatus.device = device or None
+        self.device_info = None
+        if self.protocol is not None:
+            self.replace_engine(self.apparatus.config(self.protocol, self.protocol.seed, preview_actions(self.protocol)),
+                                f"preview of {self.protocol.study}")
+
+    def device_record(self):
+        """session.json's ``device``: ``kind`` simulated (latency 0) or link (its path and latest ``info``)."""
+        if self.apparatus.device is None:
+            return {"kind": "simulated", "latency_ms": 0.0}
+        return {"kind": "link", "link": self.apparatus.device, "info": self.device_info}
+
+    def rig(self):
+        """The rig the model judges (rig_check.Rig): the engine's device and its link latency; None without a protocol."""
+        return None if self.protocol is None else rig_of(self.apparatus.config(self.protocol, 0, {}))
+
     def replace_engine(self, config, describe):
+        self.device_info = None  # until the new engine's device shakes hands
         self.apparatus.replace(config, describe)
         self.controls.engine_replaced()
 
-    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None):
+    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None,
+                      logged=()):
         """Open the participant's session (``UserError`` when refused) and start its engine.
 
         ``details``: ``experimenter``, ``session_number``, ``notes``, ``order_row`` (experiment/session_info.py).
+        ``logged``: records for the session's log before its trials (the rig check's warning, rig_check.record).
         """
         if self.protocol is None:
             raise UserError("no protocol loaded: choose one first")
@@ -156,9 +182,11 @@ class SessionController:
         else:
             described = {"device": self.apparatus.device or "simulated", "engine": "real-time", **(apparatus or {})}
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
-                                     **(details or {}))
+                                     device=self.device_record(), **(details or {}))
         self.session = session
         self.last_session = session.folder
+        for record in logged:
+            session.log.append(record)
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
         self.fire("open")
@@ -312,7 +340,10 @@ class SessionController:
         if self.host is None:
             return
         for notice in self.host.drain():
-            self.message(notice.text, level=notice.level, topic=getattr(notice, "topic", ""))
+            if isinstance(notice, (DeviceInfo, DeviceHealth)):
+                self._device_event(notice)
+            else:
+                self.message(notice.text, level=notice.level, topic=getattr(notice, "topic", ""))
         self._follow_engine()
         self._read_telemetry()
         engine = self.engine
@@ -321,6 +352,16 @@ class SessionController:
         for record in engine.controls():
             self.controls.take(record)
         self._watch_status(engine)
+
+    def _device_event(self, record):
+        """A link device's handshake (``device``) or a trial's frame counts (``device_health``, logged in a session)."""
+        if isinstance(record, DeviceInfo):
+            self.device_info = dict(record.info)
+            self.events.device.emit(info=self.device_info)
+            return
+        self.events.device_health.emit(trial=record.trial, health=record.health, totals=record.totals)
+        if self.runner is not None:
+            self.runner.log(records.device_health(record.trial, record.health, record.totals))
 
     def _follow_engine(self):
         """Announce a change of the engine's state, and let the state machine take it."""
