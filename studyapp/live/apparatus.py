@@ -54,6 +54,7 @@ class Apparatus:
         self.realtime = realtime
         self.hang_timeout = hang_timeout
         self.make_host = make_host
+        self.device_options = {}  # EngineConfig's device_* fields for a link (device_latency, device_silence, ...)
         self.host = None
         self._seen = None  # the host's state the controller last followed
 
@@ -72,6 +73,9 @@ class Apparatus:
                               safety=SafetyLimits(fmax_ceiling=protocol.fmax_ceiling))
         if self.hang_timeout is not None:
             config.hang_timeout = float(self.hang_timeout)
+        if self.device:
+            for key, value in self.device_options.items():
+                setattr(config, key, value)
         return config
 
     def replace(self, config, describe):
