@@ -27,7 +27,9 @@ Abort, and closing the console, while a session runs ask first (``confirm``;
 
 Its parts: ``ProgressPanel`` (progress_panel.py), ``SessionButtons``
 (session_buttons.py), ``LiveTab`` (live_tab.py: scope, knobs and pads, the
-bowing pad), ``SessionTools``, ``SetupPanel``, ``PageControls``, ``StatusBar``.
+bowing pad), ``SessionTools``, ``SetupPanel`` (with the device's ``DevicePanel``), ``RigCheckView`` (the
+device's choice and the rig check, which asks before a session on a rig that may not show the effect),
+``PageControls``, ``StatusBar``.
 Every widget is a view of the ``SessionController`` (``studyapp.live``, no
 Qt in it): widgets call its methods, and its events update the widgets.
 Messages are coloured by their level (info, warning, error); a device's
@@ -59,7 +61,7 @@ from studyapp.gui.live_tab import LiveTab
 from studyapp.gui.page_controls import PageControls
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.progress_panel import ProgressPanel
-from studyapp.gui.rig_prediction import RigPrediction
+from studyapp.gui.rig_check_view import RigCheckView
 from studyapp.gui.session_buttons import SessionButtons
 from studyapp.gui.session_tools import SessionTools
 from studyapp.gui.setup_panel import SetupPanel
@@ -91,13 +93,8 @@ class Console(QMainWindow):
         self.setup = SetupPanel()
         self.setup.protocol_chosen.connect(self.choose_protocol)
         self.device_panel = self.setup.device_panel
-        self.device_panel.device_chosen.connect(self.choose_device)
-        self.rig_prediction = RigPrediction(predict, self)  # the rig check, off the GUI thread
-        self.rig_request = None
-        self.rig_prediction.progress.connect(self.device_panel.show_progress)
-        self.rig_prediction.finished.connect(
-            lambda req, prediction: self.device_panel.show_verdict(rig_check.verdict(prediction, req.rig)))
-        self.rig_prediction.failed.connect(lambda why: self.device_panel.show_no_check(f"the rig check failed: {why}"))
+        self.rig = RigCheckView(self, predict)  # the device's choice and the rig check (rig_check_view.py)
+        self.rig_prediction = self.rig.prediction
         self.buttons = SessionButtons(controller, self.start_session, self.abort_session)
         b = self.buttons
         self.start_button, self.pause_button, self.abort_button = b.start_button, b.pause_button, b.abort_button
@@ -194,8 +191,6 @@ class Console(QMainWindow):
         e.response.connect(self._on_response)
         e.pickup.connect(self._on_pickup)
         e.page.connect(self._on_page)
-        e.device.connect(self.device_panel.show_info)
-        e.device_health.connect(self.device_panel.show_health)
 
         self.timer = QTimer(self)
         self.timer.setInterval(POLL_PERIOD_MS)
@@ -239,53 +234,8 @@ class Console(QMainWindow):
         self.setup.show_error("")
         return True
 
-    def choose_device(self, device):
-        """Run on ``device`` (None: the simulated device; else a link's path or URL)."""
-        try:
-            self.controller.set_device(device)
-        except UserError as exc:
-            self.setup.show_error(str(exc))
-            return False
-        self.setup.show_error("")
-        return True
-
-    def check_rig(self):
-        """Start (or show the kept) prediction of the protocol's adjustment conditions on the engine's rig."""
-        rig = self.controller.rig()
-        req = rig_check.request(self.controller.protocol, rig) if rig is not None else None
-        self.rig_request = req
-        if req is None:
-            self.device_panel.show_no_check("no adjustment task in this protocol: no breakdown to predict")
-        elif self.rig_prediction.result(req) is None:
-            self.device_panel.show_predicting(rig)
-        self.rig_prediction.run(req)
-
-    def rig_warning_accepted(self):
-        """Before a new session: None if the rig check warns (or is not ready on a link) and the experimenter
-        does not go on; else the records to log (the warning taken: rig_check.record)."""
-        req = self.rig_request
-        if req is None:
-            return ()
-        prediction = self.rig_prediction.result(req)
-        verdict = None
-        if prediction is None:
-            if not rig_check.needs_check(req.rig):
-                return ()
-            text = (f"The rig check (the model's bowing breakdown at this rig's {req.rig.latency_ms:.2f} ms link "
-                    "latency) is still running. Start the session without it?")
-        else:
-            verdict = rig_check.verdict(prediction, req.rig)
-            if not verdict.warns:
-                return ()
-            text = verdict.warning[len("warning: "):]
-            text = f"{text[0].upper()}{text[1:]}.\n\nStart the session on this rig anyway?"
-        if not self.confirm("The rig may not show the effect", text):
-            return None
-        self.controller.message(f"rig check: started anyway: {text.splitlines()[0]}", level="warning")
-        return () if verdict is None else (rig_check.record(verdict, started_anyway=True),)
-
     def start_session(self, seed=None):
-        logged = () if self.setup.resume.isChecked() else self.rig_warning_accepted()
+        logged = () if self.setup.resume.isChecked() else self.rig.accepted()
         if logged is None:
             self.setup.show_error("not started: the rig check's warning was not accepted")
             return None
@@ -371,10 +321,7 @@ class Console(QMainWindow):
             self.notices = {}
             self._midi_shown = None
         self.setup.show_engine(state, info, config, self.notices)
-        if state == "starting":
-            self.check_rig()
-        elif state == "running" and self.controller.device_info is not None:
-            self.device_panel.show_info(self.controller.device_info)
+        self.rig.engine_state(state)
         self.status.show_engine(state, info)
         if state == "running":
             self.scope.set_scene(info["rate"], info["names"])

@@ -13,6 +13,7 @@ views. Its parts, one idea each:
     steps.py        a trial or page started, held and ended on the engine
     controls.py     knobs and pads: routing, pickup, page settle, latency
     hand.py         the bow and the hand's gesture, the mouse's bow pad
+    devices.py      the device: chosen, its handshake and health, the rig it makes (rig_check.py)
     trial_media.py  the audio recording and its cues, the reference tone, trial health
 
 Time. ``poll()`` (a GUI timer calls it) never waits: it passes on the
@@ -55,7 +56,7 @@ from studyapp.live.engine_host import EngineHost
 from studyapp.live.evented import EventGroup
 from studyapp.live.hand import Hand
 from studyapp.live.master_sound import MasterSound
-from studyapp.live.rig_check import rig_of
+from studyapp.live.devices import Devices
 from studyapp.live.states import REST, TRANSITIONS, State
 from studyapp.live.trial_media import TrialMedia
 
@@ -87,7 +88,7 @@ class SessionController:
         self.trial_serial = 0  # counts steps started (restarts too); tags the step's samples and controls
         self.sound = MasterSound()  # the console's master volume and mute (master_sound.py)
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
-        self.device_info = None  # the link device's latest handshake (DeviceInfo), None on the simulated device
+        self.devices = Devices(self)  # the device: its choice, its records, the rig it makes
         self._next_status = 0.0
 
     # the state machine (states.py) --------------------------------------------------------------
@@ -111,6 +112,7 @@ class SessionController:
     audio = property(lambda self: self.apparatus.audio)
     midi = property(lambda self: self.apparatus.midi)
     latency = property(lambda self: self.controls.latency)  # knob_latency.py
+    device_info = property(lambda self: self.devices.info)  # the link device's latest handshake, or None
     controls_sent = property(lambda self: self.controls.sent)  # on-screen controls sent ...
     controls_taken = property(lambda self: self.controls.taken)  # ... and reported back (a player waits for its own)
 
@@ -140,26 +142,14 @@ class SessionController:
 
     def set_device(self, device):
         """Run on ``device`` (a link's path or URL; None: the simulated device): the preview engine restarts on it."""
-        if self.in_session:
-            raise UserError("a session is in progress: abort it before changing the device")
-        self.apparatus.device = device or None
-        self.device_info = None
-        if self.protocol is not None:
-            self.replace_engine(self.apparatus.config(self.protocol, self.protocol.seed, preview_actions(self.protocol)),
-                                f"preview of {self.protocol.study}")
-
-    def device_record(self):
-        """session.json's ``device``: ``kind`` simulated (latency 0) or link (its path and latest ``info``)."""
-        if self.apparatus.device is None:
-            return {"kind": "simulated", "latency_ms": 0.0}
-        return {"kind": "link", "link": self.apparatus.device, "info": self.device_info}
+        self.devices.choose(device)
 
     def rig(self):
-        """The rig the model judges (rig_check.Rig): the engine's device and its link latency; None without a protocol."""
-        return None if self.protocol is None else rig_of(self.apparatus.config(self.protocol, 0, {}))
+        """The rig the model judges (rig_check.Rig); None without a protocol."""
+        return self.devices.rig()
 
     def replace_engine(self, config, describe):
-        self.device_info = None  # until the new engine's device shakes hands
+        self.devices.info = None  # until the new engine's device shakes hands
         self.apparatus.replace(config, describe)
         self.controls.engine_replaced()
 
@@ -182,7 +172,7 @@ class SessionController:
         else:
             described = {"device": self.apparatus.device or "simulated", "engine": "real-time", **(apparatus or {})}
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
-                                     device=self.device_record(), **(details or {}))
+                                     device=self.devices.record(), **(details or {}))
         self.session = session
         self.last_session = session.folder
         for record in logged:
@@ -341,7 +331,7 @@ class SessionController:
             return
         for notice in self.host.drain():
             if isinstance(notice, (DeviceInfo, DeviceHealth)):
-                self._device_event(notice)
+                self.devices.take(notice)
             else:
                 self.message(notice.text, level=notice.level, topic=getattr(notice, "topic", ""))
         self._follow_engine()
@@ -352,16 +342,6 @@ class SessionController:
         for record in engine.controls():
             self.controls.take(record)
         self._watch_status(engine)
-
-    def _device_event(self, record):
-        """A link device's handshake (``device``) or a trial's frame counts (``device_health``, logged in a session)."""
-        if isinstance(record, DeviceInfo):
-            self.device_info = dict(record.info)
-            self.events.device.emit(info=self.device_info)
-            return
-        self.events.device_health.emit(trial=record.trial, health=record.health, totals=record.totals)
-        if self.runner is not None:
-            self.runner.log(records.device_health(record.trial, record.health, record.totals))
 
     def _follow_engine(self):
         """Announce a change of the engine's state, and let the state machine take it."""
