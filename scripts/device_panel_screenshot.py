@@ -50,7 +50,7 @@ def main():
     app = application()
     with tempfile.TemporaryDirectory() as folder, EmulatorProcess(Path(folder) / "studyapp-device",
                                                                   "--watchdog-ms", 200) as emulator:
-        controller = SessionController(audio="null", midi="none", device=emulator.link)
+        controller = SessionController(audio="null", midi="none", device=emulator.link, hang_timeout=0.5)
         controller.apparatus.device_options = {"device_latency": args.latency, "device_silence": 0.5}
         console = Console(controller, predict=functools.partial(rig_check.predict, seeds=args.seeds))
         console.resize(1366, 900)
@@ -64,6 +64,9 @@ def main():
             wait(app, lambda: panel.table.isVisibleTo(console), "the rig check's prediction", 3600)
             for _ in range(20):
                 app.processEvents()
+            if controller.host.state != "running":
+                sys.exit(f"device_panel_screenshot: the engine is {controller.host.state}: "
+                         f"{console.log.toPlainText()[-500:]}")
             print(save_widget(console.setup, args.file))
         finally:
             console.shut_down()

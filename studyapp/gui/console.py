@@ -404,6 +404,7 @@ class Console(QMainWindow):
             event.ignore()
             return
         self.timer.stop()
+        self.rig_prediction.cancel()
         self._stop_simulated()
         self.controller.close()
         self.participant_window.close()

@@ -123,12 +123,16 @@ class DevicePanel(QWidget):
     # what the engine reported ----------------------------------------------------------------------
     def show_device(self, device, state):
         """Before the handshake: the simulated device, or the link being opened (``state``: the engine's)."""
-        self.health.setText("")
         if device is None:
+            self.health.setText("")
             self.summary.setText(device_words.SIMULATED)
         elif state == "failed":
-            self.summary.setText(f"link {device}: not opened (see the log)")
+            if "waiting for the handshake" in self.summary.text():
+                self.summary.setText(f"link {device}: not opened")
+            self.health.setText("<span style='color:#c00'>the engine on this link failed or stopped: see the "
+                                "log</span>")
         else:
+            self.health.setText("")
             self.summary.setText(f"link {device}: waiting for the handshake…")
 
     def show_info(self, info):

@@ -60,6 +60,8 @@ class RigCheckView:
     def accepted(self):
         """Before a new session: None if the rig check warns (or is not ready on a link) and the experimenter
         does not go on; else the records to log (the warning taken: rig_check.record)."""
+        if self.request is None and self.controller.protocol is not None:
+            self.check()  # no engine has started yet (``--start``): ``studyapp run`` may have predicted it
         req = self.request
         if req is None:
             return ()

@@ -8,7 +8,9 @@ priority (the engine's worker and the GUI come first), reporting
 ``progress(done, total, condition)`` and then ``finished(key, prediction)``
 through queued signals, so the views are touched on the GUI thread only. A
 result for a request no longer current (another protocol or device chosen
-meanwhile) is cached but not shown.
+meanwhile) is cached but not shown. ``cancel()`` (the console closing) stops
+the jobs at their next progress report: the application waits for its pool's
+jobs at exit.
 """
 
 import os
@@ -25,23 +27,42 @@ class _Signals(QObject):
     failed = Signal(object, str)  # key, why
 
 
+class _Gone(Exception):
+    """The console closed: the job stops at its next progress report."""
+
+
 class _Job(QRunnable):
-    def __init__(self, req, predict, signals):
+    def __init__(self, req, predict, signals, cancelled):
         super().__init__()
-        self.req, self.predict, self.signals = req, predict, signals
+        self.req, self.predict, self.signals, self.cancelled = req, predict, signals, cancelled
+
+    def _emit(self, name, *args):
+        """Tell the GUI thread; False once the receiver is gone (the console closed)."""
+        if self.cancelled.is_set():
+            return False
+        try:
+            getattr(self.signals, name).emit(*args)
+        except RuntimeError:  # its QObject was deleted
+            return False
+        return True
+
+    def _progress(self, done, total, name):
+        if not self._emit("progress", self.req.key, done, total, name):
+            raise _Gone
 
     def run(self):
         try:  # this thread only: Linux schedules threads as tasks
             os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
         except (OSError, AttributeError):
             pass
-        key = self.req.key
         try:
-            result = self.predict(self.req, progress=lambda d, t, name: self.signals.progress.emit(key, d, t, name))
-        except Exception as exc:  # a view must say the check failed, not hang on "predicting"
-            self.signals.failed.emit(key, f"{type(exc).__name__}: {exc}")
+            result = self.predict(self.req, progress=self._progress)
+        except _Gone:
             return
-        self.signals.finished.emit(key, result)
+        except Exception as exc:  # a view must say the check failed, not hang on "predicting"
+            self._emit("failed", self.req.key, f"{type(exc).__name__}: {exc}")
+            return
+        self._emit("finished", self.req.key, result)
 
 
 class RigPrediction(QObject):
@@ -55,6 +76,7 @@ class RigPrediction(QObject):
         self.cache = rig_check.PredictionCache()
         self.current = None  # the request being shown
         self._running = {}  # key -> request, while its job runs
+        self._cancelled = threading.Event()
         self._signals = _Signals()
         self._signals.progress.connect(self._progress)
         self._signals.finished.connect(self._finished)
@@ -76,7 +98,11 @@ class RigPrediction(QObject):
             self.finished.emit(req, kept)
         elif req.key not in self._running:
             self._running[req.key] = req
-            QThreadPool.globalInstance().start(_Job(req, self.predict, self._signals))
+            QThreadPool.globalInstance().start(_Job(req, self.predict, self._signals, self._cancelled))
+
+    def cancel(self):
+        """Stop every running job at its next progress report (the console closes: the pool waits for its jobs)."""
+        self._cancelled.set()
 
     def _progress(self, key, done, total, name):
         if self.current is not None and key == self.current.key:
