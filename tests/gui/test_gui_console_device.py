@@ -113,3 +113,25 @@ def test_a_simulated_rig_starts_without_a_question(device_console, qapp, monkeyp
     assert session is not None
     assert json.loads((session.folder / "session.json").read_text())["device"] == {"kind": "simulated",
                                                                                    "latency_ms": 0.0}
+
+
+def test_a_running_prediction_stops_when_cancelled(qapp):
+    """The console cancels its prediction when it closes: the application's pool would otherwise wait for it."""
+    import time
+
+    from PySide6.QtCore import QThreadPool
+
+    from studyapp.gui.rig_prediction import RigPrediction
+    from studyapp.live import rig_check
+
+    def endless(req, progress=None):
+        while True:
+            progress(0, 1, "LVT")
+            time.sleep(0.01)
+
+    prediction = RigPrediction(endless)
+    req = rig_check.Request(("LVT",), {}, rig_check.Rig("link", 5000.0, 5), "hash")
+    prediction.run(req)
+    assert prediction.busy
+    prediction.cancel()
+    assert QThreadPool.globalInstance().waitForDone(5000)
