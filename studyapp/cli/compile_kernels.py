@@ -10,7 +10,8 @@ samples, in the app's own paths: the closed loop with an estimator in it and
 on a real device's per-sample interface, the optimiser's side-by-side
 kernels, the estimator bank and benchmark, the metric (one-off and the
 optimiser's memorised reference), the stability monitor on a recording,
-FOAW's window sizes, the audio resampler and the scope's envelope. Every
+FOAW's window sizes, the audio resampler and the scope's envelope; and it
+builds the device emulator's C core (studyapp/device/c_core.py). Every
 later process loads the compiled code from the cache; a warm cache makes
 this take a few seconds. ``make run`` and ``make test`` call it.
 
@@ -107,9 +108,19 @@ def signal_paths():
     envelope(np.zeros((2, 64)), 4)
 
 
+def device_core():
+    """The device protocol's C core (firmware/studyapp_device.c), which the device emulator runs when it builds;
+    without a C compiler the emulator runs the Python core and says so."""
+    from studyapp.device import c_core
+    try:
+        c_core.build()
+    except c_core.BuildError:
+        pass
+
+
 # the longest first: a pool of two then ends about together
 PARTS = {"closed loop": closed_loop, "optimiser kernels": optimiser_kernels, "estimator bank": estimator_bank,
-         "signal paths": signal_paths}
+         "signal paths": signal_paths, "device C core": device_core}
 
 
 def _timed(name):

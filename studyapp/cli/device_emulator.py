@@ -19,22 +19,27 @@ RATE_RANGE = (100, 100000)
 def register(sub):
     p = sub.add_parser("device-emulator", help="emulate a device speaking the device protocol on a pty link")
     p.add_argument("--link", required=True, metavar="PATH", help="the path to make a link to the pty's device end")
-    p.add_argument("--rate", type=float, default=5000.0,
+    p.add_argument("--rate", metavar="HZ", type=float, default=5000.0,
                    help=f"sample rate in Hz, a whole number {RATE_RANGE[0]}..{RATE_RANGE[1]} (default 5000)")
-    p.add_argument("--seed", type=number_options.seed, default=0, help="sensor noise and link faults (default 0)")
-    p.add_argument("--gesture", default="strokes", help="the virtual hand's gesture: strokes | hold (default strokes)")
-    p.add_argument("--latency", type=float, default=0.0, help="seconds the device's received frames are delayed")
-    p.add_argument("--jitter", type=float, default=0.0, help="extra delay, uniform over 0..S seconds")
-    p.add_argument("--loss", type=float, default=0.0, help="probability a frame is lost (either way)")
-    p.add_argument("--corrupt", type=float, default=0.0, help="probability a frame has a bit flipped (either way)")
-    p.add_argument("--disconnect-after", type=float, default=None, metavar="S",
-                   help="close the link after S seconds")
+    p.add_argument("--seed", metavar="N", type=number_options.seed, default=0,
+                   help="sensor noise and link faults (default 0)")
+    p.add_argument("--gesture", metavar="strokes|hold", default="strokes",
+                   help="the virtual hand's gesture (default strokes)")
+    p.add_argument("--latency", metavar="S", type=float, default=0.0,
+                   help="seconds the device's received frames are delayed")
+    p.add_argument("--jitter", metavar="S", type=float, default=0.0, help="extra delay, uniform over 0..S seconds")
+    p.add_argument("--loss", metavar="P", type=float, default=0.0, help="probability a frame is lost (either way)")
+    p.add_argument("--corrupt", metavar="P", type=float, default=0.0,
+                   help="probability a frame has a bit flipped (either way)")
+    p.add_argument("--disconnect-after", metavar="S", type=float, default=None, help="close the link after S seconds")
     p.add_argument("--lockstep", action="store_true",
                    help="no clock: advance only once the force tagged for the sample is in (tests)")
-    p.add_argument("--format", default="f64", help="sensor channels: f64 (SI) | counts (i32 with a gain)")
-    p.add_argument("--core", default="auto",
-                   help="firmware core: auto (C if it builds) | c | python (default auto)")
-    p.add_argument("--watchdog-ms", type=int, default=1, help="the device's watchdog, 1..1000 ms (default 1)")
+    p.add_argument("--format", metavar="f64|counts", default="f64",
+                   help="sensor channels: f64 in SI, or counts (i32 with a gain) (default f64)")
+    p.add_argument("--core", metavar="auto|c|python", default="auto",
+                   help="firmware core: auto is C if it builds (default auto)")
+    p.add_argument("--watchdog-ms", metavar="MS", type=int, default=1,
+                   help="the device's watchdog, 1..1000 ms (default 1)")
     p.set_defaults(func=run)
 
 

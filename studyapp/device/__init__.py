@@ -5,6 +5,9 @@ files, one idea each: ``cobs.py`` and ``crc.py`` (the byte stuffing and the
 check), ``frames.py`` (payload <-> wire bytes, a streaming reader),
 ``messages.py`` (the message types), ``streams.py`` (sequence numbers and
 counters of one direction), ``device_side.py`` (the safety core a firmware
-must have), ``emulator.py`` (a device on a pty). No module here is compiled
-by numba.
+must have), ``firmware.py`` (the firmware's loop around it: bytes in, a
+sample, bytes out), ``c_core.py`` (the same loop in C,
+firmware/studyapp_device.c, built and loaded), ``pty_link.py``,
+``link_faults.py`` and ``emulator.py`` (a device on a pty). No module here
+is compiled by numba.
 """

@@ -28,7 +28,7 @@ seconds (of the device's clock; of wall time in lock-step).
 
 SIGTERM, SIGINT and SIGHUP end it: the link is removed on every exit. At the
 end one line on stdout: ``stats: {json}`` (samples, the core's counters, the
-link's lost and flipped frames, frames dropped because the host did not read).
+link's lost and flipped frames each way, frames dropped because the host did not read).
 """
 
 import json
@@ -147,7 +147,9 @@ class Emulator:
 
     def stats(self):
         return {"samples": self.samples, "core": self.core_name, **self.core.counters(),
-                "link_lost": self.faults.lost, "link_flipped": self.faults.flipped, "tx_dropped": self.link.dropped}
+                "link_lost_in": self.faults.lost["in"], "link_lost_out": self.faults.lost["out"],
+                "link_flipped_in": self.faults.flipped["in"], "link_flipped_out": self.faults.flipped["out"],
+                "tx_dropped": self.link.dropped}
 
     def _sense_and_actuate(self):
         x, a, v = self.device.read_sensors()

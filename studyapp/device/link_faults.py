@@ -22,8 +22,8 @@ class LinkFaults:
         self._partial = bytearray()
         self._queue = []  # (release time, bytes)
         self._last_release = 0.0
-        self.lost = 0
-        self.flipped = 0
+        self.lost = {"in": 0, "out": 0}
+        self.flipped = {"in": 0, "out": 0}
 
     @property
     def idle(self):
@@ -43,15 +43,15 @@ class LinkFaults:
             out.append(bytes(buf))
         return out
 
-    def _damage(self, frame):
+    def _damage(self, frame, way):
         if self.loss and self._rng.random() < self.loss:
-            self.lost += 1
+            self.lost[way] += 1
             return b""
         if self.corrupt and self._rng.random() < self.corrupt:
             bit = int(self._rng.integers(len(frame) * 8))
             frame = bytearray(frame)
             frame[bit // 8] ^= 1 << (bit % 8)
-            self.flipped += 1
+            self.flipped[way] += 1
             return bytes(frame)
         return frame
 
@@ -63,7 +63,7 @@ class LinkFaults:
             self._queue.append((now, data))
             return
         for frame in self._frames(data, keep_partial=True):
-            frame = self._damage(frame)
+            frame = self._damage(frame, "in")
             if frame:
                 delay = self.latency + (self._rng.random() * self.jitter if self.jitter else 0.0)
                 self._last_release = max(self._last_release, now + delay)
@@ -87,4 +87,4 @@ class LinkFaults:
         """Bytes to the host, after loss and bit errors (no delay)."""
         if not data or not (self.loss or self.corrupt):
             return data
-        return b"".join(self._damage(f) for f in self._frames(data, keep_partial=False))
+        return b"".join(self._damage(f, "out") for f in self._frames(data, keep_partial=False))

@@ -61,7 +61,8 @@ def _check_uint(name, value, bits):
 
 
 def _check_finite(name, value, positive=False):
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and (value > 0.0 or not positive)
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    ok = number and math.isfinite(value) and (value > 0.0 or not positive)
     _check(ok, name, value, "a finite number above 0" if positive else "a finite number")
 
 
@@ -144,7 +145,8 @@ class Start(_Fixed):
         super().check()
         _check(self.packet >= 1, "START.packet", self.packet, "1..255 samples")
         # the force for sample j answers the frame holding sample j - latency, sent once its last sample is in
-        _check(self.latency >= self.packet - 1, "START.latency", self.latency, f"at least packet - 1 = {self.packet - 1}")
+        _check(self.latency >= self.packet - 1, "START.latency", self.latency,
+               f"at least packet - 1 = {self.packet - 1}")
 
 
 @dataclass(frozen=True)

@@ -29,7 +29,8 @@ class Sender:
 
 
 class Receiver:
-    """Messages out of a byte stream (any split). ``channels``: the INFO's, for SENSORS (None before INFO).
+    """Messages out of a byte stream (any split). ``channels``: the INFO's, for SENSORS (None before INFO;
+    an INFO received sets them).
 
     ``accept``: the message types this side may receive (a host frame at the host is corrupt).
     Counters: ``frames`` (valid messages), ``corrupt``, ``lost``.
@@ -63,6 +64,8 @@ class Receiver:
                 self.lost += (seq - self._last_seq - 1) & 0xFF
             self._last_seq = seq
             self.frames += 1
+            if isinstance(message, messages.Info):
+                self.channels = message.channels
             out.append(message)
         return out
 

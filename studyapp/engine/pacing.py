@@ -8,22 +8,23 @@ device, studyapp/device/link_device.py), the device itself: the worker does
 not wait before a block, the device's ``exchange`` waits for its sensor
 frames, so blocks arrive at the device's rate (a paced audio sink is then fed,
 not followed: its FIFO and the resampler take up the drift between the two
-clocks). A device that faults hands the pacing to the timer. A paced sink that stops calling back (three silent waits of
-50 ms) hands the pacing to the timer for the rest of the run. A timer more
+clocks). A device that faults hands the pacing to the timer until it is
+re-armed. A paced sink that stops calling back (three silent waits of 50 ms)
+hands the pacing to the timer for the rest of the run. A timer more
 than ``RESYNC`` behind restarts its schedule from now instead of running
 blocks back to back to catch up.
 
 A block is a *deadline miss* when it finishes after its deadline: t0 + (k+1) T
 on the timer; on the audio clock, when the device had to play silence while
 the block was being made; on the device clock, when the device's driver
-counted a force frame late during the block (its ``health["late"]``). The load of a block is its compute time (wall
-clock) over T. A miss is an *overrun* when the block's own compute took longer
-than T on the CPU (the thread's CPU time), a *stall* when it took longer than
-T by the wall clock only (the worker was taken off the CPU mid-block); the
-other misses come from starting late (the OS woke the worker late, or an
-earlier block overran): ``wake_late_max`` says how late.
-Stalls and late starts are the machine's share of the misses, overruns the
-engine's.
+counted a force frame late during the block (its ``health["late"]``). The load
+of a block is its compute time (wall clock) over T. A miss is an *overrun*
+when the block's own compute took longer than T on the CPU (the thread's CPU
+time), a *stall* when it took longer than T by the wall clock only (the worker
+was taken off the CPU mid-block); the other misses come from starting late
+(the OS woke the worker late, or an earlier block overran): ``wake_late_max``
+says how late. Stalls and late starts are the machine's share of the misses,
+overruns the engine's.
 """
 
 import time
@@ -59,6 +60,9 @@ class Pacing:
 
     def wait(self, k):
         """Wait until block ``k`` may start; True when the audio or device clock has just been given up for the timer."""
+        if self.device is not None and self.device.fault is None and not self.device_clock:
+            self.device_clock = True  # re-armed: the device paces again
+            self.device_late = self.device.health["late"]
         if self.device_clock:
             if self.device.fault is None:
                 return False

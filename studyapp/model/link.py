@@ -121,12 +121,15 @@ IDEAL = LinkSpec()
 
 
 class Link:
-    """The link's state and its seeded draws, for a device at ``rate`` Hz; ``streams``: two SeedSequences."""
+    """The link's state and its seeded draws, for a device at ``rate`` Hz; ``streams``: two SeedSequences.
+
+    ``latency_samples``, ``packet_samples``, ``jitter_samples``: L, P and J of the module docstring.
+    """
 
     def __init__(self, spec, rate, streams):
         self.spec = spec
-        self.latency, self.packet, self.jitter = spec.samples(rate)
-        slots = self.latency + self.jitter + 1
+        self.latency_samples, self.packet_samples, self.jitter_samples = spec.samples(rate)
+        slots = self.latency_samples + self.jitter_samples + 1
         self.state = np.full(LS_RING + 2 * slots, -1.0)
         self.state[LS_SAMPLE] = 0.0
         self.state[LS_FORCE] = 0.0
@@ -134,19 +137,24 @@ class Link:
         self.state[LS_RING + slots:] = 0.0
         self._rng_jitter, self._rng_loss = (np.random.default_rng(s) for s in streams)
         self._sample = 0
+        # every sample sent and none drawn: each sample's delay is L (the per-sample path's common case)
+        self._fixed = self.packet_samples == 1 and self.jitter_samples == 0 and spec.loss == 0.0
 
     def delays(self, n):
         """The next ``n`` samples' delays: L + d_p at a packet's newest sample (-1 if lost), else -1."""
         first = self._sample
         self._sample += n
+        if self._fixed:
+            return np.full(n, float(self.latency_samples))
         out = np.full(n, -1.0)
-        p = self.packet
-        ends = np.arange((first + p) // p * p - 1, first + n, p) - first  # the packets' newest samples, (j + 1) % P == 0
+        p = self.packet_samples
+        # the packets' newest samples: (j + 1) % P == 0
+        ends = np.arange((first + p) // p * p - 1, first + n, p) - first
         if ends.size == 0:
             return out
-        delay = np.full(ends.size, float(self.latency))
-        if self.jitter > 0:
-            delay += np.floor(self._rng_jitter.random(ends.size) * (self.jitter + 1))
+        delay = np.full(ends.size, float(self.latency_samples))
+        if self.jitter_samples > 0:
+            delay += np.floor(self._rng_jitter.random(ends.size) * (self.jitter_samples + 1))
         if self.spec.loss > 0.0:
             delay[self._rng_loss.random(ends.size) < self.spec.loss] = -1.0
         out[ends] = delay

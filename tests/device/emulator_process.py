@@ -10,7 +10,6 @@ import time
 import tty
 from pathlib import Path
 
-from studyapp.device import messages
 from studyapp.device.streams import Sender, host_receiver
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -86,9 +85,6 @@ class Host:
             except BlockingIOError:
                 return []
             got = self.receiver.feed(data)
-            for m in got:
-                if isinstance(m, messages.Info):
-                    self.receiver.channels = m.channels
             self.inbox += got
             return got
         return []

@@ -229,3 +229,14 @@ def test_streams_count_lost_and_corrupt():
     assert [m.nonce for m in got] == [0, 1, 4, 5]
     assert receiver.lost == 2  # seq 2 (corrupt) and 3 (dropped)
     assert receiver.corrupt == 2  # the flipped frame and a device type at the device
+
+
+def test_host_receiver_takes_the_channels_from_info():
+    from studyapp.device.emulator import COUNT_CHANNELS
+    from studyapp.device.streams import Sender, host_receiver
+    info = messages.Info(**{**INFO.__dict__, "channels": COUNT_CHANNELS})
+    sender = Sender(COUNT_CHANNELS)
+    receiver = host_receiver()
+    sensors = messages.Sensors(5, 0, ((1, 2, 3),))
+    got = receiver.feed(sender.frame(info) + sender.frame(sensors))
+    assert got == [info, sensors] and receiver.corrupt == 0

@@ -35,11 +35,11 @@ def rig():
     fake.close()
 
 
-def _host(fake, kind, timeout=1.0):
+def _host(fake, kind, count=1, timeout=2.0):
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         found = [m for m in fake.received if isinstance(m, kind)]
-        if found:
+        if len(found) >= count:
             return found
         time.sleep(0.002)
     return []
@@ -59,6 +59,7 @@ def test_force_enable_cleared_disarms_the_device_once(rig, reason, code):
     link.before_block(True, "parent")
     link.before_block(False, reason)
     link.before_block(False, reason)
+    time.sleep(0.1)  # a second DISARM would have arrived by now
     assert _host(fake, messages.Disarm) == [messages.Disarm(reason=code)]
     assert not device.armed
 
@@ -69,7 +70,7 @@ def test_trial_start_rearms_and_reports_health(rig):
     fake.sensors(0, [(0.0, 0.0, 0.0)])
     device.exchange(type("C", (), {"sample": lambda *a: 0.0})(), 1, None, None)
     link.trial_started(3)
-    assert len(_host(fake, messages.Arm)) == 2
+    assert len(_host(fake, messages.Arm, count=2)) == 2
     health = [e for e in events if isinstance(e, ev.DeviceHealth)]
     assert health[0].trial == 0 and health[0].health["frames"] == 1 and health[0].totals["samples"] == 1
     assert link.trial == 3

@@ -20,13 +20,15 @@ LATE_OK = 250  # samples ahead: 50 ms
 @pytest.fixture(scope="module")
 def emulator(tmp_path_factory):
     link = tmp_path_factory.mktemp("emu") / "device"
-    proc = start_emulator(link, "--gesture", "hold", "--core", os.environ.get("STUDYAPP_TEST_CORE", "auto"))
+    core = os.environ.get("STUDYAPP_TEST_CORE", "auto")
+    proc = start_emulator(link, "--gesture", "hold", "--core", core)
     host = Host(link)
     yield link, proc, host
     host.close()
     stats = stop_emulator(proc)
     assert not os.path.lexists(link)
     assert stats["samples"] > 0
+    assert stats["core"] == ("c" if core == "auto" else core)  # this machine builds the C core: its bytes are tested
 
 
 def handshake(host):
@@ -82,7 +84,8 @@ def test_streaming_counts_samples(emulator):
     host.wait(messages.State, where=lambda m: not m.streaming)
 
 
-def test_arm_ramp_and_watchdog_bound(emulator):
+@pytest.mark.parametrize("latency", [5, 25])
+def test_arm_ramp_and_watchdog_bound(emulator, latency):
     """Ten tries: stream armed (packets of 5 samples) with forces 5 ms ahead for 0.1 s, then stop answering.
     The device's FAULT WATCHDOG says where the force reached 0 (sample) and where the last feeding host frame
     arrived (detail): that span is at most latency + 2 ms in the device's time, whenever the host stopped (on
@@ -91,7 +94,6 @@ def test_arm_ramp_and_watchdog_bound(emulator):
     _, _, host = emulator
     handshake(host)
     bounds, walls = [], []
-    latency = 25
     for _ in range(10):
         host.send(messages.Start(5, latency), messages.Arm(10))
         host.wait(messages.State, where=lambda m: m.armed)
@@ -107,7 +109,7 @@ def test_arm_ramp_and_watchdog_bound(emulator):
         host.inbox.clear()
     limit = latency / RATE + 0.002
     wall = f"{min(walls) * 1e3:.2f}..{max(walls) * 1e3:.2f} ms" if walls else "-"
-    print(f"watchdog over 10 tries: last host frame -> force 0 in the device's time "
+    print(f"watchdog over 10 tries, latency {latency / RATE * 1e3:g} ms: last host frame -> force 0 in the device's time "
           f"{min(bounds) * 1e3:.2f}..{max(bounds) * 1e3:.2f} ms (bound {limit * 1e3:.1f} ms); host's last write "
           f"-> FAULT read {wall} ({len(walls)} tries reached the stop)")
     assert max(bounds) <= limit
@@ -189,11 +191,16 @@ def test_corrupt_and_lost_frames_are_counted(tmp_path):
     finally:
         host.close()
         stats = stop_emulator(proc)
-    assert stats["link_flipped"] > 0 and stats["link_lost"] > 0
-    # every flipped frame is counted corrupt (or, its delimiter flipped, merged with the next one)
-    assert stats["corrupt"] >= 0.5 * stats["link_flipped"] and stats["corrupt"] <= stats["link_flipped"]
-    assert stats["lost"] >= stats["link_lost"]
-    assert host.receiver.corrupt > 0 or host.receiver.lost > 0
+    flipped, lost = stats["link_flipped_in"], stats["link_lost_in"]
+    assert flipped > 10 and lost > 5 and stats["link_flipped_out"] > 10
+    # a flipped frame is corrupt; a flipped delimiter merges two frames into one corrupt run, a flip to 0x00
+    # splits one into two
+    assert 0.5 * flipped <= stats["corrupt"] <= 2 * flipped
+    assert stats["lost"] >= lost  # seq gaps: the lost frames and the corrupt ones
+    assert host.receiver.corrupt > 0 and host.receiver.lost > 0
+    print(f"200 PINGs, --corrupt 0.3 --loss 0.1: to the device {flipped} flipped, {lost} lost -> corrupt "
+          f"{stats['corrupt']}, seq gaps {stats['lost']}; to the host {stats['link_flipped_out']} flipped -> "
+          f"corrupt {host.receiver.corrupt}, gaps {host.receiver.lost}")
 
 
 def test_sigterm_and_sigint_remove_the_link(tmp_path):
@@ -244,3 +251,37 @@ def test_replaces_its_own_stale_link(tmp_path):
     assert os.readlink(link) != "/dev/pts/999999"
     stop_emulator(proc)
     assert not os.path.lexists(link)
+
+
+def test_counts_format_and_disconnect(tmp_path):
+    """--format counts: INFO announces i32 channels with their gains and SENSORS carries integers;
+    --disconnect-after closes the pty (the host reads end-of-file or EIO), removes the link, exits 0."""
+    from studyapp.device.emulator import COUNT_CHANNELS
+    link = tmp_path / "dev"
+    proc = start_emulator(link, "--format", "counts", "--disconnect-after", "3", "--core", "python")
+    host = Host(link)
+    try:
+        info = handshake(host)
+        assert info.channels == COUNT_CHANNELS
+        host.send(messages.Start(4, 40))
+        frame = host.wait(messages.Sensors)
+        assert len(frame.values) == 4 and all(isinstance(v, int) for r in frame.values for v in r)
+        assert all(abs(x) <= 0.011 for x, _, _ in frame.si(info.channels))
+        proc.wait(timeout=60)
+        assert proc.returncode == 0 and not os.path.lexists(link)
+        closed = False
+        for _ in range(1000):
+            try:
+                if os.read(host.fd, 1 << 16) == b"":
+                    closed = True
+                    break
+            except BlockingIOError:
+                time.sleep(0.01)
+            except OSError:
+                closed = True
+                break
+        assert closed
+    finally:
+        host.close()
+        if proc.poll() is None:
+            proc.kill()

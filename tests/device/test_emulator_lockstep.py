@@ -2,8 +2,6 @@
 with the forces delayed by the fixed latency, sample for sample (a toy controller; the real loop's equality
 is the host driver's test)."""
 
-import os
-
 import numpy as np
 import pytest
 
@@ -33,10 +31,10 @@ def reference(latency, n, gesture="strokes", seed=0):
     return np.array(rows)
 
 
-@pytest.mark.parametrize("latency", [1, 5])
-def test_lockstep_equals_the_delayed_loop(tmp_path, latency):
+@pytest.mark.parametrize("latency, core", [(1, "python"), (5, "c")])
+def test_lockstep_equals_the_delayed_loop(tmp_path, latency, core):
     link = tmp_path / "dev"
-    proc = start_emulator(link, "--lockstep", "--core", os.environ.get("STUDYAPP_TEST_CORE", "auto"))
+    proc = start_emulator(link, "--lockstep", "--core", core)
     host = Host(link)
     rows = []
     try:

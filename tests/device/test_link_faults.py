@@ -69,6 +69,7 @@ def test_a_stopped_host_lets_the_device_force_fall_to_zero_within_its_bound(tmp_
     assert "WATCHDOG" in report["fault"]
     code, zero_at, last_frame = next(f for f in report["device_faults"] if f[0] == messages.WATCHDOG)
     took_ms = 1e3 * (zero_at - last_frame) / RATE
+    print(f"figure: watchdog force 0 after {took_ms:.2f} ms")  # docs/devices.md quotes these (pytest -s)
     assert took_ms <= 1e3 * LATENCY / RATE + 2.0
     assert emulator.stats is None or emulator.stats.get("armed", 0) == 0
 
@@ -88,11 +89,22 @@ def test_a_killed_host_leaves_the_device_disarmed_by_its_watchdog(tmp_path, try_
     assert stats["fault"] == messages.WATCHDOG and stats["armed"] == 0
 
 
+def _watch_hangup(fd, gone):
+    try:
+        poller = select.poll()
+        poller.register(fd, select.POLLHUP | select.POLLERR)
+        while not poller.poll(1000):
+            pass
+        gone.append(time.monotonic())
+    finally:
+        os.close(fd)
+
+
 def _loop(device):
     return ClosedLoop(LoopConfig(rate=RATE, estimators={}, source="LVT", fmax=2.0, gesture="strokes"), device=device)
 
 
-def _run_until_fault(device, loop, seconds=5.0):
+def _run_until_fault(device, loop, seconds=30.0):
     forces = []
     end = time.monotonic() + seconds
     while device.fault is None and time.monotonic() < end:
@@ -101,30 +113,45 @@ def _run_until_fault(device, loop, seconds=5.0):
     return forces, after
 
 
+@pytest.fixture
+def prompt_threads():
+    """The hang-up watcher thread gets the interpreter promptly while the loop runs."""
+    before = sys.getswitchinterval()
+    sys.setswitchinterval(0.0005)
+    yield
+    sys.setswitchinterval(before)
+
+
+@pytest.mark.usefixtures("prompt_threads")
 @pytest.mark.parametrize("how", ["killed", "closed"])
 @pytest.mark.parametrize("try_", range(TRIES))
 def test_a_lost_emulator_is_a_host_fault_with_force_zero_within_20ms(tmp_path, how, try_):
     path = tmp_path / "device"
-    options = ("--disconnect-after", 1.0) if how == "closed" else ()
+    options = ("--disconnect-after", 5.0) if how == "closed" else ()
     emulator = EmulatorProcess(path, "--seed", try_, "--watchdog-ms", 1000, *options).start()
     try:
-        device = LinkDevice(path, RATE, latency=LATENCY, ramp_ms=0)
+        # when the link ended: a second descriptor on the pty sees the hang-up as the host's does (the kill's
+        # own time would count the kernel's delay in ending a process on a loaded machine)
+        gone = []
+        watcher = threading.Thread(target=_watch_hangup, args=(os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK),
+                                                               gone), daemon=True)
+        watcher.start()
+        # a silence bound of 1 s: on a loaded machine the emulator may stall for more than 20 ms, and the test is
+        # of the hang-up (the 20 ms silence bound itself is tested with the scripted device)
+        device = LinkDevice(path, RATE, latency=LATENCY, ramp_ms=0, silence=1.0)
         loop = _loop(device)
         device.arm(0)
-        killed = []
         if how == "killed":
-            timer = threading.Timer(0.5, lambda: (killed.append(time.monotonic()), emulator.process.kill()))
-            timer.start()
+            threading.Timer(0.5, emulator.process.kill).start()
         _, after = _run_until_fault(device, loop)
         device.close()
+        watcher.join(10.0)
     finally:
         emulator.kill()
-    assert device.fault is not None and "link" in device.fault
+    assert device.fault is not None and "the link failed" in device.fault
     assert all(np.all(f == 0.0) for f in after)
-    # the link ended after the last bytes came: from then to the latched fault is at most 20 ms
-    assert device.fault_time - device.last_data <= 0.020
-    if killed:
-        assert device.fault_time - killed[0] <= 0.020
+    print(f"figure: {how}: host fault {1e3 * (device.fault_time - gone[0]):.2f} ms after the hang-up")
+    assert -0.005 <= device.fault_time - gone[0] <= 0.020  # (the watcher thread may see it a little later)
 
 
 def test_corrupt_and_lost_frames_are_counted_never_applied(tmp_path):

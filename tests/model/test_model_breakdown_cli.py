@@ -13,6 +13,7 @@ from studyapp.model import breakdown
 
 KEYS = ["source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max"]
 COLUMNS = ["source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed"]
+LINK = ["latency", "packet", "jitter"]  # issue 29: the link the device ran behind, after today's keys and columns
 
 
 @pytest.fixture
@@ -25,7 +26,7 @@ def test_json_for_one_source_with_progress(capsys):
     assert main(["breakdown", "--source", "LOWPASS", "--seeds", "2", "--duration", "1.5", "--json"]) == 0
     out, err = capsys.readouterr()
     doc = json.loads(out)
-    assert list(doc) == KEYS
+    assert list(doc) == KEYS + LINK and [doc[k] for k in LINK] == [0.0, 0.0, 0.0]
     # issue 20: breakdown is judged while bowing by default
     assert (doc["source"], doc["rate"], doc["gesture"], doc["seeds"]) == ("LOWPASS", 5000.0, "strokes", 2)
     assert len(doc["fmax"]) == 2 and all(isinstance(v, float) and v > 0 for v in doc["fmax"])
@@ -54,7 +55,7 @@ def test_all_writes_one_csv_row_per_source(tmp_path, capsys):
     with out.open() as f:
         reader = csv.DictReader(f)
         rows = list(reader)
-    assert reader.fieldnames == COLUMNS
+    assert reader.fieldnames == COLUMNS + LINK
     assert [r["source"] for r in rows] == breakdown.sources()
     for r in rows:
         assert (float(r["rate"]), r["gesture"], int(r["seeds"])) == (5000.0, "hold", 2)
@@ -89,6 +90,10 @@ def test_markdown_is_headed_by_date_and_command(never_broken, tmp_path, capsys):
     (["--source", "LVT", "--gesture", "wiggle"], "--gesture 'wiggle': allowed are hold, strokes"),
     (["--source", "LVT", "--duration", "0"], "--duration 0.0: allowed is a number of seconds from 0.5 to 60"),
     (["--source", "LVT", "--all"], "not allowed with argument"),
+    (["--source", "LVT", "--latency", "-0.001"], "--latency -0.001: allowed is a number of seconds from 0 to 1"),
+    (["--source", "LVT", "--packet", "2"], "--packet 2.0: allowed is a number of seconds from 0 to 1"),
+    (["--source", "LVT", "--jitter", "nan"], "argument --jitter: 'nan' is not a finite number"),
+    (["--source", "LVT", "--latency", "1ms"], "argument --latency: invalid float value: '1ms'"),
     ([], "one of the arguments --source --all is required"),
 ])
 def test_bad_input_is_one_line_exit_2_and_no_file(never_broken, tmp_path, capsys, argv, words):
