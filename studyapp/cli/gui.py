@@ -21,6 +21,7 @@ checks them). See docs/gui.md.
 import re
 
 from studyapp.cli import number_options
+from studyapp.cli.device_choice import add_device_option
 from studyapp.cli.session_info_options import add_session_info_options
 
 SIZES = ((800, 600), (7680, 4320))  # px: the smallest and largest window --size allows
@@ -63,6 +64,7 @@ def register(sub):
                         help="window size in pixels, e.g. 1366x768 (800x600 to 7680x4320)")
     parser.add_argument("--measure-scope", type=float, metavar="SECONDS",
                         help="measure the scope's frame rate with every trace on for SECONDS, print it and exit")
+    add_device_option(parser)
     add_session_info_options(parser)
     parser.set_defaults(func=run)
 
@@ -87,6 +89,13 @@ def run(args):
         raise UserError("--results '': empty: allowed is a results folder")
     _check_before_the_console(args, protocol)
     require_display()
+    if args.device is not None:
+        from studyapp.cli.device_choice import check_device
+        from studyapp.experiment.protocol import load_protocol
+        from studyapp.gui.app import default_protocol
+
+        protocol = args.protocol or default_protocol()
+        check_device(args.device, load_protocol(protocol).rate if protocol else 5000.0)
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")
     if args.measure_scope is not None and not 0.5 <= args.measure_scope <= 600:

@@ -1,7 +1,12 @@
 """``studyapp run --protocol FILE --participant ID [--simulated-participant] [--headless]
 [--resume] [--results DIR] [--seed N] [--audio SPEC] [--midi SPEC] [--participant-screen N]
-[--replay-gesture EVENTS] [--experimenter NAME] [--session-number N] [--notes TEXT] [--order-row N]``:
-run one participant's session.
+[--replay-gesture EVENTS] [--device simulated|PATH_OR_URL] [--experimenter NAME] [--session-number N]
+[--notes TEXT] [--order-row N]``: run one participant's session.
+
+``--device`` (the console only): the device the participant holds (cli/device_choice.py). On a device on a
+link, a session with an adjustment task is first checked by the model (live/rig_check.py): when the link's
+latency makes LVT's predicted breakdown fall below 1.5x the best estimator's, a ``studyapp run: warning: ...``
+line says so, and the console asks again at Start.
 
 The experimenter's fields and the order row are stored in session.json
 (``experiment.session_info`` says what is allowed); the order row in force is
@@ -27,6 +32,7 @@ simulated participant's hand moves as that session's participant bowed
 """
 
 from studyapp.cli import number_options
+from studyapp.cli.device_choice import add_device_option
 from studyapp.cli.session_info_options import add_session_info_options, session_info_of
 
 
@@ -54,6 +60,7 @@ def register(sub):
     parser.add_argument("--replay-gesture", metavar="EVENTS",
                         help="the simulated participant bows as logged in EVENTS (a session's events.jsonl "
                              "or folder; needs --simulated-participant)")
+    add_device_option(parser)
     add_session_info_options(parser)
     parser.set_defaults(func=run)
 
@@ -95,7 +102,7 @@ def run(args):
     if args.headless and args.audio not in (None, "wav", "null"):
         raise UserError(f"--audio {args.audio}: allowed headless is wav (audio.wav in the session folder) or null")
     if args.headless:
-        for option in ("midi", "participant_screen"):
+        for option in ("midi", "participant_screen", "device"):
             if getattr(args, option) is not None:
                 raise UserError(f"--{option.replace('_', '-')}: allowed only without --headless (the console's)")
     if args.replay_gesture is not None and not args.simulated_participant:
@@ -113,9 +120,15 @@ def run(args):
 
         check_same_player(args.results, protocol.study, args.participant, args.simulated_participant)
     if not args.headless:
+        from studyapp.cli.device_choice import check_device, rig_check_line
+
         output_paths.check_audio(args.audio, inputs=[args.protocol, *filter(None, [args.replay_gesture])])
         args.audio = args.audio or "device"
         args.midi = args.midi or "first"
+        link = check_device(args.device, protocol.rate)
+        if not args.resume:
+            args.rig_prediction = rig_check_line(protocol, link, lambda text: print(f"studyapp run: {text}",
+                                                                                   file=sys.stderr, flush=True))
         return _run_in_gui(args)
 
     from studyapp.experiment.hand_trace import ReplayingHand

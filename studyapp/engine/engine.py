@@ -54,10 +54,11 @@ START_TIMEOUT = 120.0  # s for the worker to import, compile and prime
 
 
 class Engine(Watchdog):
-    def __init__(self, config=None, on_fault=None, on_notice=None):
+    def __init__(self, config=None, on_fault=None, on_notice=None, on_device=None):
         self.config = config or EngineConfig()
         self.on_fault = on_fault
         self.on_notice = on_notice or (lambda notice: None)
+        self.on_device = on_device or (lambda record: None)  # events.DeviceInfo and DeviceHealth, as they come
         self.names = self._validate()
         self.faults = []
         self.fault_time = None  # time.monotonic() when the watchdog or the worker reported the first fault
@@ -266,6 +267,8 @@ class Engine(Watchdog):
                 self._controls.append(event)
         elif isinstance(event, ev.Stopped):
             self.summary = event.summary
+        elif isinstance(event, (ev.DeviceInfo, ev.DeviceHealth)):
+            self.on_device(event)
 
     def _fault(self, text, when):
         with self._lock:

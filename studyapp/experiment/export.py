@@ -6,8 +6,9 @@ One row per response, first the columns of the "Study results" contract:
 
 then ``study, step, practice, value, knob, peak_fmax, duration, app_version``,
 the trial's engine health ``deadline_misses, underruns, faults,
-events_dropped``, and the session's ``experimenter, session_number,
-order_row, simulated``.
+events_dropped``, the session's ``experimenter, session_number,
+order_row, simulated``, and the device the participant held ``device,
+device_serial, device_latency_ms``.
 
 - ``task`` names the task type; ``trial``, ``fmax``, ``time``, ``step`` and
   ``duration`` come from the response event, the rest from the task type's
@@ -40,6 +41,11 @@ order_row, simulated``.
   session.json's ``simulated``, or its ``apparatus.participant``); the
   analysis leaves these rows out by default (``studyapp analyse
   --include-simulated``).
+- ``device``: ``simulated``, or the name a device on a link gave in its
+  handshake; ``device_serial`` its serial number (empty on the simulated
+  device); ``device_latency_ms`` the link's latency (the host's answer-ahead,
+  ms; 0 on the simulated device). From session.json's ``device``; empty for
+  a session stored before it was.
 - ``experimenter``, ``session_number``, ``order_row``: from session.json
   (``session_info``); empty when not given, or for a session stored before
   they were. The experimenter's ``notes`` stay in session.json: free text of
@@ -76,9 +82,10 @@ from studyapp.experiment.trial_health import ADDED, HEALTH_COLUMNS
 from studyapp.io.atomic import atomic_open
 
 SESSION_COLUMNS = ["experimenter", "session_number", "order_row"]  # what session.json tells of the session
+DEVICE_COLUMNS = ["device", "device_serial", "device_latency_ms"]  # session.json's ``device``
 COLUMNS = ["participant", "session", "task", "condition", "trial", "fmax", "rating", "time", "protocol_hash",
            "study", "step", "practice", "value", "knob", "peak_fmax", "duration", "app_version", *HEALTH_COLUMNS,
-           *SESSION_COLUMNS, "simulated"]
+           *SESSION_COLUMNS, "simulated", *DEVICE_COLUMNS]
 
 
 def _session_rows(folder, problems):
@@ -105,6 +112,7 @@ def _session_rows(folder, problems):
             "app_version": info["app_version"],
             **{column: info.get(column) for column in SESSION_COLUMNS},
             "simulated": is_simulated(info),
+            **device_columns(info.get("device")),
         }
     except UserError as exc:
         problems.append(f"{folder}: skipped, {exc}")
@@ -144,6 +152,21 @@ def _session_rows(folder, problems):
         base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
+
+
+def device_columns(device):
+    """``device`` (simulated, or the link device's name), ``device_serial``, ``device_latency_ms`` from
+    session.json's ``device``; empty for a session stored before it was, or a link whose handshake it lacks."""
+    empty = dict.fromkeys(DEVICE_COLUMNS)
+    if not isinstance(device, dict):
+        return empty
+    if device.get("kind") == "simulated":
+        return {**empty, "device": "simulated", "device_latency_ms": float(device.get("latency_ms", 0.0))}
+    info = device.get("info")
+    if not isinstance(info, dict):
+        return {**empty, "device": device.get("kind")}
+    return {"device": info.get("name"), "device_serial": info.get("serial"),
+            "device_latency_ms": info.get("latency_ms")}
 
 
 def _trial_health(events):

@@ -61,10 +61,22 @@ def note(text: str) -> dict:
 
 # the live apparatus --------------------------------------------------------------------------------
 def engine(info: dict, seed: int) -> dict:
-    """A session's engine came up (``info``: ``Engine.info``)."""
-    return {"type": "engine", "rate": info["rate"], "block": info["block"], "audio": info["audio"],
-            "midi": info["midi"], "paced": info["paced"], "realtime": info["realtime"], "seed": seed,
-            "note": ENGINE_NOTE}
+    """A session's engine came up (``info``: ``Engine.info``); the metadata of its recording (audio.wav, ...).
+
+    On a device on a link, ``device``: its ``info`` (link_device.LinkDevice.info: name, serial, calibration,
+    latency, measured round trip); without one the key is left out (the simulated device).
+    """
+    record = {"type": "engine", "rate": info["rate"], "block": info["block"], "audio": info["audio"],
+              "midi": info["midi"], "paced": info["paced"], "realtime": info["realtime"], "seed": seed,
+              "note": ENGINE_NOTE}
+    if info.get("device"):
+        record["device"] = info["device"]
+    return record
+
+
+def device_health(trial: int, health: dict, totals: dict) -> dict:
+    """A link device's frame counts over the engine's trial ``trial`` and since its link opened (DeviceHealth)."""
+    return {"type": "device_health", "trial": trial, "health": dict(health), "totals": dict(totals)}
 
 
 def engine_failed(faults: list) -> dict:

@@ -13,7 +13,11 @@ the simulated participant plays (``simulated``), the order row
 (``order_row``, ``order_rows``, ``order_row_source``), the schedule, the
 apparatus (device, rate), and what the experimenter tells (``experimenter``,
 ``session_number``, ``notes``; ``session_info`` checks them, before anything
-is written). Everything that happens afterwards is an
+is written). ``device`` says what the participant held: ``{"kind":
+"simulated", "latency_ms": 0}``, or ``{"kind": "link", "link": PATH_OR_URL,
+"info": {...}}`` with the device's handshake as the console last had it
+(link_device.LinkDevice.info: name, serial, protocol and firmware versions,
+calibration, latency, measured round trip; null if none had come yet). Everything that happens afterwards is an
 event in ``events.jsonl`` (see ``session_log``).
 
 A trial is finished when its ``response`` event is on disk. ``resume`` reopens
@@ -75,6 +79,7 @@ from studyapp.experiment.session_log import LogLock, LogWriteError, SessionLog, 
 from studyapp.io.free_names import first_free
 
 CREATED = records.SESSION_CREATED
+SIMULATED_DEVICE = {"kind": "simulated", "latency_ms": 0.0}  # session.json's ``device`` on the simulated device
 SESSION_END = records.SESSION_END
 
 
@@ -181,10 +186,11 @@ class Session:
 
     @classmethod
     def create(cls, protocol, participant, results, seed=None, apparatus=None, experimenter=None,
-               session_number=None, notes=None, order_row=None):
+               session_number=None, notes=None, order_row=None, device=None):
         """A new session of ``participant`` under ``results``; refused if they already have one.
 
-        ``order_row`` None: the enrolment index decides it (``session_info``).
+        ``order_row`` None: the enrolment index decides it (``session_info``). ``device``: session.json's
+        ``device`` (``kind`` simulated or link, a link's ``info``); None: the simulated device.
         """
         check_participant(participant)
         told = {"experimenter": check_experimenter(experimenter), "session_number": check_session_number(session_number),
@@ -211,6 +217,7 @@ class Session:
                 folder, info = cls._describe(protocol, participant, study_folder, participant_folder,
                                              seed, apparatus, order_row)
                 info.update(told)
+                info["device"] = dict(device if device is not None else SIMULATED_DEVICE)
                 make_folders(folder)
                 _write_description(folder, info)
             session = cls(folder, lock)

@@ -53,8 +53,14 @@ def build(args):
     if protocol is not None and getattr(args, "order_row", None) is not None:
         check_order_row(load_protocol(protocol), args.order_row)  # refused before any engine starts
     application()
-    controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"))
+    device = _device(getattr(args, "device", None))
+    controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"),
+                                   device=device)
     console = Console(controller)
+    console.device_panel.show_choice(device)
+    kept = getattr(args, "rig_prediction", None)  # studyapp run predicted it already
+    if kept is not None:
+        console.rig_prediction.cache.put(kept[0], kept[1])
     protocol = getattr(args, "protocol", None) or default_protocol()
     if protocol is not None:
         controller.load_protocol(protocol)
@@ -69,6 +75,15 @@ def build(args):
     console.setup.fill_session_info(**{key: getattr(args, key, None)
                                        for key in ("experimenter", "session_number", "notes", "order_row")})
     return controller, console
+
+
+def _device(given):
+    """The device to run on: ``--device`` (simulated or a link), else the one remembered on this machine."""
+    from studyapp.gui.device_panel import remembered
+
+    if given is not None:
+        return None if given == "simulated" else given
+    return remembered()
 
 
 def main(args):

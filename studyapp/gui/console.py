@@ -27,7 +27,9 @@ Abort, and closing the console, while a session runs ask first (``confirm``;
 
 Its parts: ``ProgressPanel`` (progress_panel.py), ``SessionButtons``
 (session_buttons.py), ``LiveTab`` (live_tab.py: scope, knobs and pads, the
-bowing pad), ``SessionTools``, ``SetupPanel``, ``PageControls``, ``StatusBar``.
+bowing pad), ``SessionTools``, ``SetupPanel`` (with the device's ``DevicePanel``), ``RigCheckView`` (the
+device's choice and the rig check, which asks before a session on a rig that may not show the effect),
+``PageControls``, ``StatusBar``.
 Every widget is a view of the ``SessionController`` (``studyapp.live``, no
 Qt in it): widgets call its methods, and its events update the widgets.
 Messages are coloured by their level (info, warning, error); a device's
@@ -60,10 +62,12 @@ from studyapp.gui.page_controls import PageControls
 from studyapp.gui.participant_placement import confine
 from studyapp.gui.participant_window import ParticipantWindow
 from studyapp.gui.progress_panel import ProgressPanel
+from studyapp.gui.rig_check_view import RigCheckView
 from studyapp.gui.session_buttons import SessionButtons
 from studyapp.gui.session_tools import SessionTools
 from studyapp.gui.setup_panel import SetupPanel
 from studyapp.gui.status_bar import StatusBar
+from studyapp.live import rig_check
 from studyapp.live.states import REST, State
 from studyapp.live.simulated_session import SimulatedSession
 
@@ -76,7 +80,7 @@ PREFERRED_SIZE = (1500, 940)  # px, where the screen has room for it
 
 
 class Console(QMainWindow):
-    def __init__(self, controller, parent=None):
+    def __init__(self, controller, parent=None, predict=rig_check.predict):
         super().__init__(parent)
         self.controller = controller
         self.simulated = None
@@ -90,6 +94,9 @@ class Console(QMainWindow):
 
         self.setup = SetupPanel()
         self.setup.protocol_chosen.connect(self.choose_protocol)
+        self.device_panel = self.setup.device_panel
+        self.rig = RigCheckView(self, predict)  # the device's choice and the rig check (rig_check_view.py)
+        self.rig_prediction = self.rig.prediction
         self.buttons = SessionButtons(controller, self.start_session, self.abort_session)
         b = self.buttons
         self.start_button, self.pause_button, self.abort_button = b.start_button, b.pause_button, b.abort_button
@@ -231,11 +238,15 @@ class Console(QMainWindow):
         return True
 
     def start_session(self, seed=None):
+        logged = () if self.setup.resume.isChecked() else self.rig.accepted()
+        if logged is None:
+            self.setup.show_error("not started: the rig check's warning was not accepted")
+            return None
         try:
             session = self.controller.start_session(
                 self.setup.participant_id, self.setup.results_folder, resume=self.setup.resume.isChecked(),
                 seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"},
-                details=self.setup.session_info)
+                details=self.setup.session_info, logged=logged)
         except (UserError, RuntimeError) as exc:
             self.setup.show_error(str(exc))
             return None
@@ -318,6 +329,7 @@ class Console(QMainWindow):
             self.notices = {}
             self._midi_shown = None
         self.setup.show_engine(state, info, config, self.notices)
+        self.rig.engine_state(state)
         self.status.show_engine(state, info)
         if state == "running":
             self.scope.set_scene(info["rate"], info["names"])
@@ -405,6 +417,7 @@ class Console(QMainWindow):
             event.ignore()
             return
         self.timer.stop()
+        self.rig_prediction.cancel()
         self._stop_simulated()
         self.controller.close()
         self.participant_window.close()

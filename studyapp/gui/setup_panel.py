@@ -11,7 +11,8 @@ the session is open the fields show its stored values (the console fills
 them from session.json, and gives back what was typed when it ends).
 
 The apparatus lines say what the engine really opened, in words: the device
-(the simulated 1-DOF device unless a driver is configured), the audio output
+(device_panel.py: simulated or a link, chosen here; its handshake, health and
+the rig check), the audio output
 (a PortAudio device, a WAV file, or none, and why: the engine's own notice
 when it fell back to the null sink) and the MIDI input (a port, or none and
 why, in which case the on-screen knobs are the controls; or none yet, when
@@ -43,6 +44,7 @@ from PySide6.QtWidgets import (
 )
 
 from studyapp.experiment.results_folder import absolute, default_results
+from studyapp.gui.device_panel import DevicePanel
 
 RESULTS_KEY = "results/folder"
 
@@ -127,15 +129,16 @@ class SetupPanel(QWidget):
         form.addRow(self.simulated)
         self.resume.toggled.connect(lambda _: self._grey_for_resume())
 
-        self.device = QLabel("")
+        self.device_panel = DevicePanel()  # the choice, the handshake, health and the rig check
+        self.device = self.device_panel.summary
         self.audio = QLabel("")
         self.midi = QLabel("")
         self.engine = QLabel("")
-        for label in (self.device, self.audio, self.midi, self.engine):
+        for label in (self.audio, self.midi, self.engine):
             label.setWordWrap(True)
         apparatus = QGroupBox("Apparatus")
         found = QFormLayout(apparatus)
-        found.addRow("Device", self.device)
+        found.addRow("Device", self.device_panel)
         found.addRow("Audio", self.audio)
         found.addRow("MIDI", self.midi)
         found.addRow("Engine", self.engine)
@@ -213,6 +216,7 @@ class SetupPanel(QWidget):
         self._editable = bool(on)
         for widget in (self.participant, self.protocol, self.results, self.resume, self.simulated):
             widget.setEnabled(on)
+        self.device_panel.set_editable(on)
         self._grey_for_resume()
 
     def _session_fields(self):
@@ -233,7 +237,8 @@ class SetupPanel(QWidget):
     def show_engine(self, state, info, config, notices):
         """Fill the apparatus lines from the engine's state, ``info`` (once running) and its notices."""
         device = config.device if config is not None else None
-        self.device.setText(f"driver {device}" if device else "simulated 1-DOF device (no device driver configured)")
+        if state in ("starting", "failed") or device is None:
+            self.device_panel.show_device(device, state)
         if state == "running":
             audio = info.get("audio", "?")
             self.audio.setText(_with_notice(_audio_words(audio), notices.get("audio")))

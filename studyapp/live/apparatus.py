@@ -55,6 +55,7 @@ class Apparatus:
         self.realtime = realtime
         self.hang_timeout = hang_timeout
         self.make_host = make_host
+        self.device_options = {}  # EngineConfig's device_* fields for a link (device_latency, device_silence, ...)
         self.host = None
         self._seen = None  # the host's state the controller last followed
 
@@ -73,15 +74,22 @@ class Apparatus:
                               safety=SafetyLimits(fmax_ceiling=protocol.fmax_ceiling))
         if self.hang_timeout is not None:
             config.hang_timeout = float(self.hang_timeout)
+        if self.device:
+            for key, value in self.device_options.items():
+                setattr(config, key, value)
         return config
 
     def replace(self, config, describe):
-        """Start an engine with ``config``; the old one stops in the background."""
+        """Start an engine with ``config``; the old one stops in the background.
+
+        A device on a link takes one host at a time: the new engine opens it only once the old one has
+        stopped (``EngineHost.start(after=...)``), still without blocking the caller."""
         if self.hang_timeout is None:  # the bound follows the machine's load at each start (engine/load_margin.py)
             config.hang_timeout = hang_timeout_for(load_per_core(), HANG_TIMEOUT)
-        old, self.host = self.host, self.make_host(config, describe).start()
-        if old is not None:
-            old.stop(wait=False)
+        old = self.host
+        stopping = old.stop(wait=False) if old is not None else None
+        host = self.make_host(config, describe)
+        self.host = host.start(after=stopping) if config.device and stopping is not None else host.start()
         self._seen = None  # announced, and followed, at the next poll
 
     def state_change(self):

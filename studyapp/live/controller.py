@@ -13,6 +13,7 @@ views. Its parts, one idea each:
     steps.py        a trial or page started, held and ended on the engine
     controls.py     knobs and pads: routing, pickup, page settle, latency
     hand.py         the bow and the hand's gesture, the mouse's bow pad
+    devices.py      the device: chosen, its handshake and health, the rig it makes (rig_check.py)
     trial_media.py  the audio recording and its cues, the reference tone, trial health
 
 Time. ``poll()`` (a GUI timer calls it) never waits: it passes on the
@@ -43,6 +44,7 @@ import time
 from pathlib import Path
 
 from studyapp.engine.config import HANG_TIMEOUT
+from studyapp.engine.events import DeviceHealth, DeviceInfo
 from studyapp.engine.load_margin import busy_warning, load_per_core
 from studyapp.errors import UserError
 from studyapp.experiment import records
@@ -59,6 +61,7 @@ from studyapp.live.engine_host import EngineHost
 from studyapp.live.evented import EventGroup
 from studyapp.live.hand import Hand
 from studyapp.live.master_sound import MasterSound
+from studyapp.live.devices import Devices
 from studyapp.live.states import REST, TRANSITIONS, State
 from studyapp.live.trial_media import TrialMedia
 
@@ -77,7 +80,7 @@ class SessionController:
         self.clock = clock
         self.events = EventGroup("protocol", "engine", "state", "trial", "knob", "selection", "bowing", "gesture",
                                  "telemetry", "status", "message", "response", "pickup", "page", "refused",
-                                 "volume")
+                                 "volume", "device", "device_health")
         self.controls = Controls(self)
         self.media = TrialMedia(self)
         self.hand = Hand(self)
@@ -92,6 +95,7 @@ class SessionController:
         self.stopped_by = "operator"  # who pressed the emergency stop last (states.emergency)
         self.simulated = False  # the simulated participant plays the session (apparatus "participant")
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
+        self.devices = Devices(self)  # the device: its choice, its records, the rig it makes
         self._next_status = 0.0
 
     # the state machine (states.py) --------------------------------------------------------------
@@ -115,6 +119,7 @@ class SessionController:
     audio = property(lambda self: self.apparatus.audio)
     midi = property(lambda self: self.apparatus.midi)
     latency = property(lambda self: self.controls.latency)  # knob_latency.py
+    device_info = property(lambda self: self.devices.info)  # the link device's latest handshake, or None
     controls_sent = property(lambda self: self.controls.sent)  # on-screen controls sent ...
     controls_taken = property(lambda self: self.controls.taken)  # ... and reported back (a player waits for its own)
 
@@ -142,14 +147,25 @@ class SessionController:
             self._set_state(self.rest)
         return protocol
 
+    def set_device(self, device):
+        """Run on ``device`` (a link's path or URL; None: the simulated device): the preview engine restarts on it."""
+        self.devices.choose(device)
+
+    def rig(self):
+        """The rig the model judges (rig_check.Rig); None without a protocol."""
+        return self.devices.rig()
+
     def replace_engine(self, config, describe):
+        self.devices.info = None  # until the new engine's device shakes hands
         self.apparatus.replace(config, describe)
         self.controls.engine_replaced()
 
-    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None):
+    def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None,
+                      logged=()):
         """Open the participant's session (``UserError`` when refused) and start its engine.
 
         ``details``: ``experimenter``, ``session_number``, ``notes``, ``order_row`` (experiment/session_info.py).
+        ``logged``: records for the session's log before its trials (the rig check's warning, rig_check.record).
         """
         if self.protocol is None:
             raise UserError("no protocol loaded: choose one first")
@@ -166,10 +182,12 @@ class SessionController:
         else:
             described = {"device": self.apparatus.device or "simulated", "engine": "real-time", **(apparatus or {})}
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
-                                     **(details or {}))
+                                     device=self.devices.record(), **(details or {}))
         self.session = session
         self.simulated = simulated  # who answers: stamped on every response (SessionRunner)
         self.last_session = session.folder
+        for record in logged:
+            session.log.append(record)
         for note in session.notes:  # what opening it found or repaired (a damaged line, a rebuilt file)
             self.message(note, level="warning")
         self.message(f"results folder {Path(results).resolve()}; before this session, {used}")
@@ -330,7 +348,10 @@ class SessionController:
         if self.host is None:
             return
         for notice in self.host.drain():
-            self.message(notice.text, level=notice.level, topic=getattr(notice, "topic", ""))
+            if isinstance(notice, (DeviceInfo, DeviceHealth)):
+                self.devices.take(notice)
+            else:
+                self.message(notice.text, level=notice.level, topic=getattr(notice, "topic", ""))
         self._follow_engine()
         self._read_telemetry()
         engine = self.engine

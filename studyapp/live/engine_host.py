@@ -34,16 +34,23 @@ class EngineHost:
         self.lost = 0
         self._cancelled = threading.Event()
         self._stopped = False
+        self._after = None
         self._thread = threading.Thread(target=self._start, name="studyapp-engine-start", daemon=True)
 
-    def start(self):
+    def start(self, after=None):
+        """Start the engine in the background, once the thread ``after`` (an old engine stopping) has ended."""
+        self._after = after
         self._thread.start()
         return self
 
     def _start(self):
+        if self._after is not None:
+            self._after.join()
+        if self._cancelled.is_set():
+            return
         try:
             engine = Engine(self.config, on_fault=lambda text: self.messages.put(Notice(text, "error")),
-                            on_notice=self.messages.put)
+                            on_notice=self.messages.put, on_device=self.messages.put)
             engine.start()
         except (UserError, EngineError) as exc:
             self.error = str(exc)
@@ -83,7 +90,8 @@ class EngineHost:
         return block if block["end"] > block["start"] else None
 
     def drain(self):
-        """Every ``events.Notice`` since the last call (faults and start errors at level ``error``)."""
+        """Every ``events.Notice`` since the last call (faults and start errors at level ``error``), and the
+        device's ``events.DeviceInfo`` and ``events.DeviceHealth`` records."""
         out = []
         while True:
             try:

@@ -1,0 +1,58 @@
+"""``--device simulated|PATH_OR_URL`` of ``studyapp gui`` and ``studyapp run``, and the rig check ``run`` prints.
+
+``simulated`` is the engine's simulated device; a path or URL is a device
+speaking docs/device-protocol.md (a serial port, ``studyapp device-emulator``'s
+pty, ``socket://HOST:PORT``), probed before any window opens (link_probe.py:
+one line and exit code 2 for a link that is not such a device). Without the
+option the console uses the device remembered on this machine (its Apparatus
+panel's choice).
+
+``rig_check_line(protocol, device, say)``: before a session with an
+adjustment task on a device on a link, the model's prediction at the link's
+latency (live/rig_check.py, seconds of CPU per condition) and, when LVT falls
+below 1.5x the best estimator, the warning line (the console asks the same at
+Start). The simulated device is the paper's own loop: nothing to check.
+"""
+
+from studyapp.errors import ParameterError
+
+SIMULATED = "simulated"
+
+
+def add_device_option(parser):
+    parser.add_argument("--device", metavar="simulated|PATH_OR_URL", default=None,
+                        help="the device: simulated, or a link to a device speaking docs/device-protocol.md "
+                             "(serial port, pty, socket://HOST:PORT); default: the one remembered on this machine")
+
+
+def check_device(device, rate):
+    """None for the simulated device, else the link (probed: ``ParameterError``, one line, if it is no device)."""
+    if device is None or device == SIMULATED:
+        return None
+    from studyapp.device.link_open import is_link
+    from studyapp.device.link_probe import probe
+
+    if not is_link(device):
+        raise ParameterError(f"--device {device}: allowed is simulated, a serial port, a pty or a pyserial URL")
+    probe(device, rate)
+    return device
+
+
+def rig_check_line(protocol, device, say):
+    """Predict the protocol's adjustment conditions on the rig (``say`` the progress); returns (request, prediction,
+    warning line or None), or None when there is nothing to check."""
+    from studyapp.engine.config import EngineConfig
+    from studyapp.live import rig_check
+
+    rig = rig_check.rig_of(EngineConfig(rate=protocol.rate, device=device))
+    req = rig_check.request(protocol, rig)
+    if req is None or not rig_check.needs_check(rig):
+        return None
+    say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_ms:.2f} ms "
+        "link latency (the model, 5 seeds)…")
+    prediction = rig_check.predict(req)
+    verdict = rig_check.verdict(prediction, rig)
+    say(f"rig check: {verdict.text}")
+    if verdict.warning is not None:
+        say(verdict.warning)
+    return req, prediction, verdict.warning

@@ -1,0 +1,120 @@
+"""The rig check's prediction off the GUI thread: a ``QRunnable`` on the global ``QThreadPool``.
+
+``RigPrediction.run(req)`` returns at once: a cached result (rig_check.PredictionCache,
+per protocol hash, latency, packet and rate) is announced straight away,
+else the prediction (``predict(req, progress=...)``, 20-25 s of one core for
+nine conditions over 5 seeds) runs on a pool thread at the lowest CPU
+priority (the engine's worker and the GUI come first), reporting
+``progress(done, total, condition)`` and then ``finished(key, prediction)``
+through queued signals, so the views are touched on the GUI thread only. A
+result for a request no longer current (another protocol or device chosen
+meanwhile) is cached but not shown. ``cancel()`` (the console closing) stops
+the jobs at their next progress report: the application waits for its pool's
+jobs at exit.
+"""
+
+import os
+import threading
+
+from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
+
+from studyapp.live import rig_check
+
+
+class _Signals(QObject):
+    progress = Signal(object, int, int, str)  # key, done, total, condition
+    finished = Signal(object, object)  # key, prediction
+    failed = Signal(object, str)  # key, why
+
+
+class _Gone(Exception):
+    """The console closed: the job stops at its next progress report."""
+
+
+class _Job(QRunnable):
+    def __init__(self, req, predict, signals, cancelled):
+        super().__init__()
+        self.req, self.predict, self.signals, self.cancelled = req, predict, signals, cancelled
+
+    def _emit(self, name, *args):
+        """Tell the GUI thread; False once the receiver is gone (the console closed)."""
+        if self.cancelled.is_set():
+            return False
+        try:
+            getattr(self.signals, name).emit(*args)
+        except RuntimeError:  # its QObject was deleted
+            return False
+        return True
+
+    def _progress(self, done, total, name):
+        if not self._emit("progress", self.req.key, done, total, name):
+            raise _Gone
+
+    def run(self):
+        try:  # this thread only: Linux schedules threads as tasks
+            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
+        except (OSError, AttributeError):
+            pass
+        try:
+            result = self.predict(self.req, progress=self._progress)
+        except _Gone:
+            return
+        except Exception as exc:  # a view must say the check failed, not hang on "predicting"
+            self._emit("failed", self.req.key, f"{type(exc).__name__}: {exc}")
+            return
+        self._emit("finished", self.req.key, result)
+
+
+class RigPrediction(QObject):
+    progress = Signal(int, int, str)
+    finished = Signal(object, object)  # request, prediction
+    failed = Signal(str)
+
+    def __init__(self, predict=rig_check.predict, parent=None):
+        super().__init__(parent)
+        self.predict = predict
+        self.cache = rig_check.PredictionCache()
+        self.current = None  # the request being shown
+        self._running = {}  # key -> request, while its job runs
+        self._cancelled = threading.Event()
+        self._signals = _Signals()
+        self._signals.progress.connect(self._progress)
+        self._signals.finished.connect(self._finished)
+        self._signals.failed.connect(self._failed)
+
+    @property
+    def busy(self):
+        return self.current is not None and self.current.key in self._running
+
+    def result(self, req):
+        return self.cache.get(req) if req is not None else None
+
+    def run(self, req):
+        self.current = req
+        if req is None:
+            return
+        kept = self.cache.get(req)
+        if kept is not None:
+            self.finished.emit(req, kept)
+        elif req.key not in self._running:
+            self._running[req.key] = req
+            QThreadPool.globalInstance().start(_Job(req, self.predict, self._signals, self._cancelled))
+
+    def cancel(self):
+        """Stop every running job at its next progress report (the console closes: the pool waits for its jobs)."""
+        self._cancelled.set()
+
+    def _progress(self, key, done, total, name):
+        if self.current is not None and key == self.current.key:
+            self.progress.emit(done, total, name)
+
+    def _finished(self, key, prediction):
+        req = self._running.pop(key)
+        self.cache.put(req, prediction)
+        if self.current is not None and key == self.current.key:
+            self.finished.emit(req, prediction)
+
+    def _failed(self, key, why):
+        self._running.pop(key, None)
+        if self.current is not None and key == self.current.key:
+            self.failed.emit(why)

@@ -1,0 +1,49 @@
+"""The device the loop runs on, in words for the console's Apparatus panel. No Qt.
+
+From a link device's ``info`` (link_device.LinkDevice.info, sent by the
+engine as ``DeviceInfo``): the handshake (name, serial number, protocol and
+firmware versions, rate, channels with their SI units), the calibration's
+source (the handshake's own gains, or a TOML file), the round trip measured
+at open (PING probe: median and 99th percentile) and the link's latency (the
+samples the host answers ahead, and the same in ms). From a ``DeviceHealth``:
+a trial's frame counts, the problems first.
+"""
+
+UNITS = {"position": "m", "velocity": "m/s", "acceleration": "m/s²"}
+SIMULATED = "simulated 1-DOF device (in the engine): link latency 0 samples, 0 ms"
+PROBLEMS = ("corrupt", "lost", "missing", "late", "faults", "clamped")
+
+
+def handshake(info):
+    channels = ", ".join(f"{name} ({UNITS.get(name, '?')})" for name in info.get("channels", ()))
+    return (f"{info['name']}, serial {info['serial']}; protocol v{info['protocol']}, firmware {info['firmware']}; "
+            f"{info['rate']:g} Hz; channels {channels}")
+
+
+def calibration(info):
+    source = str(info.get("calibration", "?"))
+    return "handshake (the device's own gains)" if source == "device" else f"TOML file {source}"
+
+
+def latency(info):
+    trip = info.get("round_trip_ms") or {}
+    measured = (f"round trip {trip['median']:.2f} ms median, {trip['p99']:.2f} ms p99"
+                if "median" in trip and "p99" in trip else "round trip not measured")
+    return (f"link latency {info['latency_samples']} samples = {info['latency_ms']:.2f} ms "
+            f"(packets of {info.get('packet', 1)}); {measured}")
+
+
+def late_risk(info):
+    """A warning when the measured round trip's p99 exceeds the link latency (forces would come too late)."""
+    trip = info.get("round_trip_ms") or {}
+    if "p99" in trip and trip["p99"] > info["latency_ms"]:
+        return (f"the measured round trip (p99 {trip['p99']:.2f} ms) exceeds the link latency "
+                f"({info['latency_ms']:.2f} ms): some forces will arrive late (counted, never applied)")
+    return None
+
+
+def health(trial, counts):
+    """A trial's frame counts: ``trial 3: 5000 frames, 0 corrupt, ...``."""
+    frames = counts.get("frames", 0)
+    problems = ", ".join(f"{counts.get(key, 0)} {key}" for key in PROBLEMS)
+    return f"trial {trial}: {frames} frames, {counts.get('samples', 0)} samples; {problems}"

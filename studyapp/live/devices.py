@@ -1,0 +1,54 @@
+"""The session's device: which one the engines run on, what it reported, and the rig it makes. No Qt.
+
+``choose(device)``: a link's path or URL, or None for the simulated device;
+the preview engine restarts on it (refused during a session). ``take(record)``
+follows the engine's device records: ``DeviceInfo`` (the handshake, kept as
+``info`` and announced as the controller's ``device`` event) and
+``DeviceHealth`` (a trial's frame counts: the ``device_health`` event, and a
+``device_health`` record in a running session's log). ``record()`` is
+session.json's ``device``; ``rig()`` the rig the model judges (rig_check.py).
+"""
+
+from studyapp.engine.events import DeviceInfo
+from studyapp.errors import UserError
+from studyapp.experiment import records
+from studyapp.experiment.session import SIMULATED_DEVICE
+from studyapp.live.apparatus import preview_actions
+from studyapp.live.rig_check import rig_of
+
+
+class Devices:
+    def __init__(self, live):
+        self.live = live
+        self.info = None  # the link device's latest handshake (DeviceInfo), None on the simulated device
+
+    def choose(self, device):
+        live = self.live
+        if live.in_session:
+            raise UserError("a session is in progress: abort it before changing the device")
+        live.apparatus.device = device or None
+        self.info = None
+        if live.protocol is not None:
+            live.replace_engine(live.apparatus.config(live.protocol, live.protocol.seed, preview_actions(live.protocol)),
+                                f"preview of {live.protocol.study}")
+
+    def take(self, record):
+        live = self.live
+        if isinstance(record, DeviceInfo):
+            self.info = dict(record.info)
+            live.events.device.emit(info=self.info)
+            return
+        live.events.device_health.emit(trial=record.trial, health=record.health, totals=record.totals)
+        if live.runner is not None:
+            live.runner.log(records.device_health(record.trial, record.health, record.totals))
+
+    def record(self):
+        """session.json's ``device``: ``kind`` simulated (latency 0) or link (its path and latest ``info``)."""
+        device = self.live.apparatus.device
+        if device is None:
+            return dict(SIMULATED_DEVICE)
+        return {"kind": "link", "link": device, "info": self.info}
+
+    def rig(self):
+        live = self.live
+        return None if live.protocol is None else rig_of(live.apparatus.config(live.protocol, 0, {}))

@@ -1,0 +1,172 @@
+"""Can this rig show the paper's effect? The predicted bowing breakdown of a protocol's adjustment conditions
+at the rig's link latency, and the verdict the console and ``studyapp run`` give before a session. No Qt.
+
+The rig (``Rig``): the simulated device is the paper's loop (latency 0); a
+device on a link answers each sensor sample k with a force tagged k + L
+(L = ``EngineConfig.device_latency`` samples, link_device.py), which the device
+applies at its sample k + L: a pure delay of L samples, the model's link with
+``latency = L / rate`` and no packets (model/link.py's special case P = 1,
+J = 0; tests/device/test_link_lockstep.py shows the two loops equal sample
+for sample). So the prediction needs no handshake: the latency the host
+answers with is the one the model takes.
+
+What is predicted (``request``): every condition of the protocol's adjustment
+task(s), each with the protocol's estimator parameters, at the protocol's
+rate, by ``model.link_prediction.predict`` (the breakdown search behind the
+link, median over seeds). The verdict (``verdict``): LVT's breakdown over the
+best estimator's (``lvt_margin``); below ``MARGIN`` = 1.5 the paper's effect
+(LVT nearly twice the estimators, Sec. 8.3, Fig. 7) is not expected, and an
+adjustment-task session is warned against (``warning``: the same line in the
+console's question at Start and in ``studyapp run``'s progress).
+
+A protocol without an adjustment task, or without LVT or another estimator in
+it, has nothing to check (``request`` is None / the margin is nan: no
+warning). ``PredictionCache`` keeps each result per ``Request.key``:
+(protocol hash, latency, packet, rate).
+"""
+
+import math
+from dataclasses import dataclass
+
+from studyapp.model import link_prediction
+from studyapp.model.link_prediction import MARGIN
+from studyapp.model.sources import LVT_SENSOR, TRUE
+
+ADJUSTMENT = "adjustment"
+
+
+@dataclass(frozen=True)
+class Rig:
+    """The device the loop runs on, as the model sees it: its link's latency and packet (s) at ``rate`` (Hz)."""
+
+    kind: str  # "simulated" or "link"
+    rate: float
+    latency_samples: int = 0
+    packet: float = 0.0
+
+    @property
+    def latency(self):
+        return self.latency_samples / self.rate
+
+    @property
+    def latency_ms(self):
+        return 1e3 * self.latency
+
+
+def rig_of(config):
+    """The ``Rig`` of an ``EngineConfig``: simulated (latency 0) or a device on a link (its answer-ahead latency)."""
+    if not config.device:
+        return Rig("simulated", float(config.rate))
+    return Rig("link", float(config.rate), int(config.device_latency))
+
+
+def needs_check(rig):
+    """False for the paper's own loop (no link delay): the model's reference, where LVT's margin is the paper's."""
+    return rig.latency_samples > 0 or rig.packet > 0
+
+
+@dataclass(frozen=True)
+class Request:
+    """What to predict for a protocol on a rig."""
+
+    conditions: tuple
+    estimators: dict
+    rig: Rig
+    protocol_hash: str
+
+    @property
+    def key(self):
+        return (self.protocol_hash, self.rig.latency, self.rig.packet, self.rig.rate)
+
+
+def adjustment_conditions(protocol):
+    """The conditions of the protocol's adjustment task(s), in the order they first appear."""
+    names = []
+    for task in protocol.tasks:
+        if task == ADJUSTMENT:
+            names += [n for n in protocol.task(task).conditions if n not in names]
+    return tuple(names)
+
+
+def request(protocol, rig):
+    """The prediction the protocol needs on ``rig``; None without an adjustment task."""
+    conditions = adjustment_conditions(protocol)
+    if not conditions:
+        return None
+    return Request(conditions, {n: protocol.estimator_params(n) for n in conditions}, rig, protocol.sha256)
+
+
+def predict(req, seeds=5, duration=link_prediction.DURATION, progress=None):
+    """{condition: median breakdown F_max (N)} for ``req`` (link_prediction.predict; seconds of CPU per condition)."""
+    return link_prediction.predict(list(req.conditions), req.rig.latency, rate=req.rig.rate, seeds=seeds,
+                                   packet=req.rig.packet, estimators=req.estimators, duration=duration,
+                                   progress=progress)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    prediction: dict
+    rig: Rig
+    margin: float  # LVT over the best estimator; nan when the protocol does not compare them
+
+    @property
+    def best(self):
+        """The estimator with the largest predicted breakdown (not LVT nor TRUE); None without one."""
+        others = {n: v for n, v in self.prediction.items() if n not in (LVT_SENSOR, TRUE)}
+        return max(others, key=others.get) if others else None
+
+    @property
+    def warns(self):
+        """True when LVT falls below ``MARGIN`` times the best estimator on this rig."""
+        return not math.isnan(self.margin) and self.margin < MARGIN
+
+    @property
+    def text(self):
+        """One line for the console's panel."""
+        if math.isnan(self.margin):
+            return "no LVT-versus-estimator comparison in this protocol's adjustment task"
+        said = f"LVT {self.margin:.2f}x the best estimator ({self.best})"
+        return f"{said}: below {MARGIN:g}x, the paper's effect is not expected" if self.warns else \
+            f"{said}: at least {MARGIN:g}x, the paper's effect is expected"
+
+    @property
+    def warning(self):
+        """The warning line before an adjustment-task session (None when the rig keeps the effect)."""
+        if not self.warns:
+            return None
+        return (f"warning: at this rig's link latency of {self.rig.latency_ms:.2f} ms "
+                f"({self.rig.latency_samples} samples at {self.rig.rate:g} Hz) the model predicts LVT's bowing "
+                f"breakdown at {self.margin:.2f}x the best estimator's ({self.best}), below {MARGIN:g}x: the "
+                "paper's effect (LVT nearly twice the estimators) is not expected on this rig (docs/devices.md)")
+
+
+def verdict(prediction, rig):
+    return Verdict(dict(prediction), rig, link_prediction.lvt_margin(prediction))
+
+
+def record(verdict_, started_anyway):
+    """The session log's ``rig_check`` record: what the model predicted on this rig and what was done about it."""
+    margin = verdict_.margin
+    return {"type": "rig_check", "latency_ms": verdict_.rig.latency_ms, "rate": verdict_.rig.rate,
+            "prediction": {n: (None if math.isinf(v) else v) for n, v in verdict_.prediction.items()},
+            "lvt_margin": None if math.isnan(margin) or math.isinf(margin) else margin, "threshold": MARGIN,
+            "warning": verdict_.warning, "started_anyway": bool(started_anyway)}
+
+
+def rows(prediction):
+    """(condition, F_max text) for a table, largest first (inf: "stable to 200 N")."""
+    ordered = sorted(prediction.items(), key=lambda item: -item[1])
+    return [(name, "stable to 200 N" if math.isinf(v) else f"{v:.2f} N") for name, v in ordered]
+
+
+class PredictionCache:
+    """Predictions kept per ``Request.key`` (protocol hash, latency, packet, rate)."""
+
+    def __init__(self):
+        self._kept = {}
+
+    def get(self, req):
+        return self._kept.get(req.key)
+
+    def put(self, req, prediction):
+        self._kept[req.key] = dict(prediction)

@@ -1,0 +1,23 @@
+"""The device in words for the Apparatus panel (live/device_words.py)."""
+
+from studyapp.live import device_words
+from tests.live.test_rig_check import INFO
+
+
+def test_the_handshake_calibration_and_latency_in_words():
+    assert device_words.handshake(INFO) == ("studyapp emulator, serial EMU-0042; protocol v1, firmware 1.0; 5000 Hz; "
+                                            "channels position (m), acceleration (m/s²), velocity (m/s)")
+    assert device_words.calibration(INFO) == "handshake (the device's own gains)"
+    assert device_words.calibration({**INFO, "calibration": "lab.toml [EMU-0042]"}) == "TOML file lab.toml [EMU-0042]"
+    assert device_words.latency(INFO) == ("link latency 5 samples = 1.00 ms (packets of 1); "
+                                          "round trip 0.05 ms median, 0.40 ms p99")
+    assert device_words.late_risk(INFO) is None
+    assert "exceeds the link latency" in device_words.late_risk({**INFO, "round_trip_ms": {"median": 1, "p99": 4.0}})
+    assert "latency 0" in device_words.SIMULATED
+
+
+def test_a_trials_health():
+    counts = {"frames": 5000, "samples": 5000, "corrupt": 1, "lost": 0, "missing": 2, "late": 3, "faults": 0,
+              "clamped": 0}
+    assert device_words.health(4, counts) == ("trial 4: 5000 frames, 5000 samples; 1 corrupt, 0 lost, 2 missing, "
+                                              "3 late, 0 faults, 0 clamped")

@@ -1,0 +1,47 @@
+"""``studyapp run --device``: the rig check's line before a session on a link (cli/device_choice.py), and the
+option refused headless (the simulated participant runs on the simulated device)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+from studyapp.cli.device_choice import rig_check_line
+from studyapp.experiment.protocol import load_protocol
+from studyapp.live import rig_check
+
+ROOT = Path(__file__).resolve().parents[2]
+DEMO = ROOT / "protocols" / "demo.toml"
+
+
+def test_run_prints_the_warning_line_on_a_link_and_nothing_on_the_simulated_device(monkeypatch):
+    monkeypatch.setattr(rig_check, "predict", lambda req: {"LOWPASS": 2.89, "LEVANT": 2.89, "LVT": 3.09})
+    said = []
+    protocol = load_protocol(DEMO)
+    req, prediction, warning = rig_check_line(protocol, "/tmp/studyapp-device", said.append)
+    assert req.rig.latency_ms == 1.0 and prediction["LVT"] == 3.09
+    assert warning == said[-1] and warning.startswith("warning: at this rig's link latency of 1.00 ms (5 samples")
+    assert "below 1.5x" in said[-2]
+    said.clear()
+    assert rig_check_line(protocol, None, said.append) is None and said == []
+
+
+def test_device_is_refused_headless(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "studyapp", "run", "--protocol", str(DEMO), "--participant", "X1",
+                           "--simulated-participant", "--headless", "--device", "/tmp/x", "--results",
+                           str(tmp_path)], capture_output=True, text=True, timeout=300, cwd=ROOT,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    assert proc.returncode == 2 and proc.stderr.strip().splitlines()[-1].endswith(
+        "--device: allowed only without --headless (the console's)")
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_device_that_is_no_link_is_one_line_before_anything_starts(tmp_path):
+    regular = tmp_path / "not-a-device"
+    regular.write_text("")
+    proc = subprocess.run([sys.executable, "-m", "studyapp", "run", "--protocol", str(DEMO), "--participant", "X2",
+                           "--device", str(regular), "--results", str(tmp_path / "results")],
+                          capture_output=True, text=True, timeout=300, cwd=ROOT,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and str(regular) in lines[0] and "regular file" in lines[0]
+    assert not (tmp_path / "results").exists()
