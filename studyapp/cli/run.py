@@ -117,8 +117,10 @@ def run(args):
     used = used_rows_text(Path(args.results) / protocol.study, args.simulated_participant)  # before this one enrols
     if args.resume:
         from studyapp.experiment.enrolment import check_same_player
+        from studyapp.experiment.session import lock_taken
 
-        check_same_player(args.results, protocol.study, args.participant, args.simulated_participant)
+        if not lock_taken(Path(args.results) / protocol.study / args.participant):  # the holder's refusal first
+            check_same_player(args.results, protocol.study, args.participant, args.simulated_participant)
     if not args.headless:
         from studyapp.cli.device_choice import check_device, rig_check_line
 

@@ -198,7 +198,7 @@ class Session:
         order_row = check_order_row(protocol, order_row)
         study_folder = Path(results) / protocol.study
         participant_folder = study_folder / participant
-        if not _lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
+        if not lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
             _refuse_existing(participant_folder, participant)
         try:
             made = make_folders(participant_folder)
@@ -292,7 +292,7 @@ class Session:
         if not session_folders(participant_folder):
             raise UserError(f"participant {participant!r} has no session to resume in {participant_folder}: "
                             "allowed is to start one without --resume")
-        if not _lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
+        if not lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
             read_description(session_folders(participant_folder)[-1])
         lock = ParticipantLock(participant_folder, participant)
         log_lock = None
@@ -356,7 +356,7 @@ def _check_owner(info, participant, participant_folder, folder):
                         f"to resume {info['participant']!r} in its own folder, or to start {participant!r} anew")
 
 
-def _lock_taken(participant_folder):
+def lock_taken(participant_folder):
     """True when another open of the participant's lock holds it (its refusal, naming the holder, comes
     first); tested on a descriptor of our own that creates and writes nothing."""
     try:

@@ -35,6 +35,9 @@ def studyapp(*args):
                             stderr=subprocess.PIPE, text=True)
 
 
+SIMULATED = {"participant": "simulated"}  # sessions the simulated participant of run_argv may resume (issue 31)
+
+
 def run_argv(results, participant, *extra):
     return ["run", "--protocol", str(DEMO), "--participant", participant, "--headless",
             "--simulated-participant", "--results", str(results), *extra]
@@ -113,7 +116,7 @@ def test_two_fresh_starts_at_once_make_one_session(tmp_path):
 
 
 def test_two_resumes_at_once_run_the_session_once(tmp_path, protocol):
-    Session.create(protocol, "L05", tmp_path).close()
+    Session.create(protocol, "L05", tmp_path, apparatus=SIMULATED).close()  # resumed by the simulated participant
     pair = [studyapp(*run_argv(tmp_path, "L05", "--resume")) for _ in range(2)]
     try:
         loser = first_to_exit(pair)
