@@ -444,7 +444,7 @@ ANALYSE21 = ["-o", "{out}/rep"]
 CASES_21 = {
     # item 11: sizes bounded before any allocation
     "live-block-1e9": [*LIVE, "--block", "1000000000"],
-    "live-block-above-half-the-watchdog": [*LIVE, "--block", "201"],
+    "live-block-above-half-the-watchdog": [*LIVE, "--block", "1000"],  # above half of any load-scaled bound (<= 250 ms)
     "estimate-block-1e12": ["estimate", "{in}/good.csv", *ESTIMATE, "--block", "1000000000000"],
     "bench-estimators-samples-1e12": ["bench", "estimators", "--samples", "1000000000000"],
     "bench-memory-rows-1e12": ["bench", "memory", "--rows", "1000000000000"],

@@ -173,7 +173,7 @@ def test_a_bad_page_is_refused_in_one_line_naming_it(change, named):
 @pytest.mark.parametrize(("table", "field", "value", "allowed"), [
     ("rating", "practice", "21", "an integer from 0 to 20"),
     ("rating", "practice", "-1", "an integer from 0 to 20"),
-    ("adjustment", "break_every", "1.5", "an integer from 0 to 1000"),
+    ("adjustment", "break_every", "1.5", "an integer from 1 to 1000"),
     ("adjustment", "min_listen_s", "601", "a number from 0 to 600 s"),
     ("adjustment", "min_listen_s", "inf", "a number from 0 to 600 s"),
     ("rating", "bow", '"sometimes"', 'one of "participant", "auto"'),
