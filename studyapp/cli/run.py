@@ -112,6 +112,8 @@ def run(args):
     check_order_row(protocol, args.order_row)
     from studyapp.experiment.results_folder import absolute, used_rows_text
 
+    if args.results is not None and not args.results.strip():  # "" would be the working folder
+        raise UserError("--results '': empty: allowed is a results folder")
     args.results = str(absolute(args.results))  # one study, one folder: never relative to where it was started
     output_paths.check_folder(args.results, "--results")
     used = used_rows_text(Path(args.results) / protocol.study, args.simulated_participant)  # before this one enrols
