@@ -73,7 +73,10 @@ def _package_locator():
         def from_function(cls, py_func, py_file):
             if config.CACHE_DIR and relative_folder(py_file) is not None:
                 return super().from_function(py_func, py_file)
-            for other in caching._CacheImpl._locator_classes:  # numba's own, in numba's order
+            impl = getattr(caching, "CacheImpl", None) or caching._CacheImpl  # renamed in numba 0.68
+            for other in impl._locator_classes:  # numba's own, in numba's order
+                if issubclass(other, cls):
+                    continue
                 locator = other.from_function(py_func, py_file)
                 if locator is not None:
                     return locator
