@@ -15,12 +15,14 @@ from studyapp.engine.audio.fifo import Fifo
 from studyapp.engine.audio.sinks import Gain, Sink, WavSink, open_sink, parse
 from studyapp.engine.signal_chain import FADE_S
 from studyapp.errors import ParameterError
+from studyapp.model.stimulus_level import STIMULUS_GAIN
 
 
 def test_wav_sink_writes_the_resampled_stream_whole_and_only_on_close(tmp_path):
     rate = 5000.0
     t = np.arange(5000) / rate
-    x = 0.08 * np.sin(2 * np.pi * 196 * t) + 0.01 * np.sin(2 * np.pi * 1200 * t)  # under the limiter's knee
+    # the loop's audio, scaled so that after the stimulus gain it is well above one LSB and under the limiter's knee
+    x = (0.08 * np.sin(2 * np.pi * 196 * t) + 0.01 * np.sin(2 * np.pi * 1200 * t)) / STIMULUS_GAIN
     path = tmp_path / "string.wav"
     sink = open_sink(f"wav:{path}", rate)
     assert isinstance(sink, WavSink) and sink.render and not sink.paced
@@ -35,7 +37,7 @@ def test_wav_sink_writes_the_resampled_stream_whole_and_only_on_close(tmp_path):
     fade = (1 - np.cos(np.pi * np.arange(1, f + 1) / (f + 1))) / 2
     window = np.ones(x.size)
     window[:f], window[-f:] = fade, fade[::-1]
-    heard = np.concatenate([np.zeros(f), x * window])
+    heard = np.concatenate([np.zeros(f), STIMULUS_GAIN * x * window])  # the chain's fixed stimulus gain first
     expected = np.round(0.5 * resample_poly(heard, 48, 5) * 32767).astype(np.int16)
     assert pcm.shape == expected.shape
     assert np.max(np.abs(pcm.astype(int) - expected.astype(int))) <= 1

@@ -12,6 +12,7 @@ from studyapp.engine.audio import sinks as device_sink
 from studyapp.engine.audio.recorder import AudioRecorder
 from studyapp.engine.audio.wav import pcm16
 from studyapp.engine.audio.sinks import DeviceSink
+from studyapp.model.stimulus_level import STIMULUS_GAIN
 
 PERIOD = 256  # frames per device callback
 
@@ -69,7 +70,8 @@ def test_the_recording_holds_the_gaps_the_device_played_and_cues_where_blocks_ar
             if blocks == cue_block:
                 recorder.cue(7, "adjustment", 1, "start", at=sink.next_frame())
             sounding = blocks >= cue_block  # silence until the cued block, then a tone: its onset shows where
-            sink.push(0.05 * np.sin(2 * np.pi * 440.0 * (t + np.arange(10) / 5000.0)), sounding=sounding)
+            # 0.05 full scale once through the chain's stimulus gain (under the limiter's knee)
+            sink.push(0.05 / STIMULUS_GAIN * np.sin(2 * np.pi * 440.0 * (t + np.arange(10) / 5000.0)), sounding=sounding)
             t += 10 / 5000.0
             blocks += 1
         level = sink.fifo.level
