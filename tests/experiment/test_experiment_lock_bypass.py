@@ -72,7 +72,7 @@ def test_deleting_the_lock_file_does_not_let_a_second_writer_in(tmp_path, protoc
 
 def test_run_resume_after_the_lock_file_is_deleted_is_refused_in_one_line(tmp_path, protocol):
     results = tmp_path / "results"
-    session = Session.create(protocol, "K03", results)
+    session = Session.create(protocol, "K03", results, apparatus={"participant": "simulated"})  # run by the simulated participant
     try:
         (session.folder.parent / ".lock").unlink()
         log = session.folder / "events.jsonl"

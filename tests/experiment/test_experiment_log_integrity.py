@@ -33,9 +33,9 @@ def protocol(tmp_path):
     return load_protocol(trials_only_demo(tmp_path))
 
 
-def two_trials(results, protocol, participant="D01"):
+def two_trials(results, protocol, participant="D01", apparatus=None):
     """A session with its rating and first adjustment trial answered (line 21 holds the rating response)."""
-    session = Session.create(protocol, participant, results, seed=1)
+    session = Session.create(protocol, participant, results, seed=1, apparatus=apparatus)
     run_simulated(session, trials=2).finish("interrupted")
     session.close()
     return session.folder
@@ -133,7 +133,7 @@ def test_a_last_line_that_lacks_only_its_newline_is_kept(tmp_path):
 
 
 def test_a_damaged_session_json_is_rebuilt_from_the_log_on_resume(tmp_path, protocol, capsys):
-    folder = two_trials(tmp_path, protocol)
+    folder = two_trials(tmp_path, protocol, apparatus={"participant": "simulated"})  # resumed by the simulated one
     original = json.loads((folder / "session.json").read_text())
     events_file = folder / "events.jsonl"
     events_file.write_bytes(events_file.read_bytes() + b'{"seq":93,"ty')  # and a torn last line
