@@ -140,9 +140,10 @@ def test_the_pointer_path_is_logged_per_trial_and_replayed_by_the_simulated_part
     target = np.array([replay.at(u) for u in when])
     late = when > 0.3  # after the hand has caught up from the centre
     lag = np.abs(block["position"][late] - target[late]).max()
-    # the arm's impedance (K = 5000 N/m) lags it by F / K = 0.2 mm at 1 N, plus the stick-slip's jerks;
-    # measured 0.4-0.6 mm (a target one sample late gave 1.8 mm)
-    assert lag < 1e-3, lag
+    # the arm's impedance (K = 5000 N/m) lags it by F / K = 0.2 mm at 1 N, plus the stick-slip's jerks (0.4-0.6 mm
+    # measured before issue 31); the pointer's critically damped 10 Hz glide (gestures.Live) now adds a lag of
+    # v * 2 / omega, about 3 mm at the path's 0.1 m/s: measured 1.3-2.2 mm over seeds 3-4 (2026-11-27)
+    assert lag < 4e-3, lag
     assert runner.gesture == "live"
     hand.finish("aborted")
     replayed.close()
