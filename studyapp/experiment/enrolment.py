@@ -38,12 +38,11 @@ def apparatus_is_simulated(apparatus):
     return isinstance(apparatus, dict) and apparatus.get("participant") == "simulated"
 
 
-def enrolled(study_folder):
-    """{participant: simulated?} of every participant with a session under ``study_folder``."""
+def first_sessions(study_folder):
+    """(participant, session.json or None when unreadable) of each participant with a session under ``study_folder``."""
     folder = Path(study_folder)
     if not folder.is_dir():
-        return {}
-    kinds = {}
+        return
     for participant_folder in sorted(p for p in folder.iterdir() if p.is_dir()):
         sessions = session_folders(participant_folder)
         if not sessions:
@@ -51,9 +50,16 @@ def enrolled(study_folder):
         try:
             info, _ = read_description(sessions[0])
         except UserError:
-            info = None  # unreadable: counted as real (module docstring)
-        kinds[participant_folder.name] = is_simulated(info)
-    return kinds
+            info = None
+        yield participant_folder.name, info
+
+
+def enrolled(study_folder):
+    """{participant: simulated?} of every participant with a session under ``study_folder``.
+
+    An unreadable session counts as real (module docstring).
+    """
+    return {name: is_simulated(info) for name, info in first_sessions(study_folder)}
 
 
 def enrolment_index(study_folder, participant, simulated):

@@ -22,9 +22,7 @@ used before a new participant takes one.
 import os
 from pathlib import Path
 
-from studyapp.errors import UserError
-from studyapp.experiment.enrolment import is_simulated
-from studyapp.experiment.session_description import read_description, session_folders
+from studyapp.experiment.enrolment import first_sessions, is_simulated
 
 ENVIRONMENT = "STUDYAPP_RESULTS"
 
@@ -47,21 +45,11 @@ def absolute(folder):
 
 def used_rows(study_folder, simulated):
     """{order row: [participants]} of the participants of one kind (``simulated`` or real) under ``study_folder``."""
-    folder = Path(study_folder)
     rows = {}
-    if not folder.is_dir():
-        return rows
-    for participant in sorted(p for p in folder.iterdir() if p.is_dir()):
-        sessions = session_folders(participant)
-        if not sessions:
+    for name, info in first_sessions(study_folder):
+        if info is None or is_simulated(info) != bool(simulated) or not isinstance(info.get("order_row"), int):
             continue
-        try:
-            info, _ = read_description(sessions[0])
-        except UserError:
-            continue
-        if is_simulated(info) != bool(simulated) or not isinstance(info.get("order_row"), int):
-            continue
-        rows.setdefault(info["order_row"], []).append(participant.name)
+        rows.setdefault(info["order_row"], []).append(name)
     return dict(sorted(rows.items()))
 
 
