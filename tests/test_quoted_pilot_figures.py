@@ -5,11 +5,14 @@ The pilot's table ("Generated on DATE by `PYTHONPATH=. python scripts/pilot.py
 paper's order and the share of the spread between participants; every
 response behind it is kept in docs/study/pilot.csv. The normal suite checks
 the table against the CSV (the figures recomputed by studyapp.analysis.pilot,
-to the table's rounding) and the CSV's seeds against the command; the slow
+to the table's rounding), the CSV's seeds against the command, and the
+simulated participant's criterion spread against the paper's share of the
+spread between participants (the calibration it documents); the slow
 tests play the first participant of each set again (one headless session,
 deterministic on its seed) and compare every adjustment response with the CSV.
 """
 
+import inspect
 import re
 import shlex
 import subprocess
@@ -21,7 +24,10 @@ import pandas as pd
 import pytest
 
 from studyapp.analysis.consistency import variance_decomposition
-from studyapp.analysis.pilot import pilot_figures
+from studyapp.analysis.pilot import pilot_figures, variance_components
+from studyapp.experiment.protocol import load_protocol
+from studyapp.experiment.simulated_participant import SimulatedParticipant
+from studyapp.model.fmax_knob import KNOB_MAX
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "experiment.md"
@@ -107,3 +113,17 @@ def test_a_quoted_participant_is_what_the_code_plays_on_its_seed(tmp_path, label
     quoted = quoted[(quoted["set"] == label) & (quoted["participant"] == who)].sort_values(["condition", "trial"])
     assert list(again["condition"]) == list(quoted["condition"]) and list(again["trial"]) == list(quoted["trial"])
     np.testing.assert_allclose(again["fmax"].to_numpy(float), quoted["fmax"].to_numpy(float), rtol=1e-12)
+
+
+def test_the_criterion_spread_gives_the_papers_between_participant_share():
+    """The simulated participant's criterion spread is calibrated to the paper's 61 % (Sec. 9.1):
+    spread^2 / (spread^2 + s_w^2), s_w^2 the pilot's within-participant variance in knob positions."""
+    task = load_protocol(ROOT / "protocols" / "sinclair2014.toml").task("adjustment")
+    step = task.decades / (KNOB_MAX - 1)  # decades per knob position
+    data = responses()
+    within = [variance_components([np.log10(rows["fmax"][rows["participant"] == p].to_numpy()) / step
+                                   for p in sorted(set(rows["participant"]))])[0]
+              for _, rows in data.groupby(["set", "condition"])]
+    spread = inspect.signature(SimulatedParticipant).parameters["criterion_spread"].default
+    share = spread ** 2 / (spread ** 2 + np.mean(within))
+    assert share == pytest.approx(0.61, abs=0.03), (np.mean(within), share)
