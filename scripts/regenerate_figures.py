@@ -1,6 +1,6 @@
 """Regenerate every figure docs/ quotes: each documented generator, in order, dated (issue 30, item 6).
 
-    make figures                                              # = the line below, OUT = figures/
+    make figures                                              # = the line below, OUT = figures/<UTC time>
     PYTHONPATH=. python scripts/regenerate_figures.py [-o OUT] [--only NAME ...] [--list] [--into-docs]
 
 Runs the generators of ``GENERATORS`` (docs/figures.md lists each with the
