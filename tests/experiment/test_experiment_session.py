@@ -16,6 +16,7 @@ from studyapp.experiment.protocol import load_protocol
 from studyapp.experiment.session import Session
 from studyapp.experiment.session_log import SessionLog, read_events
 from studyapp.experiment.session_runner import SessionRunner
+from studyapp.experiment.simulated_participant import SimulatedParticipant
 from tests.experiment.demo_protocol import trials_only_demo
 from tests.experiment.experiment_fake_loop import NOISE, THRESHOLD, factory, run_simulated
 
@@ -93,11 +94,13 @@ def test_simulated_participant_rates_by_noise_and_finds_breakdown(tmp_path, prot
     assert [e["step"] for e in responses] == [0, 1, 2, 3]
     rating = {r["condition"]: r["rating"] for r in responses[0]["responses"]}
     assert rating == {"LVT": 0.0, "LOWPASS": pytest.approx(0.5, abs=0.1), "LEVANT": 1.0}
+    criterion = round(SimulatedParticipant(session.seed).criterion)  # the participant's own bias, knob positions
     for response in responses[1:]:
         threshold = THRESHOLD[response["condition"]]
-        # Confirmed within a few knob steps of the breakdown level.
+        # Confirmed within a few knob steps of the breakdown level, once the participant's criterion is taken off.
         knob = protocol.task("adjustment").ceiling, protocol.task("adjustment").decades
-        assert fmax_from_knob(response["value"] - 8, *knob) < threshold < fmax_from_knob(response["value"] + 8, *knob)
+        value = response["value"] - criterion
+        assert fmax_from_knob(value - 8, *knob) < threshold < fmax_from_knob(value + 8, *knob)
         assert response["peak_fmax"] > threshold
     # Every knob event of the rating trial drove the loop: selection and F_max.
     rating_loop = made[0]

@@ -1,0 +1,93 @@
+"""scripts/regenerate_figures.py, the one command behind `make figures` (issue 30, item 6): what it runs, lists and writes."""
+
+import datetime
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+import regenerate_figures as rf  # noqa: E402
+
+
+def script(*args):
+    return subprocess.run([sys.executable, str(ROOT / "scripts" / "regenerate_figures.py"), *args],
+                          capture_output=True, text=True, cwd=ROOT)
+
+
+def figures_md():
+    return (ROOT / "docs" / "figures.md").read_text()
+
+
+def test_every_generator_is_in_docs_figures_md_and_every_listed_one_exists():
+    listed = re.findall(r"^\| ([a-z0-9-]+) \|", figures_md(), re.M)
+    assert listed[2:] == [g.name for g in rf.generators()]  # after the header ("generator") and its rule
+
+
+def test_every_script_docs_name_is_a_generator_or_said_not_to_be():
+    text = figures_md()
+    named = set()
+    for doc in (ROOT / "docs").glob("*.md"):
+        named |= set(re.findall(r"scripts/([a-z_]+\.py)", doc.read_text()))
+    run = {w for g in rf.generators() for step in g.steps for w in step if w.startswith("scripts/")}
+    for name in sorted(named - {"regenerate_figures.py"}):
+        assert f"scripts/{name}" in run or f"scripts/{name}" in text, name
+
+
+def test_the_breakdown_commands_are_docs_breakdown_md_headers_with_their_output_moved():
+    headers = re.findall(r"Generated on \d{4}-\d\d-\d\d by `(studyapp breakdown [^`]+)`", (ROOT / "docs" / "breakdown.md").read_text())
+    found = rf.breakdown_generators()
+    assert len(found) == len(headers) >= 2
+    for gen, header in zip(found, headers):
+        (words,) = gen.steps
+        shown = rf.shown(words, "OUT")
+        assert shown.split(" -o ")[0] == header.split(" -o ")[0]
+        assert shown.split(" -o ")[1].startswith("OUT/")
+
+
+def test_a_breakdown_header_at_another_rate_gets_its_own_name():
+    text = "Generated on 2026-11-27 by `studyapp breakdown --all --rate 48000 --seeds 5 --gesture strokes`."
+    (gen,) = rf.breakdown_generators(text)
+    assert gen.name == "breakdown-strokes-48k" and gen.steps[0][-2:] == ("-o", "{out}/breakdown-strokes-48k.md")
+
+
+def test_list_names_each_generator_and_its_commands_and_runs_nothing(tmp_path):
+    done = script("--list", "-o", str(tmp_path / "out"))
+    assert done.returncode == 0
+    for g in rf.generators():
+        assert f"{g.name}: " in done.stdout
+    assert "PYTHONPATH=. python scripts/pilot.py --seeds 1-6,7-12 -o OUT/pilot/pilot" in done.stdout
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("args, says", [(["--only", "nope"], "--only nope: no such generator"),
+                                        (["--only"], "expected at least one argument")])
+def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, args, says):
+    done = script(*args, "-o", str(tmp_path / "out"))
+    assert done.returncode == 2 and says in done.stderr and "Traceback" not in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_folder_with_something_in_it_is_refused(tmp_path):
+    (tmp_path / "keep.txt").write_text("mine")
+    done = script("--only", "pilot", "-o", str(tmp_path))
+    assert done.returncode == 2 and "not empty" in done.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["keep.txt"]
+
+
+def test_a_run_writes_each_output_dated_with_its_command_and_a_summary(tmp_path, monkeypatch, capsys):
+    good = rf.Generator("good", "nowhere", ((rf.PY, "-c", "print('figure 1.23')"),))
+    bad = rf.Generator("bad", "nowhere", ((rf.PY, "-c", "import sys; sys.exit(3)"),))
+    monkeypatch.setattr(rf, "generators", lambda: [good, bad])
+    assert rf.main(["-o", str(tmp_path / "out")]) == 1
+    today = datetime.date.today().isoformat()
+    output = (tmp_path / "out" / "good" / "output.md").read_text()
+    assert output.startswith(f"Generated on {today} by `PYTHONPATH=. python -c ") and "figure 1.23" in output
+    assert "exit 3" in (tmp_path / "out" / "bad" / "output.md").read_text()
+    summary = (tmp_path / "out" / "figures.md").read_text()
+    assert f"| good | {today} | ok |" in summary and f"| bad | {today} | FAILED |" in summary
+    err = capsys.readouterr().err
+    assert "[1/2] good" in err and "[2/2] bad" in err and "failed: bad" in err
