@@ -17,6 +17,15 @@ criterion of ``criterion_spread`` knob positions drawn once per session) and
 the hand's and ear's common moves: turning a knob as a hand does, measuring a
 condition's noise, listening for breakdown, listening long enough
 (``min_listen_s``), resting the bow.
+
+Time is the loop's: listening for ``seconds`` is looking every
+``reaction_time`` at the samples run since the last look until they add up
+to ``seconds``. Headless each look is ``reaction_time`` exactly; in a console
+on a loaded machine a look can come late and hold more (the engine runs on in
+real time), and it counts all it heard, so the participant keeps the
+engine's pace instead of spending a GUI round trip per ``reaction_time`` (a
+1.2 s probe took 15-35 s at a load of 20 on 2 cores, and the demo session
+outran its test's waits: issue 31).
 """
 
 import math
@@ -86,8 +95,10 @@ class SimulatedParticipant:
     def listen_for_breakdown(self, runner, seconds):
         """Bow for up to ``seconds``; True as soon as the string breaks down (a person reacts at once)."""
         chunk = self.reaction_time
-        for _ in range(max(1, int(round(seconds / chunk)))):
-            runner.advance(chunk)
+        needed = max(1, int(round(seconds / chunk))) * max(1, int(round(chunk * runner.loop.rate)))
+        heard = 0
+        while heard < needed:
+            heard += played(runner.advance(chunk))
             if self.broken(runner):
                 return True
         return False
@@ -115,8 +126,12 @@ class SimulatedParticipant:
         runner.set_bowing(False)
         waited = 0.0
         while waited < self.rest_time:
-            runner.advance(self.reaction_time)
-            waited += self.reaction_time
+            waited += played(runner.advance(self.reaction_time)) / runner.loop.rate
             if not self.broken(runner):
                 break
         runner.set_bowing(True)
+
+
+def played(block):
+    """How many samples of the loop ``block`` holds: what the participant heard since it last looked."""
+    return len(block["force"])
