@@ -20,8 +20,13 @@ same slots a person's clicks reach.
 engine's output (from the moment of the call) to the trial, then returns
 every sample played since the call from the telemetry ring (at least that
 much; more when the participant's thread looks late, as on a loaded machine:
-it counts them, simulated_participant.py): the participant hears exactly what
-the engine played. A paused session therefore pauses the participant too; an
+it counts them, simulated_participant.py), at most the newest half of the
+ring: the participant hears exactly what the engine played. A look that
+fell a whole ring behind used to read all of it while the worker wrote on,
+and the ring's seqlock gave up (``TornRead``, seen at a load of 26 on 2
+cores: the participant raised and, before issue 31, the session sat in
+"Running"); the writer would have to run 2 s during the copy of half a
+ring to lap it, and a torn read is looked at again. A paused session therefore pauses the participant too; an
 aborted or closed one ends it (``Stopped``). A play that ends while its
 session is still open (the participant raised: an error, or a GUI thread that
 did not answer within ``gui_thread.TIMEOUT``) aborts the session, the error
@@ -39,6 +44,8 @@ import time
 
 import numpy as np
 
+from studyapp.engine.ring import TornRead
+from studyapp.errors import EngineError
 from studyapp.experiment.hand_trace import ReplayingHand
 from studyapp.experiment.simulated_participant import SimulatedParticipant, TrialRestarted
 from studyapp.live.controls import PAGE_SETTLE_S
@@ -172,10 +179,13 @@ class ParticipantProxy:
             while c.engine is engine and c.fed < start + n:
                 self._check_attempt()
                 time.sleep(WAIT_STEP)
-            if c.engine is engine:
-                # (a new engine after a failure starts its sample count again: listen again then)
-                block = engine.telemetry(since=start)
-                return {key: value for key, value in block.items() if isinstance(value, np.ndarray)}
+            if c.engine is not engine:
+                continue  # a new engine after a failure starts its sample count again: listen again then
+            try:
+                block = engine.telemetry(since=max(start, engine.ring.committed - engine.ring.capacity // 2))
+            except (TornRead, EngineError):
+                continue  # the writer lapped a late look, or the engine stopped meanwhile: look again
+            return {key: value for key, value in block.items() if isinstance(value, np.ndarray)}
 
 
 class SimulatedSession:
