@@ -21,17 +21,19 @@ engine's output (from the moment of the call) to the trial, then returns
 every sample played since the call from the telemetry ring (at least that
 much; more when the participant's thread looks late, as on a loaded machine:
 it counts them, simulated_participant.py), at most the newest half of the
-ring: the participant hears exactly what the engine played. A look that
-fell a whole ring behind used to read all of it while the worker wrote on,
-and the ring's seqlock gave up (``TornRead``, seen at a load of 26 on 2
-cores: the participant raised and, before issue 31, the session sat in
-"Running"); the writer would have to run 2 s during the copy of half a
-ring to lap it, and a torn read is looked at again. A paused session therefore pauses the participant too; an
-aborted or closed one ends it (``Stopped``). A play that ends while its
-session is still open (the participant raised: an error, or a GUI thread that
-did not answer within ``gui_thread.TIMEOUT``) aborts the session, the error
-shown and logged as the ``abort``'s reason (``end_if_done``, from the
-console's timer): never a session left "Running" with no one to answer. A trial started again (after an
+ring: the participant hears exactly what the engine played. A look that fell
+a whole ring behind used to read all of it while the worker wrote on, and the
+ring's seqlock gave up (``TornRead``, seen at a load of 26 on 2 cores: the
+participant raised and, before issue 31, the session sat in "Running"); the
+writer would have to run 2 s during the copy of half a ring to lap it, and a
+torn read is looked at again.
+
+A paused session pauses the participant too; an aborted or closed one ends
+it (``Stopped``). A play that ends while its session is still open (the
+participant raised: an error, or a GUI thread that did not answer within
+``gui_thread.TIMEOUT``) aborts the session, the error shown and logged as the
+``abort``'s reason (``end_if_done``, from the console's timer): never a
+session left "Running" with no one to answer. A trial started again (after an
 emergency stop, or on a new engine after a lost one) raises ``TrialRestarted``
 from the participant's next call, so it plays the trial again from its start
 (the bow put back, the knob from 0), never on with what it did before. Trials are started by the
