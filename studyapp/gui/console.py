@@ -312,10 +312,7 @@ class Console(QMainWindow):
         self.controller.poll()
         confine(self.participant_window, self, self.controller.state == State.RUNNING)
         self.status.show_frame_rate(self.scope.frame_rate())
-        sim = self.simulated
-        if sim is not None and sim.done:
-            if sim.error:
-                self.controller.message(sim.error, level="error")
+        if self.simulated is not None and self.simulated.end_if_done():
             self.simulated = None
 
     # views of the controller's events --------------------------------------------

@@ -94,6 +94,7 @@ class SessionController:
         self.sound = MasterSound()  # the console's master volume and mute (master_sound.py)
         self.stopped_by = "operator"  # who pressed the emergency stop last (states.emergency)
         self.simulated = False  # the simulated participant plays the session (apparatus "participant")
+        self.abort_reason = None  # why the session is being aborted, when not the experimenter's Abort
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
         self.devices = Devices(self)  # the device: its choice, its records, the rig it makes
         self._next_status = 0.0
@@ -197,9 +198,13 @@ class SessionController:
         self.fire("open")
         return session
 
-    def abort(self):
-        """Stop the session now; it can be resumed later (``--resume``)."""
-        self.fire("abort")
+    def abort(self, reason=None):
+        """Stop the session now; it can be resumed later (``--resume``). ``reason`` goes into the log's ``abort``."""
+        self.abort_reason = reason
+        try:
+            self.fire("abort")
+        finally:
+            self.abort_reason = None
 
     def pause(self):
         self.fire("pause")

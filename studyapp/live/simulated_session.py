@@ -18,9 +18,22 @@ same slots a person's clicks reach.
 
 ``advance(seconds)`` waits until the controller has fed that much of the
 engine's output (from the moment of the call) to the trial, then returns
-those samples from the telemetry ring: the participant hears exactly what the
-engine played. A paused session therefore pauses the participant too; an
-aborted or closed one ends it (``Stopped``). A trial started again (after an
+every sample played since the call from the telemetry ring (at least that
+much; more when the participant's thread looks late, as on a loaded machine:
+it counts them, simulated_participant.py), at most the newest half of the
+ring: the participant hears exactly what the engine played. A look that fell
+a whole ring behind used to read all of it while the worker wrote on, and the
+ring's seqlock gave up (``TornRead``, seen at a load of 26 on 2 cores: the
+participant raised and, before issue 31, the session sat in "Running"); the
+writer would have to run 2 s during the copy of half a ring to lap it, and a
+torn read is looked at again.
+
+A paused session pauses the participant too; an aborted or closed one ends
+it (``Stopped``). A play that ends while its session is still open (the
+participant raised: an error, or a GUI thread that did not answer within
+``gui_thread.TIMEOUT``) aborts the session, the error shown and logged as the
+``abort``'s reason (``end_if_done``, from the console's timer): never a
+session left "Running" with no one to answer. A trial started again (after an
 emergency stop, or on a new engine after a lost one) raises ``TrialRestarted``
 from the participant's next call, so it plays the trial again from its start
 (the bow put back, the knob from 0), never on with what it did before. Trials are started by the
@@ -33,6 +46,8 @@ import time
 
 import numpy as np
 
+from studyapp.engine.ring import TornRead
+from studyapp.errors import EngineError
 from studyapp.experiment.hand_trace import ReplayingHand
 from studyapp.experiment.simulated_participant import SimulatedParticipant, TrialRestarted
 from studyapp.live.controls import PAGE_SETTLE_S
@@ -166,10 +181,13 @@ class ParticipantProxy:
             while c.engine is engine and c.fed < start + n:
                 self._check_attempt()
                 time.sleep(WAIT_STEP)
-            if c.engine is engine:
-                # (a new engine after a failure starts its sample count again: listen again then)
-                block = engine.telemetry(since=start)
-                return {key: value[:n] for key, value in block.items() if isinstance(value, np.ndarray)}
+            if c.engine is not engine:
+                continue  # a new engine after a failure starts its sample count again: listen again then
+            try:
+                block = engine.telemetry(since=max(start, engine.ring.committed - engine.ring.capacity // 2))
+            except (TornRead, EngineError):
+                continue  # the writer lapped a late look, or the engine stopped meanwhile: look again
+            return {key: value for key, value in block.items() if isinstance(value, np.ndarray)}
 
 
 class SimulatedSession:
@@ -177,6 +195,7 @@ class SimulatedSession:
 
     def __init__(self, controller, controls, act, seed, replay=None, **participant):
         self.stop_event = threading.Event()
+        self.controller = controller
         self.proxy = ParticipantProxy(controller, controls, act, self.stop_event)
         self.player = self.proxy if not replay else ReplayingHand(self.proxy, replay)
         self.participant = SimulatedParticipant(seed, **participant)
@@ -197,6 +216,20 @@ class SimulatedSession:
             self.error = f"simulated participant: {type(exc).__name__}: {exc}"
         finally:
             self.done = True
+
+    def end_if_done(self):
+        """True once the play has ended; its error is then shown, and a session it left unfinished is aborted
+        with the error as the reason: no one answers any more, so it is never left "Running" (issue 31)."""
+        if not self.done:
+            return False
+        c = self.controller
+        if self.error:
+            c.message(self.error, level="error")
+        if c.in_session:
+            c.message("the simulated participant stopped before the session's end: the session is aborted "
+                      "(resume it to go on)", level="error")
+            c.abort(reason=self.error or "the simulated participant stopped before the session's end")
+        return True
 
     def stop(self, timeout=0.0):
         """End the play; wait up to ``timeout`` s (never on the GUI thread: the player may be waiting for it)."""

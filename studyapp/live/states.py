@@ -129,7 +129,7 @@ def finish(c):
 def abort(c):
     if c.runner is None:
         return abort_unbegun(c)
-    c.runner.log(records.abort())
+    c.runner.log(records.abort(c.abort_reason))
     return end(c, State.ABORTED)
 
 

@@ -81,7 +81,6 @@ def acknowledge(console, participant, lpd8, qtbot, qapp, page, count):
         qtbot.mouseClick(participant.page_view.continue_button, Qt.MouseButton.LeftButton)
 
 
-@pytest.mark.xfail(strict=False, reason="issue 31 item 4 open: after sinclair2014's min_listen_s and the heard-F_max rule the pointer-bowed session does not finish in this test's waits; cause not found (2026-11-27 merge)")
 def test_a_whole_sinclair2014_session_bowed_with_the_pointer(session_console, qapp, qtbot, tmp_path):
     console, c = session_console, session_console.controller
     participant = console.participant_window
@@ -155,9 +154,11 @@ def test_a_whole_sinclair2014_session_bowed_with_the_pointer(session_console, qa
     assert set(bowed) <= starts
     archive = audio_checks.read_archive(folder)
     audio_checks.check_peak(archive)  # at most the ceiling, one 16-bit step of rounding allowed
-    # the pointer's strokes drive the limiter to its ceiling from the first bow on: onset and what follows are
-    # both at the ceiling, so equal within half a decibel is no thump
-    audio_checks.check_start_transients(archive, margin_db=0.5)
+    # the pointer's press takes the hand from where the strokes left it to the pointer (the live gesture's
+    # 10 Hz glide), a faster move than the strokes that follow: its onset was up to 2.3 dB louder (58 trials,
+    # 2026-11-27). A thump is tens of decibels (a step starting near the -12 dBFS ceiling over a string at
+    # -40 dBFS); the chain's own onsets are checked with no margin in test_gui_end_to_end.py.
+    audio_checks.check_start_transients(archive, margin_db=6.0)
     audio_checks.check_silences(archive)
 
     # a simulated participant replays the logged gesture (headless, the same protocol)
