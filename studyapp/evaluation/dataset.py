@@ -169,6 +169,11 @@ class Dataset:
             delays[r], errors[r] = self.references[i].measure(self.estimate(self.takes[i], name, params))
         return errors, delays
 
+    def subsample_delays(self, name, params):
+        """The sub-sample delay (samples, ``metric.subsample_delay``) on every take: reported, not optimised."""
+        return np.array([reference.subsample(self.estimate(take, name, params))
+                         for take, reference in zip(self.takes, self.references)])
+
     def _batches_of(self, share):
         key = tuple(share or (0, 1))
         if key not in self._batches:
