@@ -24,7 +24,7 @@ rule, as strict as the paper's own words allow:
 Measures (Fig. 5, Sec. 7.2): per recording, error E and |D| as a percentage
 of LOWPASS's on that recording; an estimator's value is its median over the
 group's recordings. The delay is the sub-sample delay where the evaluation
-measured it (``metric.subsample_delay``; else the whole-sample D), and delay
+measured it (``subsample_delay.subsample_delay``; else the whole-sample D), and delay
 ranks are of the median |D| in samples (a percentage of a LOWPASS delay near 0
 would blow its resolution up). Delay counts by its magnitude everywhere (ranks, medians,
 tests), as in the objective F_g: a lead of the band-limited LVT is as much a

@@ -45,20 +45,6 @@ such an estimate as 0, the same as one that matches the LVT. The normalised
 method reads a lead as a negative D. (The objective counts |D|: see
 ``normalisation.py``.)
 
-Sub-sample delay (issue 30). D is a whole number of samples; tuned estimators
-that match the LVT reference all read D = 0 on the low-force recordings, so D
-alone cannot rank them. ``subsample_delay`` refines the peak by the parabola
-through the correlation at D - 1, D, D + 1:
-
-    d = D + (r[D-1] - r[D+1]) / (2 (r[D-1] - 2 r[D] + r[D+1]))
-
-exact where r is quadratic about its peak, as the correlation of a signal
-whose power lies well below the Nyquist frequency is (checked against pure
-fractional delays and a one-pole low-pass's group delay,
-tests/evaluation/test_evaluation_subsample_delay.py). At the ends of the lag
-range, or where the three points do not bend down, d = D. d only reports;
-the objective (and so the optimiser) keeps the whole-sample D of eqs. 22-24.
-
 D is the paper's scalar "global" delay, the shift that lines up the signals as
 a whole; a filter's delay depends on frequency, and D follows the frequencies
 that carry the correlation's curvature. An overlap of zero energy correlates
@@ -182,32 +168,6 @@ def _overlap_energies(x, starts, stops):
     return out
 
 
-def parabolic_peak(ks, c, delay):
-    """The lag of the peak of the parabola through c at ``delay`` and its two neighbours (``delay`` at an end)."""
-    i = int(np.searchsorted(ks, delay))
-    if i == 0 or i == ks.shape[0] - 1:
-        return float(delay)
-    left, centre, right = c[i - 1], c[i], c[i + 1]
-    bend = left - 2.0 * centre + right
-    if not bend < 0.0:
-        return float(delay)
-    return float(delay + np.clip(0.5 * (left - right) / bend, -0.5, 0.5))
-
-
-def subsample_delay(reference, estimate, max_lag, method=DEFAULT_METHOD):
-    """The delay in samples (float), refined between samples by a parabola (module docstring)."""
-    check_method(method)
-    v, w = _as_signal("reference", reference), _as_signal("estimate", estimate)
-    if v.shape != w.shape:
-        raise InputDataError(f"reference and estimate differ in length: {v.shape[0]} and {w.shape[0]} samples")
-    max_lag = _check_reference(v, max_lag)
-    if not np.all(np.isfinite(w)):
-        return float("nan")
-    ks, c = lags(max_lag, method), cross_correlation(v, w, max_lag, method)
-    delay, _ = _delay_corrected(v, w, ks, c)
-    return parabolic_peak(ks, c, delay)
-
-
 def _delay_corrected(v, w, ks, c, order=None):
     order = _tie_order(ks) if order is None else order
     delay = int(ks[order[np.argmax(c[order])]])
@@ -258,7 +218,3 @@ class Reference:
             np.divide(sums, np.sqrt(energy), out=scaled, where=energy > 0)
             sums = scaled
         return _delay_corrected(self.v, w, self.lags, sums, self.order)
-
-    def subsample(self, estimate):
-        """``subsample_delay(reference, estimate, max_lag, method)`` (samples, float)."""
-        return subsample_delay(self.v, estimate, self.max_lag, self.method)

@@ -63,7 +63,7 @@ class Evaluation:
     baseline_errors: np.ndarray
     baseline_delays: np.ndarray
     delay_method: str = "normalised"
-    subsample_delays: dict = None  # name -> array (samples, float; metric.subsample_delay), when measured
+    subsample_delays: dict = None  # name -> array (samples, float; subsample_delay.subsample_delay), when measured
     baseline_subsample_delays: np.ndarray = None
 
     def __post_init__(self):

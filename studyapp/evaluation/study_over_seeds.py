@@ -12,7 +12,7 @@ first file's ``paper_comparison.csv`` and ``findings.csv``:
 - ``metrics_seeds.csv`` (``estimator, metric, median, min, max``, then
   ``LABEL`` per file): per estimator, over group a (F_max 0 to 7.7 N) the
   median error as % of LOWPASS, the median |D| in whole samples and the
-  median sub-sample |D| (``metric.subsample_delay``), and F_g under the file's
+  median sub-sample |D| (``subsample_delay.subsample_delay``), and F_g under the file's
   own scale;
 - ``findings_seeds.csv`` (``finding, paper, verdict, holds_on, fails_on,
   undecided_on``, then ``verdict LABEL`` and ``ours LABEL`` per file): each
