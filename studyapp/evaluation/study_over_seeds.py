@@ -18,7 +18,8 @@ first file's ``paper_comparison.csv`` and ``findings.csv``:
   undecided_on``, then ``verdict LABEL`` and ``ours LABEL`` per file): each
   finding judged on every file (``findings.py``), and over the files it
   *holds* when it holds on every one, *fails* when it fails on every one, and
-  is *undecided* otherwise: mixed, or undecided (ties) on some file. A finding
+  is otherwise "undecided (ties)" when undecided on some file, else
+  "undecided (mixed)" (it holds on some and fails on others). A finding
   left out on some file is reported on the others only.
 
 The labels are ``seed S`` when the files' seeds differ, else the file names
@@ -78,13 +79,16 @@ def metric_rows(results_by_label):
     return rows
 
 
+MIXED = "undecided (mixed)"
+
+
 def overall(verdicts):
-    """holds / fails on every file, else undecided (mixed, or ties on some file)."""
+    """holds / fails on every file; else undecided (ties) when tied on some file, or undecided (mixed)."""
     if verdicts and all(v == HOLDS for v in verdicts):
         return HOLDS
     if verdicts and all(v == FAILS for v in verdicts):
         return FAILS
-    return UNDECIDED
+    return UNDECIDED if UNDECIDED in verdicts else MIXED
 
 
 def finding_rows(findings_by_label):
