@@ -39,7 +39,9 @@ def register(sub):
                         "(audio_distance, perceptual.png)")
     perceptual_options.add_options(p, "--perceptual")
     p.add_argument("--compare-paper", action="store_true",
-                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv to -o DIR")
+                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv to -o DIR; with "
+                        "several --params files also their spread over the files: paper_comparison_seeds.csv, "
+                        "metrics_seeds.csv and findings_seeds.csv")
     p.set_defaults(func=run)
 
 
@@ -87,16 +89,21 @@ def run(args):
                              dict(zip(names, [params] + [o[0] for o in others])))
         document["seed_spread"] = spread
     validation = None
+    other = load_takes(expand_paths([args.validation]), args.reference) if args.validation else None
     if args.validation:
         from studyapp.evaluation.validation import compare
 
-        other = load_takes(expand_paths([args.validation]), args.reference)
         summary, rows = compare(result, evaluate(Dataset(other, args.max_lag, delay_method=args.delay), params))
         summary["provenance"] = {**document["provenance"], "validation_recordings": [t.name for t in other],
                                  "validation_recording_sha256": [t.sha256 for t in other]}
         validation = (summary, rows)
         document["validation"] = summary
     perceptual = None if cases is None else perceptual_options.add_to_evaluation(cases, result, document)
+    over_seeds = None
+    if args.compare_paper and others:
+        over_seeds = _study_over_seeds(args, takes, other, dict(zip(names, [params] + [o[0] for o in others])),
+                                       result, validation[0] if validation else None)
+        document["study_over_seeds"] = over_seeds
     if output is not None:
         _write_outputs(output, result, document, validation)
         if spread is not None:
@@ -109,6 +116,11 @@ def run(args):
         from studyapp.evaluation import paper_comparison
 
         paper_comparison.write(output, result, [t.position for t in takes], validation[0] if validation else None)
+        if over_seeds is not None:
+            from studyapp.evaluation.tables import write_csv
+
+            for key, rows in over_seeds.items():
+                write_csv(output / f"{key}_seeds.csv", rows)
     if args.json:
         json.dump(document, sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
@@ -116,6 +128,11 @@ def run(args):
         _print_table(result, validation)
         if perceptual is not None:
             perceptual_options.print_table(perceptual, result.names)
+        if over_seeds is not None:
+            print("findings over the parameter files (holds / fails on every one, else undecided):")
+            for row in over_seeds["findings"]:
+                print(f"  {row['verdict']:<16} ({row['holds_on']} holds, {row['fails_on']} fails, "
+                      f"{row['undecided_on']} undecided)  {row['finding']}")
         if spread is not None:
             print("F_g of each parameter file under one common scale:")
             for row in spread:
@@ -127,6 +144,29 @@ def run(args):
                     f" E apart {row['error_spread_pct']:.1f} %")
                 print(f"  {row['estimator']:<11} {cells}  spread {pct}{apart}")
     return 0
+
+
+def _study_over_seeds(args, takes, validation_takes, sets, first, first_validation):
+    """Table 1, the metrics and the findings of every parameter file (label -> parameters), and their spread."""
+    from studyapp.evaluation import paper_comparison, study_over_seeds
+    from studyapp.evaluation.dataset import Dataset
+    from studyapp.evaluation.report import evaluate
+    from studyapp.evaluation.validation import compare
+
+    positions = [t.position for t in takes]
+    results, findings = {}, {}
+    for i, (label, params) in enumerate(sets.items()):
+        result, summary = first, first_validation
+        if i:
+            result = evaluate(Dataset(takes, args.max_lag, delay_method=args.delay), params)
+            if validation_takes is not None:
+                summary, _ = compare(result, evaluate(Dataset(validation_takes, args.max_lag,
+                                                              delay_method=args.delay), params))
+        results[label] = result
+        findings[label] = paper_comparison.finding_rows(result, positions, summary)
+    return {"paper_comparison": study_over_seeds.parameter_rows(sets),
+            "metrics": study_over_seeds.metric_rows(results),
+            "findings": study_over_seeds.finding_rows(findings)}
 
 
 def _write_outputs(output, result, document, validation):

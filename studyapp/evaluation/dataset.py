@@ -33,6 +33,7 @@ from studyapp.evaluation import kernels
 from studyapp.evaluation.batch import batches
 from studyapp.evaluation.metric import DEFAULT_METHOD, Reference, check_method
 from studyapp.evaluation.normalisation import raw_objectives
+from studyapp.evaluation.subsample_delay import subsample_delay
 from studyapp.io.recording import load
 
 REFERENCE_COLUMNS = {"lvt": "velocity_lvt", "true": "velocity_true"}
@@ -168,6 +169,12 @@ class Dataset:
         for r, i in enumerate(indices):
             delays[r], errors[r] = self.references[i].measure(self.estimate(self.takes[i], name, params))
         return errors, delays
+
+    def subsample_delays(self, name, params):
+        """The sub-sample delay (samples, ``subsample_delay.subsample_delay``) on every take: reported, not optimised."""
+        return np.array([subsample_delay(reference.v, self.estimate(take, name, params), reference.max_lag,
+                                         self.delay_method)
+                         for take, reference in zip(self.takes, self.references)])
 
     def _batches_of(self, share):
         key = tuple(share or (0, 1))

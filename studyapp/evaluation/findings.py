@@ -1,22 +1,32 @@
 """The paper's findings of Sec. 7 (Fig. 5, Secs. 7.3-7.4), each judged on our evaluation by a stated rule.
 
-``findings.csv`` (columns ``finding, paper, ours, agrees``): one row per
-finding; ``paper`` gives the paper's statement and, after "rule:", the
-quantitative rule that decides ``agrees``, and ``agrees`` is True only when
-that rule holds. Three kinds of rule, as strict as the paper's own words allow:
+``findings.csv`` (columns ``finding, paper, ours, agrees, verdict``): one row
+per finding; ``paper`` gives the paper's statement and, after "rule:", the
+quantitative rule that decides it; ``verdict`` is "holds", "fails" or
+"undecided (ties)", and ``agrees`` is True only when it holds. Three kinds of
+rule, as strict as the paper's own words allow:
 
 - a number (a percentage, a mean): ours within a factor 2 of the paper's,
   paper / 2 <= ours <= 2 paper;
 - an order: the rank of ours among the n evaluated estimators (1 = lowest;
-  ties share their mean rank; an undefined median ranks last), e.g. "rank n
-  of n", "ranks 1 to k", "rank <= n / 2";
+  an undefined median ranks last), e.g. "rank n of n", "ranks 1 to k",
+  "rank <= n / 2". Tied values could stand in either order, so a value's rank
+  is the span of ranks its ties allow (``rank_span``): the rule holds when it
+  holds at every rank of the span, fails when at none, and is undecided
+  (ties) otherwise. Ties are equal values, and for the delay values closer
+  than ``DELAY_RESOLUTION`` samples (issue 30: on the study's recordings every
+  tuned estimator's median whole-sample |D| was 0, so every delay rank was a
+  tie, and a mean rank of a tie passed or failed "rank <= n / 2" by default);
 - a significance: the two-sided Wilcoxon rank-sum test of Fig. 5
   (``significance.rank_sum``) over the group's recordings, significant when
   p < 0.05 (the paper's threshold); ``ours`` quotes the deciding p.
 
 Measures (Fig. 5, Sec. 7.2): per recording, error E and |D| as a percentage
 of LOWPASS's on that recording; an estimator's value is its median over the
-group's recordings. Delay counts by its magnitude everywhere (ranks, medians,
+group's recordings. The delay is the sub-sample delay where the evaluation
+measured it (``subsample_delay.subsample_delay``; else the whole-sample D), and delay
+ranks are of the median |D| in samples (a percentage of a LOWPASS delay near 0
+would blow its resolution up). Delay counts by its magnitude everywhere (ranks, medians,
 tests), as in the objective F_g: a lead of the band-limited LVT is as much a
 mismatch as a lag. Group a is F_max 0 to 7.7 N (Fig. 5a), group b 2.2 to
 12.1 N (Fig. 5b), ``report.GROUPS``.
@@ -63,12 +73,16 @@ A finding whose estimators were not evaluated (2, 3: fewer than two of them;
 import itertools
 
 import numpy as np
-from scipy import stats
 
 from studyapp.evaluation.report import BASELINE, GROUPS
 from studyapp.evaluation.significance import ALPHA, rank_sum
 
-FINDING_COLUMNS = ["finding", "paper", "ours", "agrees"]
+FINDING_COLUMNS = ["finding", "paper", "ours", "agrees", "verdict"]
+HOLDS, FAILS, UNDECIDED = "holds", "fails", "undecided (ties)"
+# Delays closer than this (samples) are ties: twice the largest error of the sub-sample delay on
+# pure fractional delays of signals band-limited to fs / 5 (0.017 samples,
+# tests/evaluation/test_evaluation_subsample_delay.py), rounded up.
+DELAY_RESOLUTION = 0.05
 
 THIRD_ORDER_KALMAN = ("KALMAN", "KALLEV", "KALLEVACC", "KALFOAW", "KALFOAWACC")
 ACCELEROMETER_PAIRS = (("KALPOS", "KALMAN"), ("KALLEV", "KALLEVACC"), ("KALFOAW", "KALFOAWACC"))
@@ -91,7 +105,7 @@ def _samples(result, measure, mask):
     """name -> per-recording error % or |delay| % of LOWPASS over the group's recordings."""
     if measure == "error":
         return {n: result.error_pct(n)[mask] for n in result.names}
-    return {n: np.abs(result.delay_pct(n)[mask]) for n in result.names}
+    return {n: np.abs(result.subsample_delay_pct(n)[mask]) for n in result.names}
 
 
 def _median(values):
@@ -104,10 +118,45 @@ def _medians(result, measure, mask):
     return {n: _median(v) for n, v in _samples(result, measure, mask).items()}
 
 
-def _ranks(values):
-    """Average rank of each value, 1 = lowest; an undefined value ranks last."""
-    finite = [v if np.isfinite(v) else np.inf for v in values.values()]
-    return dict(zip(values, (float(r) for r in stats.rankdata(finite))))
+def rank_span(values, name, resolution=0.0):
+    """(lowest, highest) rank ``name``'s value can take: values within ``resolution`` of it are ties."""
+    finite = {n: v if np.isfinite(v) else np.inf for n, v in values.items()}
+    own = finite[name]
+    others = [v for n, v in finite.items() if n != name]
+    below = sum(v < own - resolution or (np.isinf(own) and not np.isinf(v)) for v in others)
+    above = sum(v > own + resolution or (np.isinf(v) and not np.isinf(own)) for v in others)
+    return 1 + below, len(finite) - above
+
+
+def verdict(outcomes):
+    """holds / fails / undecided (ties) from the rule's outcomes over every order the ties allow."""
+    outcomes = set(outcomes)
+    return UNDECIDED if len(outcomes) > 1 else HOLDS if outcomes == {True} else FAILS
+
+
+def combined(verdicts):
+    """The verdict of a rule that needs every part: fails if one fails, holds if all hold."""
+    return FAILS if FAILS in verdicts else HOLDS if all(v == HOLDS for v in verdicts) else UNDECIDED
+
+
+def _span_text(span):
+    low, high = span
+    return f"{low}" if low == high else f"{low}-{high} (tied)"
+
+
+def _delay_medians(result, mask):
+    """name -> median |D| in samples over the group, and the resolution of their ranks."""
+    medians = {n: _median(result.abs_delays(n)[mask]) for n in result.names}
+    return medians, DELAY_RESOLUTION if result.subsample_delays is not None else 0.0
+
+
+def _whole_zero(result, mask):
+    """A note when every estimator's median whole-sample |D| over the group is 0 (issue 30), else ''."""
+    if any(_median(np.abs(result.delays[n][mask])) != 0 for n in result.names):
+        return ""
+    if result.subsample_delays is None:
+        return "; every median whole-sample |D| is 0: not ranked"
+    return "; every median whole-sample |D| is 0: ranked by the sub-sample delay"
 
 
 def _group(group):
@@ -119,12 +168,11 @@ def _g(x):
     return f"{x:.3g}" if x is not None and np.isfinite(x) else "undefined"
 
 
-def _rank_text(rank, n):
-    return f"rank {rank:g} of {n}"
-
-
-def _row(finding, paper, rule, ours, agrees):
-    return {"finding": finding, "paper": f"{paper}; rule: {rule}", "ours": ours, "agrees": bool(agrees)}
+def _row(finding, paper, rule, ours, decided):
+    """A findings.csv row; ``decided`` a verdict, or a bool for a rule without ties."""
+    decided = decided if isinstance(decided, str) else HOLDS if decided else FAILS
+    return {"finding": finding, "paper": f"{paper}; rule: {rule}", "ours": ours, "agrees": decided == HOLDS,
+            "verdict": decided}
 
 
 def _objective_totals(result, mask):
@@ -134,27 +182,29 @@ def _objective_totals(result, mask):
 
 def kalman_best(result, mask):
     totals = _objective_totals(result, mask)
-    ranks = _ranks(totals)
+    span = rank_span(totals, PAPER_BEST)
     n = len(totals)
     best = min(result.names, key=lambda name: (totals[name], result.names.index(name)))
-    ours = f"{best} best (F_g {_g(totals[best])}); {PAPER_BEST} {_rank_text(ranks[PAPER_BEST], n)}"
+    ours = f"{best} best (F_g {_g(totals[best])}); {PAPER_BEST} rank {_span_text(span)} of {n}"
     return _row(f"{PAPER_BEST} best on the objective ({_group('a')})", f"{PAPER_BEST} best (Sec. 7.4)",
-                f"{PAPER_BEST} rank 1 of n on F_g", ours, ranks[PAPER_BEST] == 1.0)
+                f"{PAPER_BEST} rank 1 of n on F_g", ours, verdict(r == 1 for r in range(span[0], span[1] + 1)))
 
 
 def third_order_best(result, mask):
     family = [n for n in THIRD_ORDER_KALMAN if n in result.names]
     k, n = len(family), len(result.names)
-    parts, agrees = [], True
-    for measure, label in (("error", "error"), ("delay", "|delay|")):
-        ranks = _ranks(_medians(result, measure, mask))
-        worst = max(ranks[name] for name in family)
-        agrees = agrees and worst <= k
-        parts.append(f"{label} ranks " + ", ".join(f"{name} {ranks[name]:g}" for name in family))
+    parts, verdicts = [], []
+    for label, (medians, resolution) in (("error", (_medians(result, "error", mask), 0.0)),
+                                         ("|delay|", _delay_medians(result, mask))):
+        spans = {name: rank_span(medians, name, resolution) for name in family}
+        # holds when every member's worst rank is within 1..k, fails when some member's best rank is not
+        verdicts.append(verdict({max(high for _, high in spans.values()) <= k,
+                                 max(low for low, _ in spans.values()) <= k}))
+        parts.append(f"{label} ranks " + ", ".join(f"{name} {_span_text(spans[name])}" for name in family))
     return _row(f"third-order Kalman filters best on both criteria ({_group('a')})",
                 "the best performers on both criteria (Sec. 7.4)",
                 f"the {k} evaluated hold ranks 1 to {k} of {n} of median error and of median |delay|",
-                "; ".join(parts), agrees)
+                "; ".join(parts) + _whole_zero(result, mask), combined(verdicts))
 
 
 def _better_on(samples, a, b):
@@ -205,22 +255,27 @@ def accelerometer_gain(result, mask):
 
 def levant_error(result, mask):
     medians = _medians(result, "error", mask)
-    rank, n = _ranks(medians)["LEVANT"], len(medians)
+    span, n = rank_span(medians, "LEVANT"), len(medians)
     ours = medians["LEVANT"]
+    highest = verdict(r == n for r in range(span[0], span[1] + 1))
     return _row(f"LEVANT error, median % of LOWPASS ({_group('a')})",
                 f"{PAPER_LEVANT_ERROR_PCT:g}, the highest (Fig. 5)",
                 f"within a factor {FACTOR:g} ({PAPER_LEVANT_ERROR_PCT / FACTOR:g} to "
                 f"{PAPER_LEVANT_ERROR_PCT * FACTOR:g}) and rank n of n",
-                f"{_g(ours)} ({_rank_text(rank, n)})", within_factor(ours, PAPER_LEVANT_ERROR_PCT) and rank == n)
+                f"{_g(ours)} (rank {_span_text(span)} of {n})",
+                combined([verdict([within_factor(ours, PAPER_LEVANT_ERROR_PCT)]), highest]))
 
 
 def _half(result, mask, name, measure, paper, better):
     medians = _medians(result, measure, mask)
-    rank, n = _ranks(medians)[name], len(medians)
+    ranked, resolution = (medians, 0.0) if measure == "error" else _delay_medians(result, mask)
+    span, n = rank_span(ranked, name, resolution), len(medians)
     label = "error" if measure == "error" else "|delay|"
     rule = f"median {label} rank <= n / 2" if better else f"median {label} rank > n / 2"
+    samples = "" if measure == "error" else f", median {_g(ranked[name])} samples" + _whole_zero(result, mask)
     return _row(f"{name} {label}, median % of LOWPASS ({_group('a')})", paper, rule,
-                f"{_g(medians[name])} ({_rank_text(rank, n)})", rank <= n / 2 if better else rank > n / 2)
+                f"{_g(medians[name])} (rank {_span_text(span)} of {n}{samples})",
+                verdict((r <= n / 2) == better for r in range(span[0], span[1] + 1)))
 
 
 def foaw_error(result, mask):
@@ -244,12 +299,26 @@ def foaw_window_at_maximum(fraction, window):
 def beat_lowpass(result, mask):
     errors = _medians(result, "error", mask)
     delays = _medians(result, "delay", mask)
-    ours = [n for n in result.names if n != BASELINE and errors[n] < 100.0 and delays[n] < 100.0]
+    _, resolution = _delay_medians(result, mask)
+    # a median |delay| within the resolution of LOWPASS's own is a tie with 100 %: neither below nor not
+    own = result.baseline_subsample_delays if result.subsample_delays is not None else result.baseline_delays
+    baseline = _median(np.abs(np.asarray(own, dtype=np.float64))[mask])
+    tie = 100.0 * resolution / baseline if baseline > 0 else np.inf
+    candidates = [n for n in result.names if n != BASELINE and errors[n] < 100.0]
+    ours = [n for n in candidates if delays[n] < 100.0 - tie]
+    tied = [n for n in candidates if n not in ours and not delays[n] >= 100.0 + tie]
     paper = [n for n in PAPER_BEAT_LOWPASS if n in result.names]
+    if set(ours) == set(paper) and not tied:
+        decided = HOLDS
+    elif set(ours) <= set(paper) <= set(ours) | set(tied):
+        decided = UNDECIDED
+    else:
+        decided = FAILS
+    text = (", ".join(ours) or "none") + (f"; tied with LOWPASS on |delay|: {', '.join(tied)}" if tied else "")
     return _row(f"beat LOWPASS on both error and |delay| ({_group('b')})",
                 f"only {' and '.join(PAPER_BEAT_LOWPASS)} (Sec. 7.4, Fig. 5b)",
                 "the estimators with median error and median |delay| below 100 % of LOWPASS are exactly "
-                + (", ".join(paper) or "none"), ", ".join(ours) or "none", set(ours) == set(paper))
+                + (", ".join(paper) or "none"), text, decided)
 
 
 def _validation(finding, paper, mean, std, unit):

@@ -54,11 +54,16 @@ def fraction_at_maximum(positions, window, margin):
     return at_maximum / total if total else float("nan")
 
 
-def write(output, result, positions, validation=None):
-    """Write ``paper_comparison.csv`` and ``findings.csv`` into the folder ``output``."""
-    write_csv(output / "paper_comparison.csv", parameter_rows(result.params), PARAMETER_COLUMNS)
+def finding_rows(result, positions, validation=None):
+    """``findings.csv`` rows of one evaluation (``positions``: the recordings' positions, for FOAW's window)."""
     fraction = None
     if "FOAW" in result.params:
         foaw = result.params["FOAW"]
         fraction = fraction_at_maximum(positions, foaw["window"], foaw["margin"])
-    write_csv(output / "findings.csv", findings(result, fraction, validation), FINDING_COLUMNS)
+    return findings(result, fraction, validation)
+
+
+def write(output, result, positions, validation=None):
+    """Write ``paper_comparison.csv`` and ``findings.csv`` into the folder ``output``."""
+    write_csv(output / "paper_comparison.csv", parameter_rows(result.params), PARAMETER_COLUMNS)
+    write_csv(output / "findings.csv", finding_rows(result, positions, validation), FINDING_COLUMNS)

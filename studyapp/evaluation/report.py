@@ -63,6 +63,8 @@ class Evaluation:
     baseline_errors: np.ndarray
     baseline_delays: np.ndarray
     delay_method: str = "normalised"
+    subsample_delays: dict = None  # name -> array (samples, float; subsample_delay.subsample_delay), when measured
+    baseline_subsample_delays: np.ndarray = None
 
     def __post_init__(self):
         raw = np.array([self._raw(name) for name in self.names])
@@ -87,6 +89,18 @@ class Evaluation:
 
     def delay_pct(self, name):
         return _percent(self.delays[name], self.baseline_delays)
+
+    def abs_delays(self, name):
+        """|D| per recording in samples: the sub-sample delay where measured, else the whole-sample D."""
+        if self.subsample_delays is not None:
+            return np.abs(np.asarray(self.subsample_delays[name], dtype=np.float64))
+        return np.abs(np.asarray(self.delays[name], dtype=np.float64))
+
+    def subsample_delay_pct(self, name):
+        """The sub-sample delay as % of LOWPASS's (the whole-sample ``delay_pct`` where not measured)."""
+        if self.subsample_delays is None:
+            return self.delay_pct(name)
+        return _percent(self.subsample_delays[name], self.baseline_subsample_delays)
 
     def group_mask(self, group):
         return np.array([in_group(f, group) for f in self.fmax], dtype=bool)
@@ -118,6 +132,9 @@ class Evaluation:
                     "error_pct_lowpass": _list(self.error_pct(name)),
                     "delay_pct_lowpass": _list(self.delay_pct(name)),
                     "objective": _number(self.objective[name]),
+                    **({} if self.subsample_delays is None else
+                       {"delay_subsample": _list(self.subsample_delays[name]),
+                        "delay_subsample_pct_lowpass": _list(self.subsample_delay_pct(name))}),
                 }
                 for name in self.names
             },
@@ -143,6 +160,8 @@ class Evaluation:
                     "error_pct_lowpass": e_pct[r], "delay_pct_lowpass": d_pct[r],
                     "recording_objective": self.recording_objective[name][r],
                     "objective": self.objective[name], "rank": self.ranking.index(name) + 1,
+                    **({} if self.subsample_delays is None else
+                       {"delay_subsample": self.subsample_delays[name][r]}),
                 }
 
 
@@ -162,15 +181,18 @@ def evaluate(dataset, params):
     run with its own entry of ``params`` if any, else Table 1's default.
     """
     names = list(params)
-    errors, delays = {}, {}
+    errors, delays, subsample = {}, {}, {}
     for name in names:
         errors[name], delays[name] = dataset.delays_and_errors(name, params[name])
+        subsample[name] = dataset.subsample_delays(name, params[name])
     if BASELINE in errors:
-        base_e, base_d = errors[BASELINE], delays[BASELINE]
+        base_e, base_d, base_s = errors[BASELINE], delays[BASELINE], subsample[BASELINE]
     else:
         base_e, base_d = dataset.delays_and_errors(BASELINE, {})
+        base_s = dataset.subsample_delays(BASELINE, {})
     return Evaluation(
         names=names, recordings=dataset.names, fmax=[t.fmax for t in dataset.takes],
         rates=[t.rate for t in dataset.takes], params=params, errors=errors, delays=delays,
         baseline_errors=base_e, baseline_delays=base_d, delay_method=dataset.delay_method,
+        subsample_delays=subsample, baseline_subsample_delays=base_s,
     )

@@ -135,3 +135,46 @@ def test_missing_estimators_leave_their_findings_out():
     found = [r["finding"] for r in fd.findings(_evaluation(values))]
     assert not any(f.startswith(("KALMAN best", "third-order", "no significant gain", "LEVANT")) for f in found)
     assert not any(f.startswith("validation") for f in found)
+
+
+def test_rank_span_of_ties():
+    values = {"A": 1.0, "B": 1.0, "C": 2.0, "D": np.nan}
+    assert fd.rank_span(values, "A") == (1, 2) and fd.rank_span(values, "C") == (3, 3)
+    assert fd.rank_span(values, "D") == (4, 4)
+    assert fd.rank_span({"A": 1.0, "B": 1.04, "C": 1.2}, "B", 0.05) == (1, 2)
+
+
+def test_a_rank_between_ties_is_undecided_never_a_pass():
+    """Issue 30: every median |delay| 0 samples; the mean rank of the tie passed or failed by default."""
+    values = {"LOWPASS": (1.0, 0.0), "KALMAN": (0.5, 0.0), "KALLEV": (0.6, 0.0), "FOAW": (0.8, 0.0),
+              "LEASTSQ": (2.0, 0.0)}
+    ev = _evaluation(values)
+    for row in (fd.foaw_delay(ev, A), fd.leastsq_delay(ev, A), fd.third_order_best(ev, A)):
+        assert row["verdict"] == fd.UNDECIDED and not row["agrees"]
+        assert "every median whole-sample |D| is 0: not ranked" in row["ours"]
+    assert fd.foaw_error(ev, A)["verdict"] == fd.FAILS  # error rank 3 of 5, no tie: decided
+    assert fd.beat_lowpass(ev, B)["verdict"] == fd.UNDECIDED
+
+
+def test_third_order_fails_when_a_member_is_surely_out_whatever_the_ties():
+    values = {"LOWPASS": (1.0, 0.0), "KALMAN": (0.5, 0.0), "KALLEV": (3.0, 0.0), "LEASTSQ": (2.0, 0.0)}
+    assert fd.third_order_best(_evaluation(values), A)["verdict"] == fd.FAILS
+
+
+def test_kalman_tied_for_first_is_undecided():
+    values = {"LOWPASS": (1.0, 10.0), "KALMAN": (0.5, 5.0), "KALLEV": (0.5, 5.0)}
+    row = fd.kalman_best(_evaluation(values), A)
+    assert row["verdict"] == fd.UNDECIDED and "KALMAN rank 1-2 (tied) of 3" in row["ours"]
+
+
+def test_sub_sample_delays_rank_within_their_resolution():
+    values = {"LOWPASS": (1.0, 0.0), "KALMAN": (0.5, 0.0), "FOAW": (0.8, 0.0), "LEASTSQ": (2.0, 0.0)}
+    ev = _evaluation(values)
+    sub = {"LOWPASS": 0.9, "KALMAN": 0.1, "FOAW": 0.6, "LEASTSQ": 0.63}
+    ev.subsample_delays = {n: np.full(N, d) for n, d in sub.items()}
+    ev.baseline_subsample_delays = np.full(N, 0.9)
+    row = fd.foaw_delay(ev, A)  # FOAW and LEASTSQ 0.03 samples apart: ranks 2-3 of 4
+    assert row["verdict"] == fd.UNDECIDED and "rank 2-3 (tied) of 4" in row["ours"]
+    assert "ranked by the sub-sample delay" in row["ours"]
+    ev.subsample_delays["LEASTSQ"] = np.full(N, 0.7)
+    assert fd.foaw_delay(ev, A)["verdict"] == fd.FAILS and fd.leastsq_delay(ev, A)["verdict"] == fd.FAILS
