@@ -16,6 +16,12 @@ are deterministic, so one table per (rate, f0, gesture) serves every seed. It
 is computed on first use (about 0.3 s at 5 kHz, 3-5 s at 48 kHz) and kept for
 the process. ``live`` and ``playback`` read the strokes' table: the
 protocol's strokes stand for a person's bowing.
+
+Each run goes a block of ``RUN_BLOCK`` samples at a time (the loop's result
+does not depend on how it is cut) and keeps only the two columns it measures,
+and ``pitch`` holds one spectrum at a time: at 96 kHz the table's runs (2.5 s
+each) held every column of the loop at once and set the peak memory of a short
+``studyapp simulate`` (issue 30, item 4).
 """
 
 import functools
@@ -25,6 +31,7 @@ import numpy as np
 
 from studyapp.model import stability
 
+RUN_BLOCK = 4096  # samples
 GRID = tuple(float(f) for f in np.geomspace(0.05, 200.0, 25))
 DURATION = 2.5  # s
 SETTLE = 0.25  # s
@@ -38,15 +45,18 @@ def pitch(x, rate, fmin=100.0):
     if x.size < 8 or not np.any(x):
         return math.nan
     n = 1 << int(np.ceil(np.log2(x.size * 4)))
-    spec = np.abs(np.fft.rfft(x * np.hanning(x.size), n))
-    f = np.fft.rfftfreq(n, 1.0 / rate)
-    spec[f < fmin] = 0.0
+    x *= np.hanning(x.size)
+    spec = np.abs(np.fft.rfft(x, n))
+    del x
+    step = 1.0 / (n * (1.0 / rate))  # the bins' spacing, as np.fft.rfftfreq computes it: bin i is at i * step
+    low = min(spec.size, int(fmin / step) + 2)
+    spec[:low][np.arange(low) * step < fmin] = 0.0
     i = int(np.argmax(spec))
     if i == 0 or i + 1 >= spec.size or min(spec[i - 1:i + 2]) <= 0.0:
-        return float(f[i])
+        return float(i * step)
     a, b, c = np.log(spec[i - 1:i + 2])
     den = a - 2.0 * b + c
-    return float(f[i] + (0.5 * (a - c) / den if den != 0.0 else 0.0) * (f[1] - f[0]))
+    return float(i * step + (0.5 * (a - c) / den if den != 0.0 else 0.0) * step)
 
 
 def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
@@ -55,10 +65,14 @@ def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
 
     loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
                                  seed=seed, audio=False), judge=False)
-    block = loop.run(int(round(duration * loop.rate)))
+    total = int(round(duration * loop.rate))
+    velocity, string = np.empty(total), np.empty(total)
+    for done in range(0, total, RUN_BLOCK):
+        block = loop.run(min(RUN_BLOCK, total - done))
+        velocity[done:done + RUN_BLOCK] = block["velocity_true"]
+        string[done:done + RUN_BLOCK] = block["string_velocity"]
     start = int(round(SETTLE * loop.rate))
-    return (stability.band_level(block["velocity_true"], loop.rate, start),
-            pitch(block["string_velocity"][start:], loop.rate))
+    return stability.band_level(velocity, loop.rate, start), pitch(string[start:], loop.rate)
 
 
 @functools.lru_cache(maxsize=16)
