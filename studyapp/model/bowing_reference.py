@@ -21,13 +21,15 @@ The table's memory sets the peak of a short ``studyapp simulate`` at high
 rates (issue 30, item 4), so each run goes a block of ``RUN_BLOCK`` samples at
 a time (the loop's result does not depend on how it is cut) keeping only the
 two columns it measures, and its pitch (whether TRUE is still within
-PITCH_TOLERANCE of f0) is taken without zero padding (``TABLE_PADDING``): at
-96 kHz the 4x padded transform of 2^20 points took 28 MB while it ran, the
-unpadded one of 2^18 about 7 MB, with bins 0.37 Hz apart before the parabolic
-interpolation, far finer than the 2 % (8.8 Hz at 440 Hz) it decides. The
-tables equal those of the padded pitch (tests/model/test_model_bowing_reference.py
-at 5 and 48 kHz; by hand also at 96 kHz with f0 150 and 440 Hz, 48 kHz with
-2000 Hz, 20 kHz with 1000 Hz, 1 kHz with 150 Hz, 2026-11-27).
+PITCH_TOLERANCE of f0) is taken on a transform of at most ``TABLE_POINTS`` =
+2^18 points: at 96 kHz the 4x padded transform of 2^20 points took 28 MB
+while it ran, one of 2^18 about 7 MB (bins 0.37 Hz apart before the parabolic
+interpolation). Up to about 29 kHz nothing changes (4x padding stays within
+2^18 points); above, the tables equal those of the 4x padded pitch
+(tests/model/test_model_bowing_reference.py at 48 kHz; by hand at 96 kHz with
+f0 150 and 440 Hz, 48 kHz with 2000 Hz, 2026-11-27). Less padding is not
+harmless everywhere: the argmax can move between two peaks of near equal
+height (at 1 kHz with f0 150 Hz, unpadded, two grid points changed).
 """
 
 import functools
@@ -38,7 +40,7 @@ import numpy as np
 from studyapp.model import stability
 
 RUN_BLOCK = 4096  # samples
-TABLE_PADDING = 1  # the table's pitch asks only "within PITCH_TOLERANCE of f0?" (module docstring)
+TABLE_POINTS = 1 << 18  # the most points of the table's pitch transform (module docstring)
 GRID = tuple(float(f) for f in np.geomspace(0.05, 200.0, 25))
 DURATION = 2.5  # s
 SETTLE = 0.25  # s
@@ -46,15 +48,18 @@ TABLE_GESTURE = {"strokes": "strokes", "strokes-validation": "strokes-validation
                  "playback": "strokes"}
 
 
-def pitch(x, rate, fmin=100.0, padding=4):
+def pitch(x, rate, fmin=100.0, max_points=None):
     """Frequency (Hz) of the largest spectral peak of ``x`` above ``fmin`` (Hann window, zero padding, parabolic).
 
-    The transform has the first power of 2 at or above ``padding`` x the samples.
+    The transform has the first power of 2 at or above 4x the samples, at most
+    ``max_points`` (when given) unless the samples alone are more.
     """
     x = np.asarray(x, dtype=np.float64) - np.mean(x)
     if x.size < 8 or not np.any(x):
         return math.nan
-    n = 1 << int(np.ceil(np.log2(x.size * padding)))
+    n = 1 << int(np.ceil(np.log2(x.size * 4)))
+    if max_points is not None:
+        n = max(min(n, int(max_points)), 1 << int(np.ceil(np.log2(x.size))))
     x *= np.hanning(x.size)
     spec = np.abs(np.fft.rfft(x, n))
     del x
@@ -84,7 +89,7 @@ def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
     start = int(round(SETTLE * loop.rate))
     level = stability.band_level(velocity, loop.rate, start)
     del velocity
-    return level, pitch(string[start:], loop.rate, padding=TABLE_PADDING)
+    return level, pitch(string[start:], loop.rate, max_points=TABLE_POINTS)
 
 
 @functools.lru_cache(maxsize=16)
