@@ -40,3 +40,23 @@ def test_bench_memory_reports_both_inputs(tmp_path, capsys):
         assert r["input_bytes"] > 200 * 3 * 10 and r["peak_rss_bytes"] > 0
         assert r["peak_over_input"] == round(r["peak_rss_bytes"] / r["input_bytes"], 3)
     assert list(tmp_path.iterdir()) == []  # the temporary inputs are gone
+
+
+def test_bench_memory_simulate_reports_each_duration(tmp_path, capsys):
+    argv = ["bench", "memory", "--command", "simulate", "--rate", "5000", "--duration", "0.05", "0.1",
+            "--dir", str(tmp_path), "--json"]
+    assert main(argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["command"] == "simulate" and report["rate"] == 5000.0 and report["format"] == "npz"
+    assert [r["duration"] for r in report["results"]] == [0.05, 0.1]
+    for r in report["results"]:
+        assert r["output_bytes"] > r["duration"] * 5000 * 9 * 8 and r["peak_rss_bytes"] > 0
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bench_memory_simulate_refuses_a_bad_duration_before_work(tmp_path, capsys):
+    argv = ["bench", "memory", "--command", "simulate", "--duration", "1", "0", "--dir", str(tmp_path)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--duration 0: allowed" in err
+    assert list(tmp_path.iterdir()) == []

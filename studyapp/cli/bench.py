@@ -31,10 +31,19 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.midi_flood"))
 
-    p = kinds.add_parser("memory", help="peak memory of 'studyapp estimate' on a generated CSV and .npz")
-    p.add_argument("--rows", type=int, default=10_000_000, metavar="N", help="samples per input (default 10^7)")
+    p = kinds.add_parser("memory", help="peak memory of 'studyapp estimate' on a generated CSV and .npz, "
+                                        "or of 'studyapp simulate'")
+    p.add_argument("--command", choices=("estimate", "simulate"), default="estimate",
+                   help="the command measured (default estimate)")
+    p.add_argument("--rows", type=int, default=10_000_000, metavar="N",
+                   help="estimate: samples per input (default 10^7)")
     p.add_argument("--block", type=int, default=1 << 16, metavar="N",
-                   help="estimate's --block (default 65536, its own default)")
+                   help="estimate: its --block (default 65536, its own default)")
+    p.add_argument("--rate", type=float, default=96_000.0, help="simulate: sample rate in Hz (default 96000)")
+    p.add_argument("--duration", type=float, nargs="+", default=[1.0, 600.0], metavar="S",
+                   help="simulate: seconds, one run each (default 1 600)")
+    p.add_argument("--format", choices=("npz", "h5", "csv"), default="npz", help="simulate: output format "
+                                                                                 "(default npz)")
     p.add_argument("--dir", metavar="DIR", help="where the temporary inputs go (default: the system's temp folder)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.cli.memory_benchmark"))

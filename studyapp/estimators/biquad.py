@@ -1,19 +1,24 @@
 """Second-order sections for the compiled kernels.
 
-Filters are designed with scipy in SOS form (``output="sos"``, never high-order
-``b, a``) and run here in transposed direct form II, one section at a time:
+Filters are designed in SOS form (``output="sos"``, never high-order
+``b, a``): Butterworth sections by butterworth.py, equal to scipy.signal's
+without importing it, others with scipy. They run here in transposed direct
+form II, one section at a time:
 
     y  = b0 x + z1
     z1 = b1 x - a1 y + z2
     z2 = b2 x - a2 y
 
 A section is stored in a parameter vector as five numbers ``b0 b1 b2 a1 a2``
-(``a0`` is 1) and in a state vector as two, ``z1 z2``.
+(``a0`` is 1) and in a state vector as two, ``z1 z2``. ``filter_from_rest``
+runs sections in series over a signal from rest: scipy.signal.sosfilt's
+arithmetic, operation for operation.
 """
 
 import numpy as np
 from numba import njit
-from scipy import signal
+
+from studyapp.estimators.butterworth import sos_row
 
 SECTION = 5  # parameters per section
 STATE = 2  # state per section
@@ -21,8 +26,7 @@ STATE = 2  # state per section
 
 def butter_section(cutoff_hz, rate, btype="low"):
     """One 2nd-order Butterworth section as the 5 numbers this module runs."""
-    sos = signal.butter(2, cutoff_hz, btype=btype, fs=rate, output="sos")
-    return section_from_sos(sos[0])
+    return section_from_sos(sos_row(2, cutoff_hz, rate, btype))
 
 
 def section_from_sos(row):
@@ -51,3 +55,17 @@ def section_prime(p, s, x):
     y = g * x
     s[1] = p[2] * x - p[4] * y
     s[0] = y - p[0] * x
+
+
+@njit(cache=True)
+def filter_from_rest(params, x):
+    """``x`` through the sections ``params`` (``SECTION`` numbers each, in series), from a zero state."""
+    sections = params.shape[0] // SECTION
+    state = np.zeros(sections * STATE)
+    y = np.empty(x.shape[0])
+    for k in range(x.shape[0]):
+        v = x[k]
+        for j in range(sections):
+            v = section_step(params[j * SECTION:(j + 1) * SECTION], state[j * STATE:(j + 1) * STATE], v)
+        y[k] = v
+    return y

@@ -28,16 +28,16 @@ Parameters: ``[1/T, lp section(5), integrating hp section(5)]``.
 
 import numpy as np
 from numba import njit
-from scipy import signal
 
 from studyapp.estimators import kinds
 from studyapp.estimators.biquad import butter_section, section_from_sos, section_step
+from studyapp.estimators.butterworth import sos_row
 from studyapp.estimators.spec import EstimatorSpec, cutoff
 
 
 def integrating_highpass(cutoff_hz, rate):
     """One section equal to a 2nd-order Butterworth high-pass of the trapezoidal integral."""
-    sos = signal.butter(2, cutoff_hz, btype="high", fs=rate, output="sos")[0].copy()
+    sos = sos_row(2, cutoff_hz, rate, "high")
     g = sos[0]  # numerator g * [1, -2, 1]
     sos[0:3] = g * 0.5 / rate * np.array([1.0, 0.0, -1.0])
     return section_from_sos(sos)

@@ -36,7 +36,8 @@ from studyapp.io.archive_bounds import check_h5, open_npz
 from studyapp.io.file_bounds import check_not_sparse, check_size
 from studyapp.io.small_files import open_regular
 from studyapp.io.special_files import refuse_special
-from studyapp.io.atomic import atomic_open, atomic_path
+from studyapp.io.atomic import atomic_open
+from studyapp.io.h5_output import H5Output
 
 COLUMNS = (
     "t", "position", "velocity_lvt", "acceleration", "velocity_true",
@@ -103,12 +104,10 @@ def save(recording, path):
         with atomic_open(path, "wb") as f:
             np.savez(f, __meta__=np.array(meta), **recording.columns)
     elif suffix == ".h5":
-        import h5py
-
-        with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
-            f.attrs["meta"] = meta
+        with H5Output(path) as out:
+            out.file.attrs["meta"] = meta
             for name, values in recording.columns.items():
-                f.create_dataset(name, data=values)
+                out.file.create_dataset(name, data=values)
     else:
         missing = [c for c in COLUMNS if c not in recording.columns]
         if missing:

@@ -8,7 +8,8 @@ so a failure or a kill leaves no partial recording. The files are those
 ``recording.save`` writes and ``recording.load`` / ``RecordingBlocks`` read:
 
 - ``.csv``: the header, then each block's rows as they come;
-- ``.h5``: one chunked, growing dataset per column; the metadata at the end;
+- ``.h5``: one chunked, growing dataset per column; the metadata at the end
+  (io/h5_output.py: a full disk is one error naming the file, checked after each block);
 - ``.npz``: a ZIP member per column cannot grow while another is written, so
   each column goes to its own unnamed temporary file (``O_TMPFILE``: a kill
   leaves nothing) as raw float64, and ``finish`` streams them one after
@@ -31,7 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from studyapp.errors import InputDataError
-from studyapp.io.atomic import atomic_open, atomic_path
+from studyapp.io.atomic import atomic_open
+from studyapp.io.h5_output import H5Output
 from studyapp.io.recording import _meta_json, _suffix
 
 CSV_BYTES_PER_VALUE = 25
@@ -72,12 +74,9 @@ class RecordingWriter:
                 self._file = self._stack.enter_context(atomic_open(self.path, "w", newline=""))
                 self._file.write(",".join(self.columns) + "\n")
             elif self.suffix == ".h5":
-                import h5py
-
-                self._tmp = self._stack.enter_context(atomic_path(self.path))
-                self._h5 = self._stack.enter_context(h5py.File(self._tmp, "w"))
-                for name in self.columns:
-                    self._h5.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8", chunks=(H5_CHUNK,))
+                self._h5 = self._stack.enter_context(H5Output(self.path))
+                self._datasets = [self._h5.file.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8",
+                                                               chunks=(H5_CHUNK,)) for name in self.columns]
             else:
                 self._parts = {name: self._stack.enter_context(tempfile.TemporaryFile(dir=self.path.parent))
                                for name in self.columns}
@@ -94,10 +93,14 @@ class RecordingWriter:
         if self.suffix == ".csv":
             np.savetxt(self._file, np.column_stack(arrays), delimiter=",", fmt="%.17g")
         elif self.suffix == ".h5":
-            for name, values in zip(self.columns, arrays):
-                dataset = self._h5[name]
-                dataset.resize((self.samples + n,))
-                dataset[self.samples:] = values
+            try:
+                for dataset, values in zip(self._datasets, arrays):
+                    dataset.resize((self.samples + n,))
+                    dataset[self.samples:] = values
+            except Exception:
+                self._h5.check()  # HDF5 reading back what the full disk dropped: the disk's error, not HDF5's
+                raise
+            self._h5.check()
         else:
             for name, values in zip(self.columns, arrays):
                 self._parts[name].write(values.tobytes())
@@ -107,7 +110,7 @@ class RecordingWriter:
         """Complete the file with its metadata (``.h5``, ``.npz``; a CSV carries none) and give it its name."""
         text = _meta_json(_Meta(rate, meta))
         if self.suffix == ".h5":
-            self._h5.attrs["meta"] = text
+            self._h5.file.attrs["meta"] = text
         elif self.suffix == ".npz":
             self._write_npz(text)
         self._done = True

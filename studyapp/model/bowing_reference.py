@@ -16,6 +16,20 @@ are deterministic, so one table per (rate, f0, gesture) serves every seed. It
 is computed on first use (about 0.3 s at 5 kHz, 3-5 s at 48 kHz) and kept for
 the process. ``live`` and ``playback`` read the strokes' table: the
 protocol's strokes stand for a person's bowing.
+
+The table's memory sets the peak of a short ``studyapp simulate`` at high
+rates (issue 30, item 4), so each run goes a block of ``RUN_BLOCK`` samples at
+a time (the loop's result does not depend on how it is cut) keeping only the
+two columns it measures, and its pitch (whether TRUE is still within
+PITCH_TOLERANCE of f0) is taken on a transform of at most ``TABLE_POINTS`` =
+2^18 points: at 96 kHz the 4x padded transform of 2^20 points took 28 MB
+while it ran, one of 2^18 about 7 MB (bins 0.37 Hz apart before the parabolic
+interpolation). Up to about 29 kHz nothing changes (4x padding stays within
+2^18 points); above, the tables equal those of the 4x padded pitch
+(tests/model/test_model_bowing_reference.py at 48 kHz; by hand at 96 kHz with
+f0 150 and 440 Hz, 48 kHz with 2000 Hz, 2026-11-27). Less padding is not
+harmless everywhere: the argmax can move between two peaks of near equal
+height (at 1 kHz with f0 150 Hz, unpadded, two grid points changed).
 """
 
 import functools
@@ -25,6 +39,8 @@ import numpy as np
 
 from studyapp.model import stability
 
+RUN_BLOCK = 4096  # samples
+TABLE_POINTS = 1 << 18  # the most points of the table's pitch transform (module docstring)
 GRID = tuple(float(f) for f in np.geomspace(0.05, 200.0, 25))
 DURATION = 2.5  # s
 SETTLE = 0.25  # s
@@ -32,21 +48,30 @@ TABLE_GESTURE = {"strokes": "strokes", "strokes-validation": "strokes-validation
                  "playback": "strokes"}
 
 
-def pitch(x, rate, fmin=100.0):
-    """Frequency (Hz) of the largest spectral peak of ``x`` above ``fmin`` (Hann window, 4x zero padding, parabolic)."""
+def pitch(x, rate, fmin=100.0, max_points=None):
+    """Frequency (Hz) of the largest spectral peak of ``x`` above ``fmin`` (Hann window, zero padding, parabolic).
+
+    The transform has the first power of 2 at or above 4x the samples, at most
+    ``max_points`` (when given) unless the samples alone are more.
+    """
     x = np.asarray(x, dtype=np.float64) - np.mean(x)
     if x.size < 8 or not np.any(x):
         return math.nan
     n = 1 << int(np.ceil(np.log2(x.size * 4)))
-    spec = np.abs(np.fft.rfft(x * np.hanning(x.size), n))
-    f = np.fft.rfftfreq(n, 1.0 / rate)
-    spec[f < fmin] = 0.0
+    if max_points is not None:
+        n = max(min(n, int(max_points)), 1 << int(np.ceil(np.log2(x.size))))
+    x *= np.hanning(x.size)
+    spec = np.abs(np.fft.rfft(x, n))
+    del x
+    step = 1.0 / (n * (1.0 / rate))  # the bins' spacing, as np.fft.rfftfreq computes it: bin i is at i * step
+    low = min(spec.size, int(fmin / step) + 2)
+    spec[:low][np.arange(low) * step < fmin] = 0.0
     i = int(np.argmax(spec))
     if i == 0 or i + 1 >= spec.size or min(spec[i - 1:i + 2]) <= 0.0:
-        return float(f[i])
+        return float(i * step)
     a, b, c = np.log(spec[i - 1:i + 2])
     den = a - 2.0 * b + c
-    return float(f[i] + (0.5 * (a - c) / den if den != 0.0 else 0.0) * (f[1] - f[0]))
+    return float(i * step + (0.5 * (a - c) / den if den != 0.0 else 0.0) * step)
 
 
 def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
@@ -55,10 +80,16 @@ def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
 
     loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
                                  seed=seed, audio=False), judge=False)
-    block = loop.run(int(round(duration * loop.rate)))
+    total = int(round(duration * loop.rate))
+    velocity, string = np.empty(total), np.empty(total)
+    for done in range(0, total, RUN_BLOCK):
+        block = loop.run(min(RUN_BLOCK, total - done))
+        velocity[done:done + RUN_BLOCK] = block["velocity_true"]
+        string[done:done + RUN_BLOCK] = block["string_velocity"]
     start = int(round(SETTLE * loop.rate))
-    return (stability.band_level(block["velocity_true"], loop.rate, start),
-            pitch(block["string_velocity"][start:], loop.rate))
+    level = stability.band_level(velocity, loop.rate, start)
+    del velocity
+    return level, pitch(string[start:], loop.rate, max_points=TABLE_POINTS)
 
 
 @functools.lru_cache(maxsize=16)

@@ -75,9 +75,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
-from scipy import signal
 
 from studyapp.estimators.biquad import butter_section, section_from_sos
+from studyapp.estimators.butterworth import sos_row
 from studyapp.estimators.spec import NYQUIST_FRACTION
 
 
@@ -123,7 +123,7 @@ class SensorSpec:
 
     def acc_coupling_section(self, rate):
         """The AC coupling: a first-order high-pass at ``acc_corner`` as a 5-number section (b2 = a2 = 0)."""
-        return section_from_sos(signal.butter(1, self.acc_corner, btype="high", fs=rate, output="sos")[0])
+        return section_from_sos(sos_row(1, self.acc_corner, rate, "high"))
 
     def acc_lf_pole(self, rate):
         """rho of the low-frequency noise's leaky integrator."""

@@ -67,8 +67,9 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy import signal
 
+from studyapp.estimators.biquad import filter_from_rest, section_from_sos
+from studyapp.estimators.butterworth import sos_row
 from studyapp.model import calibration
 from studyapp.model.sensors import section_at
 
@@ -95,15 +96,15 @@ N_STATE = 11
 
 
 def band_sos(rate):
-    """The bowing band's filter at ``rate`` (scipy sos, two sections: high-pass, low-pass)."""
+    """The bowing band's filter at ``rate`` (scipy's sos layout, two sections: high-pass, low-pass)."""
     hi = min(BAND[1], 0.45 * rate)
-    return np.vstack([signal.butter(2, BAND[0], "high", fs=rate, output="sos"),
-                      signal.butter(2, hi, "low", fs=rate, output="sos")])
+    return np.vstack([sos_row(2, BAND[0], rate, "high"), sos_row(2, hi, rate, "low")])
 
 
 def band_level(velocity, rate, start=0):
     """RMS (m/s) of ``velocity`` through the bowing band (causal, from rest), over its samples from ``start`` on."""
-    y = signal.sosfilt(band_sos(rate), np.asarray(velocity, dtype=np.float64))[int(start):]
+    params = np.concatenate([section_from_sos(row) for row in band_sos(rate)])
+    y = filter_from_rest(params, np.ascontiguousarray(velocity, dtype=np.float64))[int(start):]
     return float(np.sqrt(np.mean(y * y))) if y.size else 0.0
 
 
@@ -152,7 +153,7 @@ class StabilityMonitor:
 
     def __init__(self, rate, f0=calibration.F0, reference=None):
         self.rate = float(rate)
-        hp = signal.butter(2, min(HIGHPASS_FRACTION * f0, 0.45 * rate), "high", fs=rate, output="sos")[0]
+        hp = sos_row(2, min(HIGHPASS_FRACTION * f0, 0.45 * rate), rate, "high")
         self.params = np.zeros(N_PARAMS)
         self.params[MP_HP:MP_HP + 5] = np.array([hp[0], hp[1], hp[2], hp[4], hp[5]]) / hp[3]
         self.params[MP_LONG] = 1.0 - np.exp(-1.0 / (WINDOW * rate))

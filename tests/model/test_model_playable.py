@@ -2,7 +2,8 @@
 
 Below rate = 6 f0 the waveguide's interpolated delay lines put the pitch more
 than 1 % off, and at 4 f0 or less it does not sound at f0 at all
-(model/playable.py). The pitch here: TRUE bowed on the strokes well below its
+(model/playable.py). The pitch here (model/string_pitch.py, as
+scripts/string_pitch.py measures it): TRUE bowed on the strokes well below its
 breakdown, the string velocity's spectral peak in each stroke's cruise (at
 least 8 periods long), median over the cruises: within 1 % of f0 on a grid of
 accepted (rate, f0) pairs with the edges rate = 6 f0 at 1, 2.64 and 12 kHz.
@@ -15,56 +16,30 @@ import pytest
 
 from studyapp.cli import main
 from studyapp.errors import ParameterError
-from studyapp.model import bowed_string, calibration
-from studyapp.model.bowed_string import StringDesign
-from studyapp.model.bowing_reference import pitch
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.playable import check_playable, min_rate
+from studyapp.model.string_pitch import alone_pitch, cruise_pitches
 
 GRID = [(1000.0, 1000.0 / 6), (1000.0, 125.0), (2640.0, 440.0), (5000.0, 440.0), (5000.0, 5000.0 / 6),
         (12000.0, 2000.0), (48000.0, 2000.0), (48000.0, 150.0), (96000.0, 2000.0), (96000.0, 440.0)]
-
-
-def cruise_pitch(rate, f0, fmax, seed=0, seconds=2.5):
-    loop = ClosedLoop(LoopConfig(rate=rate, source="TRUE", fmax=fmax, gesture="strokes", seed=seed, f0=f0,
-                                 audio=False), judge=False)
-    block = loop.run(int(seconds * rate))
-    m = max(1, int(0.01 * rate))
-    speed = np.convolve(np.abs(block["velocity_true"]), np.ones(m) / m, "same")
-    cruise = (speed > 0.8 * calibration.STROKE_SPEED).astype(np.int8)
-    edges = np.flatnonzero(np.diff(np.r_[0, cruise, 0]))
-    found = []
-    for a, e in zip(edges[::2] + int(0.02 * rate), edges[1::2]):
-        if (e - a) * f0 / rate >= 8:
-            found.append(pitch(block["string_velocity"][a:e], rate, fmin=0.5 * f0))
-    assert len(found) >= 2
-    return float(np.median(found))
 
 
 @pytest.mark.parametrize("rate, f0", GRID, ids=[f"{r:g}Hz-{f:.0f}Hz" for r, f in GRID])
 @pytest.mark.parametrize("fmax", [1.0, 5.0])
 def test_the_string_sounds_at_f0_at_every_accepted_rate(rate, f0, fmax):
     check_playable(rate, f0)
-    assert cruise_pitch(rate, f0, fmax) == pytest.approx(f0, rel=0.01)
-
-
-def string_alone(rate, f0, v_bow=0.18, seconds=1.0):
-    """The waveguide by itself under a constant bow (the strokes' speed): its pitch over the second half."""
-    design = StringDesign(rate, f0)
-    state, bridge, nut = design.new_state()
-    n = int(seconds * rate)
-    u, v_string, v_bridge = np.zeros(n), np.zeros(n), np.zeros(n)
-    bowed_string.run(design.params(), state, bridge, nut, np.full(n, v_bow), True, u, v_string, v_bridge)
-    return pitch(v_string[n // 2:], rate, fmin=0.5 * f0)
+    found = cruise_pitches(rate, f0, fmax)
+    assert len(found) >= 2
+    assert float(np.median(found)) == pytest.approx(f0, rel=0.01)
 
 
 @pytest.mark.parametrize("rate", [1000.0, 5000.0])
 def test_why_the_bound_is_6(rate):
     # the interpolated lines put the pitch more than 1 % off between 4 and 6 f0 (-1.6 % at 4.5, +1.3 % at 5.5)
     for ratio in (4.5, 5.5):
-        assert abs(string_alone(rate, rate / ratio) * ratio / rate - 1.0) > 0.01
+        assert abs(alone_pitch(rate, rate / ratio) * ratio / rate - 1.0) > 0.01
     for ratio in (6.0, 6.5, 7.0, 7.5, 8.0, 10.0, 12.0, 20.0):
-        assert string_alone(rate, rate / ratio) * ratio / rate == pytest.approx(1.0, abs=0.01)
+        assert alone_pitch(rate, rate / ratio) * ratio / rate == pytest.approx(1.0, abs=0.01)
 
 
 def test_unplayable_pairs_are_one_line_errors():
