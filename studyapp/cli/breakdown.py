@@ -1,5 +1,5 @@
 """``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--first-seed K] [--gesture strokes|hold]
-[--latency S] [--packet S] [--jitter S] [--json] [-o FILE]``.
+[--windows seconds|samples] [--latency S] [--packet S] [--jitter S] [--json] [-o FILE]``.
 
 Breakdown F_max (studyapp.model.breakdown) for one source or every source,
 over seeds K..K+N-1 (K = 0 by default). Prints a table (or with ``--json`` one JSON object for
@@ -10,6 +10,12 @@ command that regenerates it) or ``.json``. Stable up to the search's 200 N is
 ``inf`` in CSV, ``null`` in JSON and "> 200" in Markdown; broken already at
 0.05 N is 0.05, "<= 0.05" in Markdown. Progress goes to stderr.
 
+Each estimator runs with Table 1 made for ``--rate`` (estimators/at_rate.py):
+``--windows seconds`` (the default) scales the parameters counted in samples
+(LEASTSQ's and FOAW's windows, the FOAW hybrids', BDIFF's steps) by
+rate / 5 kHz, so they keep the duration they were tuned for; ``--windows
+samples`` keeps the counts as printed. At 5 kHz the two are the same.
+
 ``--latency``, ``--packet`` and ``--jitter`` (seconds, default 0) put the
 simulated device behind a link (studyapp.model.link); the JSON has their keys,
 the CSV their columns (after today's), the Markdown a sentence naming them.
@@ -19,7 +25,7 @@ from studyapp.cli import link_options
 
 SUFFIXES = (".csv", ".md", ".json")
 COLUMNS = ("source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed", "first_seed",
-           "seeds_used")
+           "seeds_used", "windows")
 LINK_COLUMNS = ("latency", "packet", "jitter")  # s, the link's (studyapp.model.link.NAMES)
 
 
@@ -42,6 +48,9 @@ def register(subparsers):
                         "tremor) (default strokes)")
     p.add_argument("--duration", type=float, default=5.0, metavar="SECONDS",
                    help="length of each trial, 0.5..60 s (default 5; shorter misses late onsets)")
+    p.add_argument("--windows", default="seconds", metavar="seconds|samples",
+                   help="Table 1's parameters counted in samples at --rate: seconds (scaled by rate / 5000, keeping the "
+                        "duration Table 1 was tuned for) or samples (the counts as printed) (default seconds)")
     link_options.add(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of the table")
     p.add_argument("-o", "--output", metavar="FILE", help="also write the result: .csv, .md or .json")
@@ -67,7 +76,7 @@ def command_line(args):
     which = "--all" if args.all else f"--source {shlex.quote(args.source)}"
     words = (f"studyapp breakdown {which} --rate {args.rate:g} --seeds {args.seeds} --first-seed {args.first_seed}"
              f" --gesture {args.gesture}")
-    words += f" --duration {args.duration:g}" + link_options.words(args)
+    words += f" --duration {args.duration:g} --windows {args.windows}" + link_options.words(args)
     if args.output:
         words += f" -o {shlex.quote(str(args.output))}"
     return words
@@ -77,6 +86,7 @@ def run(args):
     import json
     import sys
 
+    from studyapp.estimators.at_rate import check_windows
     from studyapp.estimators.spec import validate_rate
     from studyapp.model import breakdown, calibration
     from studyapp.model.playable import check_playable
@@ -87,6 +97,7 @@ def run(args):
     breakdown.check_first_seed(args.first_seed, args.seeds, "--first-seed")
     breakdown.check_gesture(args.gesture, "--gesture")
     breakdown.check_duration(args.duration, "--duration")
+    check_windows(args.windows, "--windows")
     link = link_options.spec(args)
     if args.output:
         check_output(args.output)
@@ -107,7 +118,7 @@ def run(args):
 
         results.append(breakdown.breakdown_over_seeds(name, rate=args.rate, seeds=args.seeds, gesture=args.gesture,
                                                       duration=args.duration, progress=progress, link=link,
-                                                      first_seed=args.first_seed))
+                                                      first_seed=args.first_seed, windows=args.windows))
 
     if args.json:
         json.dump(_json(results if args.all else results[0]), sys.stdout, indent=1, allow_nan=False)
@@ -169,7 +180,7 @@ def _cells(result, fmt):
     return [result["source"], f"{result['rate']:g}", result["gesture"], str(result["seeds"]),
             fmt(result["fmax_median"]), fmt(result["fmax_min"]), fmt(result["fmax_max"]),
             ";".join(fmt(v) for v in result["fmax"]), str(result["first_seed"]),
-            ";".join(str(s) for s in result["seeds_used"])]
+            ";".join(str(s) for s in result["seeds_used"]), result["windows"]]
 
 
 def text_table(results):

@@ -22,12 +22,12 @@ rate, with the estimators evaluated there, and returns its ``Result``.
   the rate's optimum in a few minutes.
 """
 
+from studyapp.estimators.at_rate import TABLE1_RATE  # SEARCH_RANGES were set at it too
 from studyapp.estimators.registry import spec
 from studyapp.evaluation.dataset import RawObjectives
 from studyapp.evaluation.optimiser import Optimiser
 from studyapp.evaluation.space import SEARCH_RANGES, Space
 
-TABLE1_RATE = 5000.0  # the paper's rate, at which Table 1 and SEARCH_RANGES were set
 
 
 def search_spaces(names, rate, windows="seconds"):

@@ -41,6 +41,7 @@ import numpy as np
 
 from studyapp.errors import ParameterError, UserError
 from studyapp.estimators import conventions
+from studyapp.estimators.at_rate import at_rate
 from studyapp.estimators.benchmark import cost as streaming_cost
 from studyapp.estimators.registry import spec
 from studyapp.evaluation.executors import InlineExecutor
@@ -71,15 +72,9 @@ def params_at_rate(params, rate, params_rate, windows="seconds"):
         raise UserError(f"windows = {windows!r}: allowed is 'seconds' or 'samples'")
     available, missing = {}, {}
     for name, values in params.items():
-        s = spec(name)
-        values = dict(values)
-        if windows == "seconds":
-            for p in s.params:
-                if p.kind == "int" and p.unit == "samples" and p.name in values:
-                    scaled = int(round(values[p.name] * rate / params_rate))
-                    values[p.name] = int(min(p.high, max(p.low, scaled)))
+        values = at_rate(name, values, rate, params_rate, windows)
         try:
-            _, available[name] = s.validate(rate, values)
+            _, available[name] = spec(name).validate(rate, values)
         except ParameterError as exc:
             missing[name] = str(exc)
     return available, missing

@@ -1,15 +1,17 @@
-"""TRUE's band level while bowing: the reference the stability monitor judges a live loop against.
+"""TRUE's band levels while bowing: the reference the stability monitor judges a live loop against.
 
 The bowing verdict (stability.py) compares the handle's velocity in the band
-stability.BAND with what the ideal sensor gives on the same gesture at the same
-F_max. A breakdown search (breakdown.py) runs TRUE beside each trial; a live
-loop cannot, so it reads this table instead: TRUE's band level
-(stability.band_level over [SETTLE, DURATION] s of the gesture from rest) at
-F_max on a log grid GRID (0.05-200 N, 25 points, a factor 1.41 apart),
-interpolated linearly in log F_max and log level, and held constant outside the
-grid. TRUE's string stays at its pitch up to about 22 N (5 kHz); above the
-first grid point where it leaves f0 by more than stability.PITCH_TOLERANCE,
-the table holds the last healthy level (a broken TRUE is no reference).
+stability.BAND, and in the upper band stability.hiss_band(rate) where the rate
+has one (above 5.6 kHz), with what the ideal sensor gives on the same gesture
+at the same F_max. A breakdown search (breakdown.py) runs TRUE beside each
+trial; a live loop cannot, so it reads this table instead: TRUE's level in each
+band (stability.band_level and stability.hiss_level over [SETTLE, DURATION] s
+of the gesture from rest) at F_max on a log grid GRID (0.05-200 N, 25 points,
+a factor 1.41 apart), interpolated linearly in log F_max and log level, and
+held constant outside the grid. TRUE's string stays at its pitch up to about
+22 N (5 kHz); above the first grid point where it leaves f0 by more than
+stability.PITCH_TOLERANCE, the table holds the last healthy levels (a broken
+TRUE is no reference).
 
 TRUE's run does not depend on the seed (it reads no sensor) and the strokes
 are deterministic, so one table per (rate, f0, gesture) serves every seed. It
@@ -75,7 +77,8 @@ def pitch(x, rate, fmin=100.0, max_points=None):
 
 
 def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
-    """(band level, pitch) of TRUE bowing ``gesture`` at ``fmax`` for ``duration`` s, measured after SETTLE."""
+    """(band level, upper band level or None, pitch) of TRUE bowing ``gesture`` at ``fmax`` for ``duration`` s,
+    measured after SETTLE."""
     from studyapp.model.loop import ClosedLoop, LoopConfig  # the loop imports this module
 
     loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
@@ -87,27 +90,45 @@ def true_run(rate, f0, gesture, fmax, duration=DURATION, seed=0):
         velocity[done:done + RUN_BLOCK] = block["velocity_true"]
         string[done:done + RUN_BLOCK] = block["string_velocity"]
     start = int(round(SETTLE * loop.rate))
-    level = stability.band_level(velocity, loop.rate, start)
-    del velocity
-    return level, pitch(string[start:], loop.rate, max_points=TABLE_POINTS)
+    return measures(velocity, string, loop.rate, start, max_points=TABLE_POINTS)
+
+
+def measures(velocity, string_velocity, rate, start, max_points=None):
+    """(band level, upper band level or None, pitch) of a bowing run's handle and string velocities from ``start``."""
+    return (stability.band_level(velocity, rate, start), stability.hiss_level(velocity, rate, start),
+            pitch(string_velocity[start:], rate, max_points=max_points))
 
 
 @functools.lru_cache(maxsize=16)
 def table(rate, f0, gesture):
-    """(log F_max, log level) arrays of TRUE's band level over GRID, held after TRUE leaves its pitch."""
+    """(log F_max, log band level, log upper band level or None) arrays of TRUE over GRID, held after TRUE leaves
+    its pitch."""
     levels = []
     for fmax in GRID:
-        level, p = true_run(rate, f0, gesture, fmax)
+        band, hiss, p = true_run(rate, f0, gesture, fmax)
         if levels and not abs(p / f0 - 1.0) <= stability.PITCH_TOLERANCE:
-            level = levels[-1]
-        levels.append(max(level, 1e-12))
-    return np.log(np.array(GRID)), np.log(np.array(levels))
+            band, hiss = levels[-1]
+        levels.append((max(band, 1e-12), None if hiss is None else max(hiss, 1e-12)))
+    band, hiss = zip(*levels)
+    return (np.log(np.array(GRID)), np.log(np.array(band)),
+            None if hiss[0] is None else np.log(np.array(hiss)))
 
 
 def level(rate, f0, gesture, fmax):
     """TRUE's band level (m/s) at ``fmax`` on ``gesture`` (``hold`` has none: None)."""
+    return _interpolated(rate, f0, gesture, fmax, 1)
+
+
+def hiss_level(rate, f0, gesture, fmax):
+    """TRUE's upper band level (m/s) at ``fmax`` on ``gesture`` (``hold``, or a rate without the band: None)."""
+    return _interpolated(rate, f0, gesture, fmax, 2)
+
+
+def _interpolated(rate, f0, gesture, fmax, column):
     name = TABLE_GESTURE.get(gesture)
     if name is None:
         return None
-    log_f, log_level = table(float(rate), float(f0), name)
-    return float(np.exp(np.interp(math.log(max(fmax, GRID[0])), log_f, log_level)))
+    found = table(float(rate), float(f0), name)
+    if found[column] is None:
+        return None
+    return float(np.exp(np.interp(math.log(max(fmax, GRID[0])), found[0], found[column])))

@@ -8,14 +8,21 @@ bowing with the protocol's gesture (``strokes`` by default; ``hold`` kept).
 One trial, ``is_broken(source, f)``: the closed loop (loop.py) runs for
 ``duration`` s at F_max = f with ``source`` as the velocity in the loop.
 - Bowing (``strokes``): broken if the loop faults, if the handle's velocity in
-  the band stability.BAND, RMS over [SETTLE, duration], is more than
-  stability.RISE (6 dB) above TRUE's on the same gesture at the same F_max and
-  seed (TRUE's runs are cached), or if the string's pitch (the largest spectral
-  peak of the string's velocity at the bow above 100 Hz, over the same span) is
-  more than stability.PITCH_TOLERANCE off f0. docs/model.md justifies it.
+  the band stability.BAND, or in the upper band stability.hiss_band(rate)
+  (2.5 kHz up to min(16 kHz, 0.45 x rate), none at 5 kHz), RMS over
+  [SETTLE, duration], is more than stability.RISE (6 dB) above TRUE's in the
+  same band on the same gesture at the same F_max and seed (TRUE's runs are
+  cached), or if the string's pitch (the largest spectral peak of the string's
+  velocity at the bow above 100 Hz, over the same span) is more than
+  stability.PITCH_TOLERANCE off f0. docs/model.md justifies it.
 - Holding (``hold``): broken if the loop faults or the stability monitor's hold
   criterion flags breakdown once its SETTLE = 0.25 s window has filled
   (checked every BLOCK = 0.05 s).
+
+The source runs with its parameters from ``estimators`` or, when not given
+there, with Table 1 made for the rate (estimators/at_rate.py; ``windows``
+"seconds": windows counted in samples keep their 5 kHz duration, "samples":
+the counts as printed).
 
 The search, ``breakdown_fmax``, assumes broken(f) is monotonic in f and
 bisects log f. It starts from the bracket [LOW, HIGH] = [0.05, 200] N (200 N:
@@ -38,7 +45,7 @@ so each seed is one run of the same world, like one trial of the paper's six
 per participant; a seed's value does not depend on K or N. The result gives every seed's
 F_max and their median (for even N the mean of the middle two, numpy.median),
 minimum and maximum; inf (stable to 200 N) counts as the largest value.
-It also says the link it ran with (``LINK_KEYS``, seconds).
+It also says how Table 1 was made for the rate (``windows``) and the link it ran with (``LINK_KEYS``, seconds).
 """
 
 import functools
@@ -48,6 +55,7 @@ import numpy as np
 
 from studyapp.errors import ParameterError
 from studyapp.estimators import names
+from studyapp.estimators.at_rate import check_windows, table1
 from studyapp.estimators.spec import validate_rate
 from studyapp.model import bowing_reference, stability
 from studyapp.model.calibration import F0
@@ -65,7 +73,7 @@ DURATION_RANGE = (0.5, 60.0)  # s per trial; below about 2 s a late onset is mis
 DURATION = 5.0  # s per trial by default: about ten strokes
 MAX_SEED_END = 1_000_000  # K + N at most this: seeds stay small whole numbers wherever they are derived from
 KEYS = ("source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max", "first_seed",
-        "seeds_used") + LINK_KEYS
+        "seeds_used", "windows") + LINK_KEYS
 
 
 def sources():
@@ -113,12 +121,12 @@ def check_duration(seconds, label="duration"):
 
 
 def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, seed=0, estimators=None, f0=None,
-              link=None):
+              link=None, windows="seconds"):
     """Whether ``source`` at ``fmax`` N breaks down within ``duration`` s of ``gesture`` (the module's criteria),
     the device behind ``link`` (a link.LinkSpec; None: ideal)."""
     estimators = dict(estimators or {})
     if not is_pseudo(source) and source not in estimators:
-        estimators[source] = {}
+        estimators[source] = table1(source, rate, windows)
     f0 = F0 if f0 is None else f0
     loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
                                  f0=f0, seed=seed, audio=False, link=link), judge=False)
@@ -128,9 +136,10 @@ def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, s
     block = loop.run(total)
     if loop.fault is not None:
         return True
-    level, pitch = _bowing_measures(block, loop.rate, loop.string.f0)
-    ref_level, _ = _true_bowing(float(loop.rate), float(f0), gesture, float(fmax), total, int(seed))
-    return level > stability.RISE * ref_level or not abs(pitch / loop.string.f0 - 1.0) <= stability.PITCH_TOLERANCE
+    level, hiss, pitch = _bowing_measures(block, loop.rate)
+    ref_level, ref_hiss, _ = _true_bowing(float(loop.rate), float(f0), gesture, float(fmax), total, int(seed))
+    return (level > stability.RISE * ref_level or stability.over(hiss, ref_hiss, stability.RISE)
+            or not abs(pitch / loop.string.f0 - 1.0) <= stability.PITCH_TOLERANCE)
 
 
 def _broken_holding(loop, duration):
@@ -146,22 +155,20 @@ def _broken_holding(loop, duration):
     return False
 
 
-def _bowing_measures(block, rate, f0):
-    """(band level m/s, pitch Hz) of a bowing trial over [SETTLE, end]."""
-    start = int(round(SETTLE * rate))
-    return (stability.band_level(block["velocity_true"], rate, start),
-            bowing_reference.pitch(block["string_velocity"][start:], rate))
+def _bowing_measures(block, rate):
+    """(band level m/s, upper band level m/s or None, pitch Hz) of a bowing trial over [SETTLE, end]."""
+    return bowing_reference.measures(block["velocity_true"], block["string_velocity"], rate, int(round(SETTLE * rate)))
 
 
 @functools.lru_cache(maxsize=4096)
 def _true_bowing(rate, f0, gesture, fmax, total, seed):
     loop = ClosedLoop(LoopConfig(rate=rate, estimators={}, source="TRUE", fmax=fmax, gesture=gesture, f0=f0,
                                  seed=seed, audio=False), judge=False)
-    return _bowing_measures(loop.run(total), loop.rate, loop.string.f0)
+    return _bowing_measures(loop.run(total), loop.rate)
 
 
 def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, low=LOW, high=HIGH, tolerance=0.02,
-                   seed=0, estimators=None, f0=None, progress=None, link=None):
+                   seed=0, estimators=None, f0=None, progress=None, link=None, windows="seconds"):
     """The largest F_max (N) at which ``source`` stays stable, by bisection on a log scale.
 
     Stable means: ``is_broken`` is False (bowing ``strokes`` by default;
@@ -169,8 +176,10 @@ def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, lo
     ``high`` does not; otherwise the geometric midpoint of the final bracket,
     whose width is at most ``tolerance`` (relative). ``progress(fmax, broken)``
     is called after each trial. ``link``: the device's link (None: ideal).
+    ``windows``: how Table 1 is made for the rate when ``estimators`` does not give the source (module doc).
     """
-    kwargs = dict(rate=rate, gesture=gesture, duration=duration, seed=seed, estimators=estimators, f0=f0, link=link)
+    kwargs = dict(rate=rate, gesture=gesture, duration=duration, seed=seed, estimators=estimators, f0=f0, link=link,
+                  windows=windows)
 
     def trial(fmax):
         broken = is_broken(source, fmax, **kwargs)
@@ -193,7 +202,7 @@ def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, lo
 
 
 def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", duration=DURATION, tolerance=0.02, progress=None,
-                         link=None, estimators=None, first_seed=0):
+                         link=None, estimators=None, first_seed=0, windows="seconds"):
     """Breakdown F_max for seeds ``first_seed``..``first_seed`` + ``seeds`` - 1: a dict with exactly the keys ``KEYS``.
 
     ``fmax`` lists the seeds' values (N; inf when stable up to 200 N), in the
@@ -205,7 +214,7 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
     and ``trial`` the number of trials it took. ``link`` (a link.LinkSpec; None:
     ideal) is the device's link, ``latency``, ``packet`` and ``jitter`` its
     times (s); ``estimators``: name -> params of the estimators in the loop
-    (the source's Table 1 defaults when not given).
+    (the source's Table 1 made for the rate when not given, ``windows`` saying how: the module's doc).
     """
     check_source(source)
     rate = validate_rate(rate)
@@ -213,6 +222,7 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
     first_seed = check_first_seed(first_seed, seeds)
     check_gesture(gesture)
     duration = check_duration(duration)
+    check_windows(windows)
     used = list(range(first_seed, first_seed + seeds))
     values = []
     for seed in used:
@@ -224,11 +234,11 @@ def breakdown_over_seeds(source, rate=5000.0, seeds=5, gesture="strokes", durati
                 progress(seed, len(trials), fmax, "broken" if broken else "stable")
 
         value = breakdown_fmax(source, rate=rate, gesture=gesture, duration=duration, tolerance=tolerance,
-                               seed=seed, progress=on_trial, link=link, estimators=estimators)
+                               seed=seed, progress=on_trial, link=link, estimators=estimators, windows=windows)
         values.append(float(value))
         if progress is not None:
             progress(seed, len(trials), value, "result")
     return {"source": source, "rate": rate, "gesture": gesture, "seeds": seeds, "fmax": values,
             "fmax_median": float(np.median(values)), "fmax_min": min(values), "fmax_max": max(values),
-            "first_seed": first_seed, "seeds_used": used,
+            "first_seed": first_seed, "seeds_used": used, "windows": windows,
             **{name: getattr(link or IDEAL, name) for name in LINK_KEYS}}

@@ -29,7 +29,7 @@ the source switches at a block boundary.
 The stability monitor (stability.py) is advanced per sample by the
 controller. Python runs only at block boundaries: it applies setting changes
 (source, F_max, force scale, bowing, gesture) and reads the monitor's
-verdict. While the gesture bows, the monitor judges against TRUE's band level
+verdict. While the gesture bows, the monitor judges against TRUE's band levels
 on it at the loop's F_max (bowing_reference.py; ``judge=False`` leaves the
 monitor on its hold criterion, as the reference's own TRUE runs need).
 
@@ -236,12 +236,17 @@ class ClosedLoop:
         self.gesture_name = name
         bowing = self._judge_bowing and bowing_reference.TABLE_GESTURE.get(name) is not None
         self.monitor.reference = self.reference_level if bowing else None
+        self.monitor.hiss_reference = self.hiss_reference_level if bowing else None
         if bowing:
             self.reference_level()  # the table now (once per process), not in a live block
 
     def reference_level(self):
         """TRUE's band level (m/s) on this gesture at this F_max: what the monitor judges against while bowing."""
         return bowing_reference.level(self.rate, self.string.f0, self.gesture_name, self.fmax)
+
+    def hiss_reference_level(self):
+        """TRUE's upper band level (m/s) on this gesture at this F_max (None where the rate has no upper band)."""
+        return bowing_reference.hiss_level(self.rate, self.string.f0, self.gesture_name, self.fmax)
 
     def set_hand_target(self, x_m):
         x_m = float(x_m)

@@ -27,6 +27,24 @@ trial the same way (breakdown.py), with TRUE run at the same seed and F_max,
 and adds the string's pitch: more than PITCH_TOLERANCE = 2 % off f0 is broken
 (it catches TRUE's own breakdown, where the string leaves f0 for a higher mode).
 
+Above the paper's rate, a second band (issue 30): the handle's velocity
+through HISS = 2.5 kHz (4th-order Butterworth high-pass) up to
+min(16 kHz, HISS_TOP_FRACTION x rate) (2nd-order low-pass), mean square over
+BOW_WINDOW, judged the same way against TRUE's level in that band:
+
+    broken  =  band > RISE * reference  or  upper band > RISE * upper reference
+
+2.5 kHz is the 5 kHz loop's Nyquist frequency: there the upper band is empty
+(the rate must exceed 2.5 kHz / 0.45 = 5.6 kHz) and the verdict is exactly the
+paper-rate one. At higher rates the loop makes sound up to rate / 2 and an
+estimator whose parameters are counted in samples (Table 1's FOAW and LEASTSQ
+windows, kept at 17 and 33 samples) hisses there: at 48 kHz the handle carries
+3.1-3.4 x TRUE's upper band level at every F_max with FOAW's 17 samples, while
+the sources whose noise is low-pitched stay at 0.95-1.6 x up to their buzz.
+Its lower edge keeps the string's first partials and the loop's mode (about
+720 Hz) out (the 4th-order high-pass puts 720 Hz 43 dB down; a 2nd-order one let
+LVT's loop mode fill the band); 16 kHz is the top of most adults' hearing.
+
 With the hand holding (``hold``): the oscillation of a stuck string. The
 handle's velocity high-passed at f0 / 2, so tremor does not count:
 
@@ -56,6 +74,7 @@ hovering at the threshold does not flip it back and forth within a trial:
 broken is entered at the thresholds above and left only below lower ones,
 
     bowing:   enter  band > RISE x reference,          leave  band < RELEASE x reference,  RELEASE = sqrt(2) (3 dB)
+              (and the same for the upper band: broken while either band is above RELEASE x its reference)
     holding:  enter  level > VIBRATION_MIN, cv < CV_MAX,  leave  level < VIBRATION_MIN or cv > CV_RELEASE = 0.25
 
 A breakdown's onset is judged exactly as before (``studyapp breakdown`` and
@@ -69,11 +88,13 @@ import numpy as np
 from numba import njit
 
 from studyapp.estimators.biquad import filter_from_rest, section_from_sos
-from studyapp.estimators.butterworth import sos_row
+from studyapp.estimators.butterworth import sos_row, sos_rows
 from studyapp.model import calibration
 from studyapp.model.sensors import section_at
 
 BAND = (50.0, 400.0)  # Hz, the bowing verdict's band
+HISS = (2500.0, 16000.0)  # Hz, the bowing verdict's upper band (its top capped at HISS_TOP_FRACTION x rate)
+HISS_TOP_FRACTION = 0.45  # of the rate
 RISE = 2.0  # over TRUE's band level: 6 dB
 PITCH_TOLERANCE = 0.02  # of f0
 BOW_WINDOW = 1.0  # s
@@ -86,13 +107,14 @@ CV_MAX = 0.15
 RELEASE = math.sqrt(2.0)  # bowing: a broken verdict holds until the band falls below this x TRUE's (3 dB)
 CV_RELEASE = 0.25  # holding: ... until the envelope's cv rises above this (or the level falls below VIBRATION_MIN)
 
-# parameter vector: high-pass section (5), long and short smoothing factors, band sections (2 x 5), band smoothing
-MP_HP, MP_LONG, MP_SHORT, MP_BAND, MP_BAND_LONG = 0, 5, 6, 7, 17
-N_PARAMS = 18
+# parameter vector: high-pass section (5), long and short smoothing factors, band sections (2 x 5), band smoothing,
+# upper band sections (3 x 5; zeros where the rate has no upper band)
+MP_HP, MP_LONG, MP_SHORT, MP_BAND, MP_BAND_LONG, MP_HISS = 0, 5, 6, 7, 17, 18
+N_PARAMS = 33
 # state: high-pass (2), long mean of r^2, short mean of r^2, long mean of e, long mean of e^2, band sections (4),
-# band mean square
-MS_HP, MS_MS, MS_ENV_MS, MS_ENV_MEAN, MS_ENV_SQ, MS_BAND, MS_BAND_MS = 0, 2, 3, 4, 5, 6, 10
-N_STATE = 11
+# band mean square, upper band sections (6), upper band mean square
+MS_HP, MS_MS, MS_ENV_MS, MS_ENV_MEAN, MS_ENV_SQ, MS_BAND, MS_BAND_MS, MS_HISS, MS_HISS_MS = 0, 2, 3, 4, 5, 6, 10, 11, 17
+N_STATE = 18
 
 
 def band_sos(rate):
@@ -103,9 +125,45 @@ def band_sos(rate):
 
 def band_level(velocity, rate, start=0):
     """RMS (m/s) of ``velocity`` through the bowing band (causal, from rest), over its samples from ``start`` on."""
-    params = np.concatenate([section_from_sos(row) for row in band_sos(rate)])
-    y = filter_from_rest(params, np.ascontiguousarray(velocity, dtype=np.float64))[int(start):]
+    y = filter_from_rest(_sections(band_sos(rate)), np.ascontiguousarray(velocity, dtype=np.float64))
+    return _rms(y[int(start):])
+
+
+def hiss_band(rate):
+    """The upper band (Hz) at ``rate``: (HISS[0], min(HISS[1], HISS_TOP_FRACTION x rate)), or None if empty."""
+    top = min(HISS[1], HISS_TOP_FRACTION * float(rate))
+    return (HISS[0], top) if top > HISS[0] else None
+
+
+def hiss_sos(rate):
+    """The upper band's filter at ``rate`` (scipy's sos layout, three sections: 4th-order high-pass, 2nd-order
+    low-pass); None where the rate has no upper band."""
+    band = hiss_band(rate)
+    if band is None:
+        return None
+    return np.vstack([sos_rows(4, band[0], rate, "high"), sos_row(2, band[1], rate, "low")])
+
+
+def hiss_level(velocity, rate, start=0):
+    """RMS (m/s) of ``velocity`` through the upper band (causal, from rest) from ``start`` on; None without one."""
+    sos = hiss_sos(rate)
+    if sos is None:
+        return None
+    y = filter_from_rest(_sections(sos), np.ascontiguousarray(velocity, dtype=np.float64))
+    return _rms(y[int(start):])
+
+
+def _sections(sos):
+    return np.concatenate([section_from_sos(row) for row in sos])
+
+
+def _rms(y):
     return float(np.sqrt(np.mean(y * y))) if y.size else 0.0
+
+
+def over(level, reference, factor):
+    """Whether a band's ``level`` is above ``factor`` x TRUE's ``reference`` (no reference, no upper band: False)."""
+    return reference is not None and level is not None and level > factor * reference
 
 
 @njit(cache=True, inline="always")
@@ -124,6 +182,10 @@ def observe(mp, ms, v):
     b = section_at(mp, MP_BAND, ms, MS_BAND, v)
     b = section_at(mp, MP_BAND + 5, ms, MS_BAND + 2, b)
     ms[MS_BAND_MS] += mp[MP_BAND_LONG] * (b * b - ms[MS_BAND_MS])
+    h = section_at(mp, MP_HISS, ms, MS_HISS, v)
+    h = section_at(mp, MP_HISS + 5, ms, MS_HISS + 2, h)
+    h = section_at(mp, MP_HISS + 10, ms, MS_HISS + 4, h)
+    ms[MS_HISS_MS] += mp[MP_BAND_LONG] * (h * h - ms[MS_HISS_MS])
 
 
 @njit(cache=True)
@@ -145,10 +207,12 @@ def verdict(ms):
 
 
 class StabilityMonitor:
-    """``.broken``, ``.score`` (= ``.level``, m/s), ``.cv``, ``.band``; the loop advances ``.state`` per sample.
+    """``.broken``, ``.score`` (= ``.level``, m/s), ``.cv``, ``.band``, ``.hiss``; the loop advances ``.state`` per sample.
 
     ``reference``: None judges as with the hand holding; a callable giving
     TRUE's band level (m/s) now (bowing_reference.py) judges while bowing.
+    ``hiss_reference``: None, or a callable giving TRUE's upper band level
+    (m/s) now, or None where the rate has no upper band; read only while bowing.
     """
 
     def __init__(self, rate, f0=calibration.F0, reference=None):
@@ -158,19 +222,27 @@ class StabilityMonitor:
         self.params[MP_HP:MP_HP + 5] = np.array([hp[0], hp[1], hp[2], hp[4], hp[5]]) / hp[3]
         self.params[MP_LONG] = 1.0 - np.exp(-1.0 / (WINDOW * rate))
         self.params[MP_SHORT] = 1.0 - np.exp(-1.0 / (ENVELOPE * rate))
-        for j, sec in enumerate(band_sos(rate)):
-            self.params[MP_BAND + 5 * j:MP_BAND + 5 * j + 5] = np.array([sec[0], sec[1], sec[2], sec[4], sec[5]]) / sec[3]
+        self._set_sections(MP_BAND, band_sos(rate))
         self.params[MP_BAND_LONG] = 1.0 - np.exp(-1.0 / (BOW_WINDOW * rate))
+        hiss = hiss_sos(rate)
+        if hiss is not None:  # else its sections stay 0: the kernel's upper band then reads 0
+            self._set_sections(MP_HISS, hiss)
         self.state = np.zeros(N_STATE)
         self.reference = reference
+        self.hiss_reference = None
         self.engaged = True  # friction on: F_max x force scale > 0 (the loop sets it)
         self.reset()
+
+    def _set_sections(self, at, sos):
+        for j, sec in enumerate(sos):
+            self.params[at + 5 * j:at + 5 * j + 5] = np.array([sec[0], sec[1], sec[2], sec[4], sec[5]]) / sec[3]
 
     def reset(self):
         self.state[:] = 0.0
         self.level = 0.0
         self.cv = 1.0
         self.band = 0.0
+        self.hiss = 0.0
         self.broken = False
 
     @property
@@ -179,9 +251,11 @@ class StabilityMonitor:
         return self.level if self.reference is None else self.band
 
     def judge(self):
-        """Update ``level``, ``cv``, ``band`` and ``broken`` from the state (the loop calls this after each block)."""
+        """Update ``level``, ``cv``, ``band``, ``hiss`` and ``broken`` from the state (the loop calls this after each
+        block)."""
         self.level, self.cv = verdict(self.state)
         self.band = math.sqrt(max(self.state[MS_BAND_MS], 0.0))
+        self.hiss = math.sqrt(max(self.state[MS_HISS_MS], 0.0))
         if not self.engaged:
             self.broken = False
         elif self.reference is None:
@@ -190,7 +264,10 @@ class StabilityMonitor:
             self.broken = bool(enter or (self.broken and not leave))
         else:
             reference = self.reference()
-            self.broken = bool(self.band > RISE * reference or (self.broken and self.band >= RELEASE * reference))
+            hiss = None if self.hiss_reference is None else self.hiss_reference()
+            enter = self.band > RISE * reference or over(self.hiss, hiss, RISE)
+            stay = self.band >= RELEASE * reference or over(self.hiss, hiss, RELEASE)
+            self.broken = bool(enter or (self.broken and stay))
         return self.broken
 
     def measure(self, velocity):

@@ -12,7 +12,7 @@ import pytest
 from scipy import signal
 
 from studyapp.estimators.biquad import filter_from_rest, section_from_sos
-from studyapp.estimators.butterworth import sos_row
+from studyapp.estimators.butterworth import sos_row, sos_rows
 
 RATES = (1000.0, 5000.0, 44100.0, 48000.0, 96000.0, 1234.5)
 
@@ -47,3 +47,18 @@ def test_filter_from_rest_equals_sosfilt(seed):
                      signal.butter(2, 400.0, "low", fs=5000.0, output="sos")])
     params = np.concatenate([section_from_sos(row) for row in sos])
     np.testing.assert_array_equal(filter_from_rest(params, x), signal.sosfilt(sos, x))
+
+
+@pytest.mark.parametrize("rate", [6000.0, 10000.0, 20000.0, 44100.0, 48000.0, 96000.0])
+@pytest.mark.parametrize("order", [4, 6, 8])
+@pytest.mark.parametrize("btype", ["low", "high"])
+def test_even_orders_equal_scipy_section_for_section(rate, order, btype):
+    """The bowing verdict's 4th-order upper band (stability.hiss_sos): scipy's zpk2sos pairing and order."""
+    for f in (100.0, 2500.0, 0.3 * rate, 0.45 * rate):
+        np.testing.assert_array_equal(sos_rows(order, f, rate, btype), signal.butter(order, f, btype, fs=rate,
+                                                                                     output="sos"))
+
+
+def test_odd_orders_above_two_are_refused():
+    with pytest.raises(ValueError, match="order 3"):
+        sos_rows(3, 100.0, 5000.0)

@@ -11,9 +11,10 @@ import pytest
 from studyapp.cli import main
 from studyapp.model import breakdown
 
-KEYS = ["source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max", "first_seed", "seeds_used"]
+KEYS = ["source", "rate", "gesture", "seeds", "fmax", "fmax_median", "fmax_min", "fmax_max", "first_seed", "seeds_used",
+        "windows"]
 COLUMNS = ["source", "rate", "gesture", "seeds", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed", "first_seed",
-           "seeds_used"]
+           "seeds_used", "windows"]  # issue 30: how Table 1 was made for the rate
 LINK = ["latency", "packet", "jitter"]  # issue 29: the link the device ran behind, after today's keys and columns
 
 
@@ -30,7 +31,7 @@ def test_json_for_one_source_with_progress(capsys):
     assert list(doc) == KEYS + LINK and [doc[k] for k in LINK] == [0.0, 0.0, 0.0]
     # issue 20: breakdown is judged while bowing by default
     assert (doc["source"], doc["rate"], doc["gesture"], doc["seeds"]) == ("LOWPASS", 5000.0, "strokes", 2)
-    assert (doc["first_seed"], doc["seeds_used"]) == (0, [0, 1])
+    assert (doc["first_seed"], doc["seeds_used"], doc["windows"]) == (0, [0, 1], "seconds")
     assert len(doc["fmax"]) == 2 and all(isinstance(v, float) and v > 0 for v in doc["fmax"])
     assert doc["fmax_median"] == pytest.approx(statistics.median(doc["fmax"]))
     assert (doc["fmax_min"], doc["fmax_max"]) == (min(doc["fmax"]), max(doc["fmax"]))
@@ -76,13 +77,13 @@ def test_markdown_is_headed_by_date_and_command(never_broken, tmp_path, capsys):
     lines = out.read_text().splitlines()
     header = next(line for line in lines if line.startswith("Generated on"))
     assert datetime.date.today().isoformat() in header
-    assert (f"`studyapp breakdown --all --rate 5000 --seeds 2 --first-seed 0 --gesture strokes --duration 5 -o {out}`"
-            in header)
+    assert (f"`studyapp breakdown --all --rate 5000 --seeds 2 --first-seed 0 --gesture strokes --duration 5 "
+            f"--windows seconds -o {out}`" in header)
     table = [line for line in lines if line.startswith("|")]
     assert table[0] == "| " + " | ".join(COLUMNS) + " |"
     assert [row.split(" | ")[0].strip("| ") for row in table[2:]] == breakdown.sources()
     assert all("> 200" in row for row in table[2:])
-    assert all(row.endswith(" | 0 | 0; 1 |") for row in table[2:])
+    assert all(row.endswith(" | 0 | 0; 1 | seconds |") for row in table[2:])
 
 
 def test_first_seed_gives_the_same_seeds_the_same_values(tmp_path, capsys):
@@ -104,7 +105,7 @@ def test_first_seed_gives_the_same_seeds_the_same_values(tmp_path, capsys):
     assert [float(v) for v in row["fmax_per_seed"].split(";")] == from_one["fmax"]
     assert main([*common, "--seeds", "2", "--first-seed", "1", "-o", str(out_md)]) == 0
     text = out_md.read_text()
-    assert "--seeds 2 --first-seed 1 --gesture strokes" in text and text.rstrip().endswith(" | 1 | 1; 2 |")
+    assert "--seeds 2 --first-seed 1 --gesture strokes" in text and text.rstrip().endswith(" | 1 | 1; 2 | seconds |")
     err = capsys.readouterr().err
     assert "seed 2/2: F_max" in err and "seed 3/2" not in err  # progress counts the run's seeds
 
@@ -121,6 +122,7 @@ def test_first_seed_gives_the_same_seeds_the_same_values(tmp_path, capsys):
     (["--all", "--rate", "500"], "--rate 500: allowed is a number from 1000 to 96000 Hz"),
     (["--source", "LVT", "--gesture", "wiggle"], "--gesture 'wiggle': allowed are hold, strokes"),
     (["--source", "LVT", "--duration", "0"], "--duration 0.0: allowed is a number of seconds from 0.5 to 60"),
+    (["--source", "LVT", "--windows", "ms"], "--windows 'ms': allowed are seconds, samples"),
     (["--source", "LVT", "--all"], "not allowed with argument"),
     (["--source", "LVT", "--latency", "-0.001"], "--latency -0.001: allowed is a number of seconds from 0 to 1"),
     (["--source", "LVT", "--packet", "2"], "--packet 2.0: allowed is a number of seconds from 0 to 1"),
