@@ -60,7 +60,9 @@ def breakdown_generators(text=None):
         words = shlex.split(command)
         gesture = words[words.index("--gesture") + 1] if "--gesture" in words else "strokes"
         rate = words[words.index("--rate") + 1] if "--rate" in words else "5000"
-        name = f"breakdown-{gesture}" + ("" if float(rate) == 5000.0 else f"-{float(rate) / 1000:g}k")
+        windows = words[words.index("--windows") + 1] if "--windows" in words else "seconds"
+        name = (f"breakdown-{gesture}" + ("" if float(rate) == 5000.0 else f"-{float(rate) / 1000:g}k")
+                + ("-samples" if windows == "samples" else ""))
         out = words.index("-o") + 1 if "-o" in words else None
         if out is None:
             words += ["-o", f"{{out}}/{name}.md"]
