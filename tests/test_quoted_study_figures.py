@@ -2,7 +2,7 @@
 
 The study (docs/evaluation.md, "Against the paper: Table 1 and the findings")
 is four commands: ``simulate-set`` (train and validation), ``optimise``
-(seed 0), ``evaluate --compare-paper``; docs/study/ keeps the tuned
+(seed 0, the first of ``make figures ONLY=study``'s three), ``evaluate --compare-paper``; docs/study/ keeps the tuned
 params.toml and the two CSVs, and docs/evaluation.md prints the CSVs as
 Markdown by the script it shows. The normal suite checks that chain's cheap
 links: ``paper_comparison.csv``'s ``ours`` is params.toml's value, and each
@@ -23,8 +23,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = ROOT / "docs" / "study"
-STALE = pytest.mark.xfail(strict=True, raises=AssertionError, reason="docs/study is of the code of 2026-11-25 (the world changed since; "
-                                               "issue 30 item 5 regenerates it): remove this marker then")
 
 
 def rows(name):
@@ -54,7 +52,7 @@ def test_ours_in_paper_comparison_is_the_tuned_params():
 
 def test_evaluation_md_prints_the_csvs_as_its_script_does():
     text = (ROOT / "docs" / "evaluation.md").read_text()
-    section = text[text.index("**Run of 2026-11-25**"):text.index("**Run of 2026-11-23**")]
+    section = text[text.index("**Run of 2026-11-27**"):text.index("**Run of 2026-11-25**")]
     for name in ("paper_comparison.csv", "findings.csv"):
         header, *body = rows(name)
         assert "| " + " | ".join(header) + " |" in section, name
@@ -68,7 +66,6 @@ def simulate_set(folder, *extra):
 
 
 @pytest.mark.slow
-@STALE
 def test_the_data_set_is_the_one_params_was_tuned_on(tmp_path):
     simulate_set(tmp_path / "train")
     provenance = params()["provenance"]
@@ -78,7 +75,6 @@ def test_the_data_set_is_the_one_params_was_tuned_on(tmp_path):
 
 
 @pytest.mark.slow
-@STALE
 def test_evaluate_of_the_tuned_params_gives_the_quoted_findings(tmp_path):
     simulate_set(tmp_path / "train")
     simulate_set(tmp_path / "valid", "--validation")
