@@ -81,7 +81,7 @@ def test_report_matches_the_metric_and_lowpass_is_100_percent():
     doc = result.to_json()
     assert set(doc) >= {"estimators", "ranking"}
     assert set(doc["estimators"]["BDIFF"]) == {"error", "delay", "error_pct_lowpass", "delay_pct_lowpass",
-                                               "objective"}
+                                               "delay_subsample", "delay_subsample_pct_lowpass", "objective"}
     assert result.group_mask("b").tolist() == [False, True, True]
 
 
