@@ -121,7 +121,7 @@ class Engine(Watchdog):
         self._events = EventRing.create()
         self.guard = ctx.Process(
             target=guard.main, name="studyapp-guard", daemon=True,
-            args=(self.status_block.name, c.hang_timeout, REALTIME_PRIORITY + 1 if c.realtime else None),
+            args=(self.status_block.name, c.hang_timeout, REALTIME_PRIORITY + 1 if c.realtime else None, self.ring.spec),
         )
         self.guard.start()
         self.process = ctx.Process(

@@ -16,7 +16,12 @@ Every ``POLL`` seconds it
    heartbeat is older than ``hang_timeout``, it clears ``force_enable``
    (reason "watchdog", the silence, and the moment, ``force_off_time``).
 
-3. looks at its owner, the process that started the engine (the console, ``live``):
+3. withholds the force of the block the worker has staged in the telemetry
+   ring (``Ring.withhold``) whenever it sees ``force_enable`` go from set to
+   cleared, whoever cleared it: a worker stopped after its last read of the
+   word and before its commit would otherwise publish that block's force on
+   SIGCONT, after the trip (engine/safety.py);
+4. looks at its owner, the process that started the engine (the console, ``live``):
    when the owner is stopped (SIGSTOP, Ctrl-Z, a debugger: ``/proc/<pid>/stat``
    state ``T`` or ``t``) or gone (a SIGKILL pending, exiting, or the guard's parent
    no longer it: a killed process of a few hundred MB takes 50-360 ms to die), it
@@ -38,7 +43,9 @@ import os
 import signal
 import time
 
+from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
+from studyapp.engine.telemetry import WITHHELD
 
 POLL = 0.002  # s between rounds
 WATCHED = "running"  # the worker's state in which its heartbeat must keep coming
@@ -48,18 +55,22 @@ PF_EXITING = 0x4  # /proc/<pid>/stat field 9 (flags): the process has begun to e
 SIGKILL_BIT = 1 << (signal.SIGKILL - 1)  # /proc/<pid>/stat field 31: its pending signals
 
 
-def main(status_name, hang_timeout, priority=None):
-    """Entry point of the guard process (spawned by ``Engine.start``); ``priority``: SCHED_FIFO's, or None."""
+def main(status_name, hang_timeout, priority=None, ring_spec=None):
+    """Entry point of the guard process (spawned by ``Engine.start``); ``priority``: SCHED_FIFO's, or None;
+    ``ring_spec``: the worker's telemetry ring."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     parent = os.getppid()
     if priority is not None:  # None: the engine runs without real-time priority, and so does its guard
         _try_realtime(priority)
     status = StatusBlock.attach(status_name)
+    ring = Ring.attach(ring_spec) if ring_spec is not None else None
     owner = Owner(parent)
     try:
-        watch(status, hang_timeout, owner.state)
+        watch(status, hang_timeout, owner.state, ring=ring)
     finally:
         owner.close()
+        if ring is not None:
+            ring.close()
         status.close()
 
 
@@ -94,8 +105,10 @@ class Owner:
             self._stat = None
 
 
-def watch(status, hang_timeout, owner=lambda: ALIVE, rounds=None):
-    """The guard's loop (``owner``: the owner's state now; ``rounds``: stop after that many, for tests)."""
+def watch(status, hang_timeout, owner=lambda: ALIVE, rounds=None, ring=None):
+    """The guard's loop (``owner``: the owner's state now; ``rounds``: stop after that many, for tests;
+    ``ring``: the telemetry ring whose staged block loses its force when the force goes off)."""
+    enabled = status.force_enable
     while rounds is None or rounds > 0:
         if rounds is not None:
             rounds -= 1
@@ -110,6 +123,9 @@ def watch(status, hang_timeout, owner=lambda: ALIVE, rounds=None):
         silence = now - heartbeat
         if state == WATCHED and silence > hang_timeout and status.force_enable:
             status.disable_force("watchdog", silence)
+        was_enabled, enabled = enabled, status.force_enable
+        if was_enabled and not enabled and ring is not None:
+            ring.withhold(WITHHELD)
         time.sleep(POLL)
 
 

@@ -10,7 +10,11 @@ Layout of the shared memory::
     float64[channels, capacity]   data; sample number n of channel c is at [c, n % capacity]
 
 Writing a block of m samples (a seqlock for rings): raise ``started`` to the new
-total, write the samples, raise ``committed`` to the same total. Reading samples
+total, write the samples (``stage``), raise ``committed`` to the same total
+(``commit``). Between the two the block is *staged*: written, not yet readable.
+``withhold`` zeroes channels of a staged block from any process; the force
+guard uses it so that a block staged before a trip, by a worker stopped before
+its commit, is committed with its force withheld (engine/guard.py). Reading samples
 [a, b): take ``b <= committed`` before copying, copy, then read ``started``
 again. The slots being overwritten at any moment hold samples older than
 ``started - capacity``, so the copy is intact exactly when ``a >= started -
@@ -98,6 +102,11 @@ class Ring:
 
     def write(self, block):
         """Append a block: a ``(channels, m)`` array, or a dict ``{channel: m samples}`` naming all channels."""
+        self.stage(block)
+        self.commit()
+
+    def stage(self, block):
+        """Write a block without making it readable yet (``commit`` does); arguments as ``write``."""
         if isinstance(block, dict):
             block = np.stack([np.asarray(block[c], dtype=np.float64) for c in self.channels])
         m = block.shape[1]
@@ -112,7 +121,23 @@ class Ring:
         split = min(m, self.capacity - first)
         self._data[:, first:first + split] = block[:, :split]
         self._data[:, :m - split] = block[:, split:]
-        self._header[_COMMITTED] = end
+
+    def commit(self):
+        """Make the staged block readable."""
+        self._header[_COMMITTED] = self._header[_STARTED]
+
+    def withhold(self, channels):
+        """Zero ``channels`` (names) of the staged block, if one is staged; returns the samples zeroed."""
+        start, end = int(self._header[_COMMITTED]), int(self._header[_STARTED])
+        m = min(end - start, self.capacity)
+        if m <= 0:
+            return 0
+        first = start % self.capacity
+        split = min(m, self.capacity - first)
+        rows = [self._index[c] for c in channels]
+        self._data[rows, first:first + split] = 0.0
+        self._data[rows, :m - split] = 0.0
+        return m
 
     def _copy(self, a, b):
         first = a % self.capacity

@@ -19,10 +19,12 @@ Three layers keep a fault from leaving the device pushing:
    ``clear()`` (an experimenter's decision, never automatic). The word is read
    twice per block: before the block runs (``before_block``), so a worker
    that was stopped or starved while the watchdog tripped computes its next
-   block with zero force from the first sample; and after it ran, before its
-   force is written (``check``), so a block in flight across the trip has its
-   force withheld (set to 0) instead of written. After a trip not one sample
-   of non-zero force leaves the worker, SIGCONT or not.
+   block with zero force from the first sample; and after its telemetry is
+   staged in the ring, just before the commit (``check``), so a block in
+   flight across the trip has its force withheld (set to 0) instead of
+   written. A worker stopped between that read and the commit leaves its
+   block staged, and the force guard withholds it (engine/guard.py). After a
+   trip not one sample of non-zero force leaves the worker, SIGCONT or not.
 3. Runaway. A sample is *suspect* when the motor is saturated (|F| >=
    ``saturation`` x the device's sustained limit, 60 N for the TGR) or the
    handle moves faster than ``velocity_bound``. When suspect samples fill at

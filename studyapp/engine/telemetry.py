@@ -16,6 +16,7 @@ CHANNELS = (
     "t", "position", "velocity_lvt", "velocity_true", "source_velocity", "string_velocity",
     "force", "fmax", "force_scale", "friction", "broken", "stability_score", "trial", "trial_clock",
 )
+WITHHELD = ("force", "force_scale")  # the channels zeroed in a block whose force is withheld (engine/safety.py)
 # rows with one value per block, and the rest, copied from the loop's output
 _FMAX, _FORCE_SCALE, _BROKEN, _SCORE, _TRIAL, _CLOCK = (
     CHANNELS.index(c) for c in ("fmax", "force_scale", "broken", "stability_score", "trial", "trial_clock"))

@@ -64,7 +64,7 @@ from studyapp.engine.ring import Ring
 from studyapp.engine.safety import Safety
 from studyapp.engine.status import StatusBlock
 from studyapp.engine.supervision import GuardWatch
-from studyapp.engine.telemetry import Rows, channels_for
+from studyapp.engine.telemetry import WITHHELD, Rows, channels_for
 from studyapp.model.controls import as_actions
 
 REALTIME_PRIORITY = 5  # below JACK's own threads (10 and 9 by default)
@@ -283,13 +283,18 @@ class Worker(ControlRouting):
             self.link.before_block(enabled, self.status.force_off_reason)
         bowing = self.loop.bowing
         out = self.loop.run(self.block)
-        enabled, why = self.guard.force()
-        self.safety.check(out, force_enable=enabled, why=why)
         if self.sink.render:
             # the bow as it was for this block (a fault lifts it): silence while it is off the string
             self.sink.push(out["audio"], sounding=bowing and self.loop.fault is None, cut=self.cut)
         self.cut = False
-        self.ring.write(self._rows.fill(out, self.loop, self.trial, self.trial_start))
+        self.ring.stage(self._rows.fill(out, self.loop, self.trial, self.trial_start))
+        # Read the word after staging, just before the commit: a trip before this read withholds the
+        # block's force here; one after it finds the block staged, and the guard withholds it (guard.py).
+        enabled, why = self.guard.force()
+        self.safety.check(out, force_enable=enabled, why=why)
+        if not enabled:
+            self.ring.withhold(WITHHELD)
+        self.ring.commit()
         finished = time.monotonic()
         cpu = time.thread_time() - cpu_started
         self.k += 1

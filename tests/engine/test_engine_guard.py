@@ -9,6 +9,7 @@ goes silent. The times are measured by ``studyapp bench force-cut``.
 import ctypes
 import os
 import signal
+import threading
 import time
 
 import numpy as np
@@ -16,6 +17,7 @@ import numpy as np
 from studyapp.engine import guard
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.engine import Engine
+from studyapp.engine.ring import Ring
 from studyapp.engine.status import NUMBERS, StatusBlock
 from tests.engine.waiting import wait_for
 
@@ -44,6 +46,49 @@ def test_the_guard_clears_the_word_for_a_silent_running_worker_only():
         assert not status.force_enable and status.force_off_reason == "watchdog"
         assert status.force_off_silence > 4.0 and status.force_off_time > 0
     finally:
+        status.close()
+
+
+def test_when_the_force_goes_off_the_guard_withholds_the_block_a_stopped_worker_left_staged():
+    # issue 31: a worker stopped after its last read of the word and before its commit published its
+    # block's force on SIGCONT, 10 samples after the trip (test_engine_live_faults.py, 1 run in ~4)
+    status = StatusBlock.create()
+    ring = Ring.create(["t", "force", "force_scale"], capacity=100)
+    block = {"t": np.arange(10.0), "force": np.full(10, -1.9), "force_scale": np.ones(10)}
+    try:
+        status.set(state="running", heartbeat=time.monotonic())
+        status.publish()
+        guard.watch(status, hang_timeout=10.0, rounds=1, ring=ring)
+        ring.stage(block)  # staged, then stopped before the commit
+        guard.watch(status, hang_timeout=10.0, rounds=2, ring=ring)
+        assert status.force_enable and np.all(ring._data[1, :10] == -1.9)  # no trip: nothing withheld
+        time.sleep(0.03)
+        guard.watch(status, hang_timeout=0.02, rounds=1, ring=ring)  # the trip
+        ring.commit()  # SIGCONT
+        data, _, _ = ring.read_since(0)
+        assert not status.force_enable and np.all(data[1] == 0.0) and np.all(data[2] == 0.0)
+        np.testing.assert_array_equal(data[0], np.arange(10.0))
+        # the emergency stop clears the word from the parent: the guard withholds at that change too
+        status.force_enable = True  # the experimenter's Resume
+        status.set(heartbeat=time.monotonic() + 60.0)
+        status.publish()
+        watching = threading.Thread(target=guard.watch, args=(status, 10.0), kwargs={"ring": ring})
+        watching.start()
+        try:
+            ring.stage(block)
+            status.disable_force("operator")
+            wait_for(lambda: np.all(ring._data[1, 10:20] == 0.0), timeout=5.0)
+            ring.commit()
+            # once: a block staged while the force stays off is the worker's to withhold, not the guard's
+            ring.stage(block)
+            time.sleep(20 * guard.POLL)
+            assert np.all(ring._data[1, 20:30] == -1.9)
+        finally:
+            status.set(state="stopped")
+            status.publish()
+            watching.join(5.0)
+    finally:
+        ring.close()
         status.close()
 
 

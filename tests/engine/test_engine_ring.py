@@ -34,6 +34,27 @@ def test_ring_round_trip_across_the_wrap():
         ring.close()
 
 
+def test_a_staged_block_is_unread_until_committed_and_withhold_zeroes_only_it_across_the_wrap():
+    ring = Ring.create(["force", "force_scale", "t"], capacity=10)
+    try:
+        assert ring.withhold(["force"]) == 0  # nothing staged: nothing zeroed
+        ring.write({"force": np.full(7, 2.0), "force_scale": np.ones(7), "t": np.arange(7.0)})
+        ring.stage({"force": np.full(6, 3.0), "force_scale": np.ones(6), "t": np.arange(7.0, 13.0)})
+        data, _, end = ring.read_since(0)
+        assert end == ring.committed == 7 and np.all(data[0] == 2.0)
+        assert ring.withhold(["force", "force_scale"]) == 6
+        ring.commit()
+        data, first, end = ring.read_since(7)
+        assert (first, end) == (7, 13)
+        np.testing.assert_array_equal(data[0], 0.0)
+        np.testing.assert_array_equal(data[1], 0.0)
+        np.testing.assert_array_equal(data[2], np.arange(7.0, 13.0))  # the other channels stand
+        np.testing.assert_array_equal(ring.read_latest(10)[0][0][:4], 2.0)  # committed samples untouched
+        assert ring.withhold(["force"]) == 0
+    finally:
+        ring.close()
+
+
 def test_ring_reader_that_fell_behind_is_told_what_it_lost():
     ring = Ring.create(["a"], capacity=8)
     try:
