@@ -70,9 +70,10 @@ class RigPrediction(QObject):
     finished = Signal(object, object)  # request, prediction
     failed = Signal(str)
 
-    def __init__(self, predict=rig_check.predict, parent=None):
+    def __init__(self, predict=rig_check.predict, parent=None, pool=None):
         super().__init__(parent)
         self.predict = predict
+        self.pool = pool or QThreadPool.globalInstance()  # the application's, which it waits for at exit
         self.cache = rig_check.PredictionCache()
         self.current = None  # the request being shown
         self._running = {}  # key -> request, while its job runs
@@ -98,7 +99,7 @@ class RigPrediction(QObject):
             self.finished.emit(req, kept)
         elif req.key not in self._running:
             self._running[req.key] = req
-            QThreadPool.globalInstance().start(_Job(req, self.predict, self._signals, self._cancelled))
+            self.pool.start(_Job(req, self.predict, self._signals, self._cancelled))
 
     def cancel(self):
         """Stop every running job at its next progress report (the console closes: the pool waits for its jobs)."""
