@@ -66,6 +66,7 @@ from studyapp.live.states import REST, TRANSITIONS, State
 from studyapp.live.trial_media import TrialMedia
 
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
+CLEAR_TIMEOUT = 5.0  # s a cleared stop may wait for the worker's word that it cleared; then the stop holds again
 
 
 def instructions_for(protocol, task):
@@ -98,6 +99,7 @@ class SessionController:
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
         self.devices = Devices(self)  # the device: its choice, its records, the rig it makes
         self._next_status = 0.0
+        self._clearing_since = 0.0  # the controller's clock when the last clear began
 
     # the state machine (states.py) --------------------------------------------------------------
     def fire(self, event):
@@ -109,6 +111,8 @@ class SessionController:
         return True
 
     def _set_state(self, state):
+        if state == State.CLEARING and self.state != State.CLEARING:
+            self._clearing_since = self.clock()
         self.state = State(state)
         self.events.state.emit(state=self.state)
 
@@ -410,6 +414,12 @@ class SessionController:
                 self.events.selection.emit(source=status["source"], fmax=status["fmax"])
         if clearing and not status["fault_latched"] and engine.status_block.force_enable:
             self.fire("cleared")
+        elif clearing and now - self._clearing_since > CLEAR_TIMEOUT:
+            # never "Clearing" for good (a full CI run at load 6 once stayed there for minutes): the stop holds
+            self.message(f"the engine did not confirm the clear within {CLEAR_TIMEOUT:g} s (fault latched: "
+                         f"{bool(status['fault_latched'])}, force enabled: {bool(engine.status_block.force_enable)}); "
+                         "the emergency stop holds: press Resume again, or restart the engine", level="error")
+            self.fire("clear_timeout")
 
     def message(self, text, level="info", topic=""):
         self.events.message.emit(text=str(text), level=level, topic=topic)

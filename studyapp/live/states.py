@@ -7,6 +7,7 @@
     RUNNING / PAUSED  --engine_failed-->  ENGINE_LOST  --restart-->  RESTARTING
     RESTARTING  --engine_up-->  RUNNING (the trial again)   --engine_failed-->  ENGINE_LOST
     any  --emergency-->  EMERGENCY  --clear-->  CLEARING  --cleared-->  RUNNING (the trial again) or rest
+                                                  CLEARING  --clear_timeout-->  EMERGENCY (the stop holds again)
 
 ``TRANSITIONS`` maps (state, event) to a function of the controller
 (``controller.SessionController``) that acts and returns the next state; an
@@ -259,5 +260,6 @@ TRANSITIONS = _table(
     ((State.EMERGENCY,), "engine_up", hold_new_engine),
     ((State.EMERGENCY,), "clear", clear),
     ((State.CLEARING,), "cleared", cleared),
+    ((State.CLEARING,), "clear_timeout", emergency),
     ((State.CLEARING,), "engine_failed", clear_failed),
 )

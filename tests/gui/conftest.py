@@ -97,10 +97,13 @@ def idle_console(console, qapp):
     c = console.controller
     if c.in_session:
         console.abort_session()
-    if c.emergency:
-        c.clear_emergency()
+    def settled():
+        if c.emergency:  # again after a clear the engine never confirmed (CLEAR_TIMEOUT gives the stop back)
+            c.clear_emergency()
+        return c.engine is not None and c.state in ("idle", "finished", "aborted")
+
     try:
-        wait_until(qapp, lambda: c.engine is not None and c.state in ("idle", "finished", "aborted"), ENGINE_START)
+        wait_until(qapp, settled, ENGINE_START)
     except AssertionError as e:  # say what the console was doing (a full CI run once timed out here, 3 times)
         raise AssertionError(f"{e}: state {c.state!r}, engine {c.engine!r}; console log: "
                              f"{console.log.toPlainText()[-1500:]}") from None

@@ -8,7 +8,7 @@ import pytest
 from studyapp.engine import commands as cmd
 from studyapp.experiment.session_log import read_events
 from studyapp.model.fmax_knob import fmax_from_knob
-from studyapp.live.controller import TRANSITIONS, SessionController, State
+from studyapp.live.controller import CLEAR_TIMEOUT, TRANSITIONS, SessionController, State
 from tests.live.fakes import LATENCY, FakeHost
 
 PROTOCOL = """
@@ -58,6 +58,7 @@ EXPECTED = {
     (S.EMERGENCY, "engine_up"): S.EMERGENCY,
     (S.EMERGENCY, "clear"): S.CLEARING,
     (S.CLEARING, "cleared"): S.RUNNING,
+    (S.CLEARING, "clear_timeout"): S.EMERGENCY,  # the worker never confirmed: the stop holds again
     (S.CLEARING, "engine_failed"): S.ENGINE_LOST,
 }
 
@@ -161,9 +162,42 @@ def take(c, state, event):
     elif event == "cleared":
         c.host.engine.latched = False
         c.poll()
+    elif event == "clear_timeout":
+        c.host.engine.latched = True  # the worker never confirms the clear
+        started = c.clock()
+        c.clock = lambda: started + CLEAR_TIMEOUT + 1.0  # still latched, past the wait
+        c.poll()
     else:
         {"abort": c.abort, "pause": c.pause, "resume": c.resume, "emergency": c.emergency_stop,
          "clear": c.clear_emergency, "restart": c.restart_engine, "done": lambda: c.fire("done")}[event]()
+
+
+def test_a_clear_the_worker_never_confirms_gives_the_stop_back_instead_of_clearing_for_good(controller):
+    # a full CI run at load 6 (2026-11-27) left the console "Clearing the emergency stop…" for minutes
+    c = controller
+    now = [100.0]
+    c.clock = lambda: now[0]
+    messages = []
+    c.events.message.connect(lambda text, level, topic: messages.append((level, text)))
+    start(c)
+    up(c)
+    engine = c.host.engine
+    c.emergency_stop()
+    c.clear_emergency()
+    engine.latched = True  # the worker's fault stays latched (the clear lost, or latched again)
+    now[0] += CLEAR_TIMEOUT - 0.1
+    c.poll()
+    assert c.state == S.CLEARING and engine.status_block.force_enable
+    now[0] += 0.2
+    c.poll()
+    assert c.state == S.EMERGENCY and engine.status_block.force_enable is False
+    assert any(level == "error" and "did not confirm the clear" in text and "fault latched: True" in text
+               for level, text in messages)
+    assert [e["type"] for e in log(c)].count("emergency_stop") == 2  # the stop holds again, logged
+    engine.latched = False  # Resume again: this time the worker confirms
+    c.clear_emergency()
+    c.poll()
+    assert c.state == S.RUNNING
 
 
 def reach_emergency_while_starting(c):
