@@ -415,7 +415,7 @@ class SessionController:
         if clearing and not status["fault_latched"] and engine.status_block.force_enable:
             self.fire("cleared")
         elif clearing and now - self._clearing_since > CLEAR_TIMEOUT:
-            # never "Clearing" for good (a full CI run at load 6 once stayed there for minutes): the stop holds
+            # never "Clearing" for good (a worker whose loop latched its own fault refuses the clear): the stop holds
             self.message(f"the engine did not confirm the clear within {CLEAR_TIMEOUT:g} s (fault latched: "
                          f"{bool(status['fault_latched'])}, force enabled: {bool(engine.status_block.force_enable)}); "
                          "the emergency stop holds: press Resume again, or restart the engine", level="error")

@@ -95,6 +95,7 @@ def console(qapp):
 def idle_console(console, qapp):
     """The shared console, its preview engine running, no session, no emergency stop, bow lifted."""
     c = console.controller
+    assert console.timer.isActive(), "a test left the shared console without its poll"
     if c.in_session:
         console.abort_session()
     def settled():

@@ -173,7 +173,7 @@ def take(c, state, event):
 
 
 def test_a_clear_the_worker_never_confirms_gives_the_stop_back_instead_of_clearing_for_good(controller):
-    # a full CI run at load 6 (2026-11-27) left the console "Clearing the emergency stop…" for minutes
+    # on main a worker that refused the clear (its loop latched its own fault) left the console Clearing for good
     c = controller
     now = [100.0]
     c.clock = lambda: now[0]
