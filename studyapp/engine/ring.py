@@ -117,10 +117,9 @@ class Ring:
             m = self.capacity
         end = start + m
         self._header[_STARTED] = end
-        first = start % self.capacity
-        split = min(m, self.capacity - first)
-        self._data[:, first:first + split] = block[:, :split]
-        self._data[:, :m - split] = block[:, split:]
+        head, tail, split = self._spans(start, m)
+        self._data[:, head] = block[:, :split]
+        self._data[:, tail] = block[:, split:]
 
     def commit(self):
         """Make the staged block readable."""
@@ -132,20 +131,23 @@ class Ring:
         m = min(end - start, self.capacity)
         if m <= 0:
             return 0
-        first = start % self.capacity
-        split = min(m, self.capacity - first)
+        head, tail, _ = self._spans(start, m)
         rows = [self._index[c] for c in channels]
-        self._data[rows, first:first + split] = 0.0
-        self._data[rows, :m - split] = 0.0
+        self._data[rows, head] = 0.0
+        self._data[rows, tail] = 0.0
         return m
 
+    def _spans(self, start, m):
+        """The slots of samples [start, start + m): (slice to the end of the data, slice from its start, split)."""
+        first = start % self.capacity
+        split = min(m, self.capacity - first)
+        return slice(first, first + split), slice(0, m - split), split
+
     def _copy(self, a, b):
-        first = a % self.capacity
-        n = b - a
-        split = min(n, self.capacity - first)
-        out = np.empty((len(self.channels), n))
-        out[:, :split] = self._data[:, first:first + split]
-        out[:, split:] = self._data[:, :n - split]
+        head, tail, split = self._spans(a, b - a)
+        out = np.empty((len(self.channels), b - a))
+        out[:, :split] = self._data[:, head]
+        out[:, split:] = self._data[:, tail]
         return out
 
     def read_since(self, position, limit=None, retries=8):
