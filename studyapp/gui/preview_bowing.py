@@ -21,11 +21,12 @@ PREVIEW_FMAX = 1.0  # N, the rating task's F_max
 
 
 class PreviewBowing:
-    def __init__(self, console, settle=1.5, timeout=120.0, clock=time.monotonic):
+    def __init__(self, console, settle=1.5, timeout=240.0, clock=time.monotonic):
         self.console = console
         self.settle = float(settle)
         self.clock = clock
-        self.deadline = clock() + float(timeout)
+        self.timeout = float(timeout)
+        self.deadline = clock() + self.timeout
         self.bowing_since = None
         self.timer = QTimer(console)
         self.timer.setInterval(50)
@@ -45,7 +46,7 @@ class PreviewBowing:
             self.fail(f"the engine failed: {host.error or 'its worker stopped'}")
             return
         if self.clock() > self.deadline:
-            self.fail(f"the engine is {state} after {self.deadline:g} s")
+            self.fail(f"the engine is {state} {self.timeout:g} s after the console opened: {self._waiting(state)}")
             return
         if state != "running" or not self.console.knobs.isEnabled():
             return
@@ -61,6 +62,15 @@ class PreviewBowing:
             return
         self.timer.stop()
         self.ready()
+
+    def _waiting(self, state):
+        """What the check still waits for, for the timeout's line."""
+        if state != "running":
+            return "it never ran"
+        if not self.console.knobs.isEnabled():
+            return "the knobs were never enabled"
+        need = self.settle * self.console.controller.host.config.rate
+        return f"the scope holds {self.console.scope.samples} of the {need:.0f} samples of bowing it waits for"
 
     def ready(self):
         raise NotImplementedError

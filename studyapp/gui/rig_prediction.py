@@ -1,4 +1,4 @@
-"""The rig check's prediction off the GUI thread: a ``QRunnable`` on the global ``QThreadPool``.
+"""The rig check's prediction off the GUI thread: a ``QRunnable`` on a ``QThreadPool`` of its own.
 
 ``RigPrediction.run(req)`` returns at once: a cached result (rig_check.PredictionCache,
 per protocol hash, latency, packet and rate) is announced straight away,
@@ -6,11 +6,16 @@ else the prediction (``predict(req, progress=...)``, 20-25 s of one core for
 nine conditions over 5 seeds) runs on a pool thread at the lowest CPU
 priority (the engine's worker and the GUI come first), reporting
 ``progress(done, total, condition)`` and then ``finished(key, prediction)``
-through queued signals, so the views are touched on the GUI thread only. A
-result for a request no longer current (another protocol or device chosen
-meanwhile) is cached but not shown. ``cancel()`` (the console closing) stops
-the jobs at their next progress report: the application waits for its pool's
-jobs at exit.
+through queued signals, so the views are touched on the GUI thread only.
+
+One job runs at a time, on a pool of this object's own: another console's
+predictions (a second window, the tests' consoles) never hold it. A request
+that stops being current (another protocol or device chosen) has its job
+stopped at its next progress report, or as it starts if it was still queued:
+at the lowest priority on a busy machine, a stale job left to finish would
+hold the thread for minutes. ``cancel()`` (the console closing) stops every
+job the same way; the pool, a child of this object, waits for its running job
+when it is destroyed.
 """
 
 import os
@@ -28,7 +33,7 @@ class _Signals(QObject):
 
 
 class _Gone(Exception):
-    """The console closed: the job stops at its next progress report."""
+    """The job was cancelled: it stops at its next progress report."""
 
 
 class _Job(QRunnable):
@@ -37,7 +42,7 @@ class _Job(QRunnable):
         self.req, self.predict, self.signals, self.cancelled = req, predict, signals, cancelled
 
     def _emit(self, name, *args):
-        """Tell the GUI thread; False once the receiver is gone (the console closed)."""
+        """Tell the GUI thread; False once the job is cancelled or the receiver is gone (the console closed)."""
         if self.cancelled.is_set():
             return False
         try:
@@ -51,6 +56,8 @@ class _Job(QRunnable):
             raise _Gone
 
     def run(self):
+        if self.cancelled.is_set():  # stopped while it waited in the queue
+            return
         try:  # this thread only: Linux schedules threads as tasks
             os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
         except (OSError, AttributeError):
@@ -73,11 +80,13 @@ class RigPrediction(QObject):
     def __init__(self, predict=rig_check.predict, parent=None, pool=None):
         super().__init__(parent)
         self.predict = predict
-        self.pool = pool or QThreadPool.globalInstance()  # the application's, which it waits for at exit
+        if pool is None:
+            pool = QThreadPool(self)
+            pool.setMaxThreadCount(1)
+        self.pool = pool
         self.cache = rig_check.PredictionCache()
         self.current = None  # the request being shown
-        self._running = {}  # key -> request, while its job runs
-        self._cancelled = threading.Event()
+        self._running = {}  # key -> (request, its cancel event), while its job is queued or runs
         self._signals = _Signals()
         self._signals.progress.connect(self._progress)
         self._signals.finished.connect(self._finished)
@@ -92,25 +101,34 @@ class RigPrediction(QObject):
 
     def run(self, req):
         self.current = req
+        self._stop(keep=None if req is None else req.key)
         if req is None:
             return
         kept = self.cache.get(req)
         if kept is not None:
             self.finished.emit(req, kept)
         elif req.key not in self._running:
-            self._running[req.key] = req
-            self.pool.start(_Job(req, self.predict, self._signals, self._cancelled))
+            cancelled = threading.Event()
+            self._running[req.key] = (req, cancelled)
+            self.pool.start(_Job(req, self.predict, self._signals, cancelled))
 
     def cancel(self):
-        """Stop every running job at its next progress report (the console closes: the pool waits for its jobs)."""
-        self._cancelled.set()
+        """Stop every job: a queued one as it starts, a running one at its next progress report."""
+        self.current = None
+        self._stop(keep=None)
+
+    def _stop(self, keep):
+        for key in [k for k in self._running if k != keep]:
+            self._running.pop(key)[1].set()
 
     def _progress(self, key, done, total, name):
         if self.current is not None and key == self.current.key:
             self.progress.emit(done, total, name)
 
     def _finished(self, key, prediction):
-        req = self._running.pop(key)
+        if key not in self._running:  # stopped just after it finished: not current any more
+            return
+        req, _ = self._running.pop(key)
         self.cache.put(req, prediction)
         if self.current is not None and key == self.current.key:
             self.finished.emit(req, prediction)

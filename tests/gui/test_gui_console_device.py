@@ -115,32 +115,83 @@ def test_a_simulated_rig_starts_without_a_question(device_console, qapp, monkeyp
                                                                                    "latency_ms": 0.0}
 
 
-def test_a_running_prediction_stops_when_cancelled(qapp):
-    """The console cancels its prediction when it closes: the application's pool would otherwise wait for it."""
-    import threading
+def _endless(ended, started=None):
     import time
 
-    from PySide6.QtCore import QThreadPool
-
-    from studyapp.gui.rig_prediction import RigPrediction
-    from studyapp.live import rig_check
-
-    ended = threading.Event()
-
     def endless(req, progress=None):
+        if started is not None:
+            started.set()
         try:
             while True:
                 progress(0, 1, "LVT")
                 time.sleep(0.01)
         finally:
             ended.set()
+    return endless
 
-    # a pool of its own: the application's may still hold other tests' consoles' predictions, which under
-    # load (the lowest CPU priority beside two busy processes) reach their next check minutes later
-    pool = QThreadPool()
-    prediction = RigPrediction(endless, pool=pool)
-    req = rig_check.Request(("LVT",), {}, rig_check.Rig("link", 5000.0, 5), "hash")
-    prediction.run(req)
-    assert prediction.busy
+
+def _request(latency):
+    from studyapp.live import rig_check
+
+    return rig_check.Request(("LVT",), {}, rig_check.Rig("link", 5000.0, latency), "hash")
+
+
+def test_a_running_prediction_stops_when_cancelled(qapp):
+    """The console cancels its prediction when it closes: its pool would otherwise wait for it."""
+    from studyapp.gui.rig_prediction import RigPrediction
+
+    ended, started = threading.Event(), threading.Event()
+    prediction = RigPrediction(_endless(ended, started))
+    prediction.run(_request(5))
+    assert prediction.busy and started.wait(60.0)
     prediction.cancel()
-    assert ended.wait(60.0) and pool.waitForDone(60_000)
+    assert ended.wait(60.0) and prediction.pool.waitForDone(60_000)
+    assert not prediction.busy
+
+
+def test_a_request_no_longer_current_stops_its_job_and_a_queued_one_never_runs(qapp):
+    """Another device chosen while a prediction runs: the stale job stops at its next report (at the lowest
+    priority on a busy machine, left to finish it held the one thread for minutes), and one queued behind
+    it and made stale in turn never calls ``predict``."""
+    from studyapp.gui.rig_prediction import RigPrediction
+
+    ended, started = threading.Event(), threading.Event()
+    calls = []
+    endless = _endless(ended, started)
+
+    def predict(req, progress=None):
+        calls.append(req.rig.latency_samples)
+        return endless(req, progress) if req.rig.latency_samples == 5 else {"LVT": 8.0}
+
+    prediction = RigPrediction(predict)
+    shown = []
+    prediction.finished.connect(lambda req, p: shown.append((req.rig.latency_samples, p)))
+    prediction.run(_request(5))
+    assert started.wait(60.0)
+    prediction.run(_request(7))  # queued behind the running job on the one thread
+    prediction.run(_request(9))  # 7 goes stale before it starts
+    assert ended.wait(60.0)
+    wait_until(qapp, lambda: shown, 60)
+    assert shown == [(9, {"LVT": 8.0})] and calls == [5, 9]
+    assert prediction.pool.waitForDone(60_000)
+
+
+def test_one_consoles_prediction_never_waits_for_anothers(qapp):
+    """Each ``RigPrediction`` has its own thread: a console's quick check is not queued behind another's
+    (a clean-clone run at load 4 timed out waiting for rows that were quick, behind the tests' shared console)."""
+    from studyapp.gui.rig_prediction import RigPrediction
+
+    ended, started = threading.Event(), threading.Event()
+    busy = RigPrediction(_endless(ended, started))
+    quick = RigPrediction(lambda req, progress=None: {"LVT": 8.0})
+    shown = []
+    quick.finished.connect(lambda req, p: shown.append(p))
+    for _ in range(4):  # more than the machine's cores: the application's pool would hold them all
+        busy.run(_request(5))
+        busy.run(_request(6))
+    assert started.wait(60.0)
+    quick.run(_request(5))
+    wait_until(qapp, lambda: shown, 60)
+    assert shown == [{"LVT": 8.0}] and busy.busy
+    busy.cancel()
+    assert ended.wait(60.0) and busy.pool.waitForDone(60_000)
