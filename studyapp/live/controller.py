@@ -14,6 +14,7 @@ views. Its parts, one idea each:
     controls.py     knobs and pads: routing, pickup, page settle, latency
     hand.py         the bow and the hand's gesture, the mouse's bow pad
     devices.py      the device: chosen, its handshake and health, the rig it makes (rig_check.py)
+    status_watch.py the status bar's events; a clear confirmed, or the stop given back after CLEAR_TIMEOUT
     trial_media.py  the audio recording and its cues, the reference tone, trial health
 
 Time. ``poll()`` (a GUI timer calls it) never waits: it passes on the
@@ -63,10 +64,8 @@ from studyapp.live.hand import Hand
 from studyapp.live.master_sound import MasterSound
 from studyapp.live.devices import Devices
 from studyapp.live.states import REST, TRANSITIONS, State
+from studyapp.live.status_watch import StatusWatch
 from studyapp.live.trial_media import TrialMedia
-
-STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
-CLEAR_TIMEOUT = 5.0  # s a cleared stop may wait for the worker's word that it cleared; then the stop holds again
 
 
 def instructions_for(protocol, task):
@@ -98,8 +97,7 @@ class SessionController:
         self.abort_reason = None  # why the session is being aborted, when not the experimenter's Abort
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
         self.devices = Devices(self)  # the device: its choice, its records, the rig it makes
-        self._next_status = 0.0
-        self._clearing_since = 0.0  # the controller's clock when the last clear began
+        self.status_watch = StatusWatch(self)  # the status events, and a clear confirmed or given back
 
     # the state machine (states.py) --------------------------------------------------------------
     def fire(self, event):
@@ -112,7 +110,7 @@ class SessionController:
 
     def _set_state(self, state):
         if state == State.CLEARING and self.state != State.CLEARING:
-            self._clearing_since = self.clock()
+            self.status_watch.clearing_began()
         self.state = State(state)
         self.events.state.emit(state=self.state)
 
@@ -368,7 +366,7 @@ class SessionController:
             return
         for record in engine.controls():
             self.controls.take(record)
-        self._watch_status(engine)
+        self.status_watch.watch(engine)
 
     def _follow_engine(self):
         """Announce a change of the engine's state, and let the state machine take it."""
@@ -399,27 +397,6 @@ class SessionController:
             if n:
                 self.runner.advance(n / self.runner.loop.rate)
                 self._after_task_event()
-
-    def _watch_status(self, engine):
-        now = self.clock()
-        clearing = self.state == State.CLEARING
-        if not clearing and now < self._next_status:
-            return
-        status = engine.status()
-        if now >= self._next_status:
-            self._next_status = now + STATUS_PERIOD
-            self.events.status.emit(status=status, lost=self.host.lost,
-                                    knob_latency=(self.latency.last, self.latency.largest))
-            if self.runner is None:
-                self.events.selection.emit(source=status["source"], fmax=status["fmax"])
-        if clearing and not status["fault_latched"] and engine.status_block.force_enable:
-            self.fire("cleared")
-        elif clearing and now - self._clearing_since > CLEAR_TIMEOUT:
-            # never "Clearing" for good (a worker whose loop latched its own fault refuses the clear): the stop holds
-            self.message(f"the engine did not confirm the clear within {CLEAR_TIMEOUT:g} s (fault latched: "
-                         f"{bool(status['fault_latched'])}, force enabled: {bool(engine.status_block.force_enable)}); "
-                         "the emergency stop holds: press Resume again, or restart the engine", level="error")
-            self.fire("clear_timeout")
 
     def message(self, text, level="info", topic=""):
         self.events.message.emit(text=str(text), level=level, topic=topic)

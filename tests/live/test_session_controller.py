@@ -8,7 +8,8 @@ import pytest
 from studyapp.engine import commands as cmd
 from studyapp.experiment.session_log import read_events
 from studyapp.model.fmax_knob import fmax_from_knob
-from studyapp.live.controller import CLEAR_TIMEOUT, TRANSITIONS, SessionController, State
+from studyapp.live.controller import TRANSITIONS, SessionController, State
+from studyapp.live.status_watch import CLEAR_TIMEOUT
 from tests.live.fakes import LATENCY, FakeHost
 
 PROTOCOL = """
