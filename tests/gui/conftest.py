@@ -50,23 +50,32 @@ def line_within(proc, timeout):
     return proc.stdout.readline()
 
 
+_ANSWERING = []  # answer_question's timers, stopped by idle_console before the next test
+
+
 def answer_question(console, qtbot, button):
     """Click ``button`` (a ``QMessageBox.StandardButton``) of the console's next question once it is open.
 
     The question (``Console.confirm``) runs its own event loop, so the answer is set up before the
-    action that asks: a timer looks for the open question every 10 ms (for at most 10 s) and clicks.
+    action that asks: a timer looks for the open question every 10 ms and clicks. It gives up 60 s after
+    its first look, not after it was set up: its first look comes only once the GUI thread is back in an
+    event loop, late on a loaded machine. ``idle_console`` stops one a failed test left behind.
     """
     from PySide6.QtCore import Qt, QTimer
 
     timer = QTimer(console)
     timer.setInterval(10)
-    deadline = time.monotonic() + 10.0
+    _ANSWERING.append(timer)
+    deadline = []
 
     def click():
         box = console.confirmation
-        if (box is None or not box.isVisible()) and time.monotonic() < deadline:
+        if not deadline:
+            deadline.append(time.monotonic() + 60.0)
+        if (box is None or not box.isVisible()) and time.monotonic() < deadline[0]:
             return
         timer.stop()
+        _ANSWERING.remove(timer)
         timer.deleteLater()
         assert box is not None, "no question was asked"
         qtbot.mouseClick(box.button(button), Qt.MouseButton.LeftButton)
@@ -103,11 +112,19 @@ def idle_console(console, qapp):
             c.clear_emergency()
         return c.engine is not None and c.state in ("idle", "finished", "aborted")
 
-    try:
-        wait_until(qapp, settled, ENGINE_START)
-    except AssertionError as e:  # say what the console was doing (a full CI run once timed out here, 3 times)
-        raise AssertionError(f"{e}: state {c.state!r}, engine {c.engine!r}; console log: "
-                             f"{console.log.toPlainText()[-1500:]}") from None
+    def settle():
+        try:
+            wait_until(qapp, settled, ENGINE_START)
+        except AssertionError as e:  # say what the console was doing (a full CI run once timed out here, 3 times)
+            raise AssertionError(f"{e}: state {c.state!r}, engine {c.engine!r}; console log: "
+                                 f"{console.log.toPlainText()[-1500:]}") from None
+
+    while _ANSWERING:  # a test that failed before its question came: its answer must not outlive it
+        _ANSWERING.pop().stop()
+    settle()
+    if c.protocol is None or Path(c.protocol.path) != DEMO:  # a test that failed midway left its own protocol
+        assert console.choose_protocol(str(DEMO)), console.setup.error.text()
+        settle()
     console.set_bowing(False)
     console.turn_knob(0, 0)
     return console
