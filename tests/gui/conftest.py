@@ -84,6 +84,21 @@ def answer_question(console, qtbot, button):
     timer.start()
 
 
+@pytest.fixture(autouse=True)
+def no_quit_left_behind(request):
+    """Fail the test that called ``QApplication.exit``/``quit`` with no event loop running: Qt keeps "quit now"
+    set, and every later ``QDialog.exec()`` in the process returns at once with its question still open (two
+    whole runs failed their abort test that way, after a test of ``studyapp gui --screenshot``'s exit)."""
+    yield
+    if "qapp" not in request.fixturenames:
+        return
+    from PySide6.QtCore import QEventLoop, QTimer
+
+    loop = QEventLoop()
+    QTimer.singleShot(0, lambda: loop.exit(0))
+    assert loop.exec() == 0, "this test left Qt quitting: it called QApplication.exit or quit with no loop running"
+
+
 @pytest.fixture(scope="package")
 def console(qapp):
     from studyapp.gui.console import Console

@@ -25,8 +25,15 @@ class _Console(QWidget):
     ("running", False, 0, "the knobs were never enabled"),
     ("running", True, 1200, "the scope holds 1200 of the 7500 samples of bowing it waits for"),
 ])
-def test_the_timeout_says_how_long_it_waited_and_for_what(qapp, capsys, state, knobs, samples, why):
+def test_the_timeout_says_how_long_it_waited_and_for_what(qapp, capsys, monkeypatch, state, knobs, samples, why):
+    from studyapp.gui import preview_bowing
     from studyapp.gui.preview_bowing import PreviewBowing
+
+    # never the real QApplication.exit here: with no loop running it sets Qt's "quit now", and every later
+    # QDialog.exec() in this process returned at once with its question still open (a whole run's abort test)
+    exits = []
+    app = SimpleNamespace(exit=exits.append)
+    monkeypatch.setattr(preview_bowing, "QApplication", SimpleNamespace(instance=lambda: app))
 
     now = [33_000.0]  # a monotonic clock reads from the machine's boot
     console = _Console(state, knobs, samples)
@@ -36,4 +43,4 @@ def test_the_timeout_says_how_long_it_waited_and_for_what(qapp, capsys, state, k
     bowing._check()
     assert capsys.readouterr().err.strip() == \
         f"studyapp gui: error: the engine is {state} 240 s after the console opened: {why}"
-    assert not bowing.timer.isActive()
+    assert not bowing.timer.isActive() and exits == [1]
