@@ -66,13 +66,13 @@ def answer_question(console, qtbot, button):
     timer = QTimer(console)
     timer.setInterval(10)
     _ANSWERING.append(timer)
-    deadline = []
+    deadline = None
 
     def click():
+        nonlocal deadline
         box = console.confirmation
-        if not deadline:
-            deadline.append(time.monotonic() + 60.0)
-        if (box is None or not box.isVisible()) and time.monotonic() < deadline[0]:
+        deadline = deadline or time.monotonic() + 60.0
+        if (box is None or not box.isVisible()) and time.monotonic() < deadline:
             return
         timer.stop()
         _ANSWERING.remove(timer)
