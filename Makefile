@@ -5,17 +5,26 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+LOCK := requirements.lock
 
-.PHONY: run test setup clean figures
+.PHONY: run test setup lock clean figures
 
-$(STAMP): pyproject.toml scripts/system-deps.txt
+# the exact versions and hashes of the lock (pip and setuptools among them), then the package itself
+# with no dependencies of its own, built by the locked setuptools; again whenever the lock changes
+$(STAMP): pyproject.toml $(LOCK) scripts/system-deps.txt
 	@scripts/install-system-deps
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	@$(PY) -m pip install -q --upgrade pip
-	@$(PY) -m pip install -q -e '.[test]'
+	@$(PY) scripts/locked_environment.py check $(LOCK)
+	@$(PY) -m pip install -q --require-hashes -r $(LOCK)
+	@$(PY) -m pip install -q --no-deps --no-build-isolation -e .
 	@touch $(STAMP)
 
 setup: $(STAMP)
+
+# resolve pyproject.toml's ranges afresh into the lock (newest versions they allow), by hand: then
+# make setup, make test, and commit the lock if green (README, Quick start)
+lock:
+	$(PYTHON) scripts/locked_environment.py write $(LOCK)
 
 run: $(STAMP)
 	$(VENV)/bin/studyapp compile
