@@ -6,7 +6,8 @@ over seeds K..K+N-1 (K = 0 by default). Prints a table (or with ``--json`` one J
 ``--source``, a list of them for ``--all``); ``-o`` also writes it, by suffix:
 ``.csv`` (one row per source, the seeds' values ';'-joined in
 ``fmax_per_seed``, the seeds in the same order in ``seeds_used``), ``.md`` (the same table, headed by the date and the
-command that regenerates it) or ``.json``. Stable up to the search's 200 N is
+command that regenerates it) or ``.json``. Each JSON object ends with its ``provenance``: the
+command, when, and where (studyapp.provenance: versions, commit, CPU, BLAS). Stable up to the search's 200 N is
 ``inf`` in CSV, ``null`` in JSON and "> 200" in Markdown; broken already at
 0.05 N is 0.05, "<= 0.05" in Markdown. Progress goes to stderr.
 
@@ -88,6 +89,7 @@ def run(args):
 
     from studyapp.estimators.at_rate import check_windows
     from studyapp.estimators.spec import validate_rate
+    from studyapp.evaluation.provenance import provenance
     from studyapp.model import breakdown, calibration
     from studyapp.model.playable import check_playable
 
@@ -120,6 +122,8 @@ def run(args):
                                                       duration=args.duration, progress=progress, link=link,
                                                       first_seed=args.first_seed, windows=args.windows))
 
+    made = provenance(command=command_line(args))
+    results = [{**r, "provenance": made} for r in results]
     if args.json:
         json.dump(_json(results if args.all else results[0]), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")

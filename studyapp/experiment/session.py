@@ -59,6 +59,7 @@ import numpy as np
 from studyapp import __version__
 from studyapp.io.atomic import atomic_open
 from studyapp.errors import UserError
+from studyapp.provenance import environment
 from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
@@ -258,6 +259,7 @@ class Session:
             "session": folder.name,
             "started": wall_time(),
             "app_version": __version__,
+            "environment": environment(),
             "seed": seed,
             "protocol": {
                 "path": protocol.path,

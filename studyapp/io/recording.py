@@ -5,6 +5,9 @@ metadata. On disk it is one of
 
 - ``.h5``  HDF5: one dataset per column, metadata as JSON in the root attribute ``meta``;
 - ``.npz`` NumPy: one array per column plus ``__meta__`` (JSON text);
+
+  the metadata's ``environment`` is ``studyapp.provenance.environment()`` of the program that wrote the
+  file (versions, commit, CPU model, BLAS kernels);
 - ``.csv`` exchange: a header with the columns ``COLUMNS`` in that order, then one row per
   sample, nothing else (any CSV reader takes it as is). It carries no metadata: ``load``
   recovers the rate from ``t``. A leading ``# {json}`` comment line is accepted on input.
@@ -38,6 +41,7 @@ from studyapp.io.small_files import open_regular
 from studyapp.io.special_files import refuse_special
 from studyapp.io.atomic import atomic_open
 from studyapp.io.h5_output import H5Output
+from studyapp.provenance import environment
 
 COLUMNS = (
     "t", "position", "velocity_lvt", "acceleration", "velocity_true",
@@ -84,7 +88,10 @@ def check_path(path):
 
 
 def _meta_json(recording):
-    meta = {"format": FORMAT_VERSION, "version": __version__, **recording.meta, "rate": recording.rate}
+    """The metadata as written: the recording's own, its rate, and the environment of the writer (the
+    software and machine writing the file now, even when the recording was read from another's)."""
+    meta = {"format": FORMAT_VERSION, "version": __version__, **recording.meta, "rate": recording.rate,
+            "environment": environment()}
     return json.dumps(meta, sort_keys=True, default=_plain)
 
 

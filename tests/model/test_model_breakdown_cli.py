@@ -28,7 +28,7 @@ def test_json_for_one_source_with_progress(capsys):
     assert main(["breakdown", "--source", "LOWPASS", "--seeds", "2", "--duration", "1.5", "--json"]) == 0
     out, err = capsys.readouterr()
     doc = json.loads(out)
-    assert list(doc) == KEYS + LINK and [doc[k] for k in LINK] == [0.0, 0.0, 0.0]
+    assert list(doc) == KEYS + LINK + ["provenance"] and [doc[k] for k in LINK] == [0.0, 0.0, 0.0]
     # issue 20: breakdown is judged while bowing by default
     assert (doc["source"], doc["rate"], doc["gesture"], doc["seeds"]) == ("LOWPASS", 5000.0, "strokes", 2)
     assert (doc["first_seed"], doc["seeds_used"], doc["windows"]) == (0, [0, 1], "seconds")
