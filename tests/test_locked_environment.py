@@ -91,3 +91,13 @@ def test_the_stamp_depends_on_the_lock_and_installs_it_with_hashes():
                             stdin=subprocess.DEVNULL).stdout
     assert "pip install -q --require-hashes -r requirements.lock" in recipe
     assert "pip install -q --no-deps --no-build-isolation -e ." in recipe
+
+
+def test_another_platform_is_refused_in_one_line(tmp_path):
+    other = tmp_path / "requirements.lock"
+    other.write_text(re.sub(r"^# platform: .+$", "# platform: CPython 3.99 Plan9 mips", LOCK.read_text(), flags=re.M))
+    done = subprocess.run([sys.executable, str(ROOT / "scripts" / "locked_environment.py"), "check", str(other)],
+                          capture_output=True, text=True, stdin=subprocess.DEVNULL)
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.count("\n") == 1 and "locked for CPython 3.99 Plan9 mips" in done.stderr
+    assert "pip install -e '.[test]'" in done.stderr and "make lock" in done.stderr
