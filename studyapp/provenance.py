@@ -42,9 +42,13 @@ _CONFIG_SYMBOLS = ("scipy_openblas_get_config64_", "scipy_openblas_get_config", 
                    "openblas_get_config")
 
 
-@functools.lru_cache(maxsize=1)
 def environment():
-    """The flat dict of strings the module docstring lists (a new copy each call is not needed: read only)."""
+    """The flat dict of strings the module docstring lists: a copy of the process's, the caller's to keep."""
+    return dict(_environment())
+
+
+@functools.lru_cache(maxsize=1)
+def _environment():
     info = {"studyapp_version": __version__, "studyapp_commit": commit(SOURCE),
             "python_version": platform.python_version()}
     for name in PACKAGES:
