@@ -5,12 +5,12 @@ metadata. On disk it is one of
 
 - ``.h5``  HDF5: one dataset per column, metadata as JSON in the root attribute ``meta``;
 - ``.npz`` NumPy: one array per column plus ``__meta__`` (JSON text);
-
-  the metadata's ``environment`` is ``studyapp.provenance.environment()`` of the program that wrote the
-  file (versions, commit, CPU model, BLAS kernels);
 - ``.csv`` exchange: a header with the columns ``COLUMNS`` in that order, then one row per
   sample, nothing else (any CSV reader takes it as is). It carries no metadata: ``load``
   recovers the rate from ``t``. A leading ``# {json}`` comment line is accepted on input.
+
+The metadata's ``environment`` is ``studyapp.provenance.environment()`` of the program that wrote
+the file: versions, git commit, CPU model, BLAS kernels.
 
 Units are SI: t (s), position (m), velocity_lvt, velocity_true, string_velocity (m/s),
 acceleration, acceleration_true (m/s^2), force (N, the force commanded on the handle),
