@@ -32,8 +32,9 @@ run: $(STAMP)
 
 # the numba kernels compiled once, before any test process needs them (studyapp compile); then the
 # suite on every core (at most 4), each worker with its own JACK server, Xvfb display and temporary
-# directory (a worker that runs out of tests takes some of another's: worksteal); then the tests that
-# measure a real-time guarantee (marker "alone"), with the machine to themselves
+# directory (a worker that runs out of tests takes some of another's: worksteal; the long files are
+# collected first, tests/conftest.py); then the tests that measure a real-time guarantee (marker
+# "alone"), with the machine to themselves
 test: $(STAMP)
 	$(VENV)/bin/studyapp compile
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal -m "not alone"

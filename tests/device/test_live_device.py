@@ -6,11 +6,17 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from studyapp.device.emulator_process import EmulatorProcess
 
 REPO = Path(__file__).resolve().parents[2]
 
 
+# a real-time guarantee: the engine, paced by the emulator's clock, feeds the device's watchdog for 3 s (at a load
+# of 5-11 it fell 200 ms behind and "the device reported WATCHDOG", issue 39); the emulator's lock-step mode,
+# which has no clock, is a host driver's (tests/device/test_link_lockstep.py): `live` stalls on it at once
+@pytest.mark.alone
 def test_live_runs_on_the_emulator_and_reports_the_device(tmp_path):
     path = tmp_path / "device"
     env = {**os.environ, "PYTHONPATH": str(REPO)}

@@ -115,34 +115,54 @@ def console(qapp):
     window.shut_down()  # close() mid-session would ask (Console.confirm)
 
 
-@pytest.fixture
-def idle_console(console, qapp):
-    """The shared console, its preview engine running, no session, no emergency stop, bow lifted."""
+def make_idle(console, qapp, timeout=ENGINE_START):
+    """Bring the shared console back to idle for the next test: no session, no emergency stop, the demo's
+    preview engine running, bow lifted.
+
+    A test that lost its engine (the worker died, or hung past the watchdog: the host "failed") left the
+    console at rest without one, and nothing at rest starts a new one: every later test of the worker then
+    waited 180 s for an engine and erred (9 did in one loaded run, issue 39). So a lost engine is replaced
+    here, as an experimenter does by choosing the protocol again. A console that does not settle within
+    ``timeout`` fails this test, saying what it found, and is given a new engine before the next test."""
     c = console.controller
-    assert console.timer.isActive(), "a test left the shared console without its poll"
-    if c.in_session:
-        console.abort_session()
+
     def settled():
         if c.emergency:  # again after a clear the engine never confirmed (CLEAR_TIMEOUT gives the stop back)
             c.clear_emergency()
         return c.engine is not None and c.state in ("idle", "finished", "aborted")
 
+    def new_engine():
+        if c.in_session:
+            console.abort_session()
+        assert console.choose_protocol(str(DEMO)), console.setup.error.text()
+
     def settle():
         try:
-            wait_until(qapp, settled, ENGINE_START)
+            wait_until(qapp, settled, timeout)
         except AssertionError as e:  # say what the console was doing (a full CI run once timed out here, 3 times)
-            raise AssertionError(f"{e}: state {c.state!r}, engine {c.engine!r}; console log: "
-                                 f"{console.log.toPlainText()[-1500:]}") from None
+            found = (f"{e}: state {c.state!r}, engine {c.engine!r}, host {c.host.state if c.host else None!r}; "
+                     f"console log: {console.log.toPlainText()[-1500:]}")
+            new_engine()  # the next test starts from a new engine, not from this one's stall
+            raise AssertionError(found) from None
 
     while _ANSWERING:  # a test that failed before its question came: its answer must not outlive it
         _ANSWERING.pop().stop()
+    if c.in_session:
+        console.abort_session()
+    lost = c.host is None or c.host.state in ("failed", "stopped")
+    if lost or c.protocol is None or Path(c.protocol.path) != DEMO:  # or a test that failed midway left its own
+        new_engine()
     settle()
-    if c.protocol is None or Path(c.protocol.path) != DEMO:  # a test that failed midway left its own protocol
-        assert console.choose_protocol(str(DEMO)), console.setup.error.text()
-        settle()
     console.set_bowing(False)
     console.turn_knob(0, 0)
     return console
+
+
+@pytest.fixture
+def idle_console(console, qapp):
+    """The shared console, its preview engine running, no session, no emergency stop, bow lifted (``make_idle``)."""
+    assert console.timer.isActive(), "a test left the shared console without its poll"
+    return make_idle(console, qapp)
 
 
 @pytest.fixture(scope="session")
