@@ -16,8 +16,13 @@ of equals) is positive, and the smallest eigenvalue.
 
 Why not numpy.cov and numpy.linalg.eigh: they go through BLAS and LAPACK,
 whose kernels OpenBLAS chooses by CPU, and different kernels round
-differently (issue 39); here every sum is a ``math.fsum`` and every other
-step one float operation in a fixed order, the same bits on every machine.
+differently (issue 39). Here each covariance entry is a ``math.fsum``
+(correctly rounded, so its order does not matter) of elementwise products,
+the projections t_k = (x_k - c) . u are summed coordinate by coordinate in a
+fixed order, and every other step is one float operation in a fixed order:
+the same bits on every machine. (An elementwise numpy operation rounds each
+entry once, whatever SIMD width runs it; a matrix product does not.) For an
+elite of 2000 points the axis takes a few ms.
 Against numpy the eigenvalues agree to about 1e-15 of the largest and the axis
 to about 1e-13 wherever the two largest eigenvalues are apart
 (tests/evaluation/test_principal_axis.py).
@@ -25,17 +30,31 @@ to about 1e-13 wherever the two largest eigenvalues are apart
 
 import math
 
+import numpy as np
+
 MAX_SWEEPS = 50
 TINY = 1e-300
 
 
 def covariance(points):
-    """The sample covariance (rows of floats) of ``points``: a sequence of n >= 2 points of d coordinates."""
-    points = [[float(v) for v in p] for p in points]
-    n, d = len(points), len(points[0])
-    mean = [math.fsum(p[i] for p in points) / n for i in range(d)]
-    centred = [[p[i] - mean[i] for i in range(d)] for p in points]
-    return [[math.fsum(c[i] * c[j] for c in centred) / (n - 1) for j in range(d)] for i in range(d)]
+    """The sample covariance (rows of floats) of ``points``: n >= 2 points (rows) of d coordinates."""
+    x = np.asarray(points, dtype=np.float64)
+    n, d = x.shape
+    centred = x - np.array([math.fsum(x[:, i]) / n for i in range(d)])  # one rounding per entry, as in Python
+    c = [[0.0] * d for _ in range(d)]
+    for i in range(d):
+        for j in range(i, d):
+            c[i][j] = c[j][i] = math.fsum(centred[:, i] * centred[:, j]) / (n - 1)
+    return c
+
+
+def projections(points, centre, u):
+    """t_k = sum_i (x_ki - c_i) u_i for every point, summed over i = 0, 1, ... in that order."""
+    x = np.asarray(points, dtype=np.float64)
+    t = np.zeros(x.shape[0])
+    for i in range(x.shape[1]):
+        t = t + (x[:, i] - float(centre[i])) * float(u[i])
+    return t
 
 
 def eigh(c):

@@ -134,10 +134,10 @@ class AdaptiveSearch:
             return None
         points = [p[:-1] for p in self.elite]
         u, smallest = principal_axis.principal_axis(points)
-        t = [principal_axis.dot([x - c for x, c in zip(p, self.centre)], u) for p in points]
-        length = max(max(t) - min(t), MIN_RADIUS)
+        t = principal_axis.projections(points, self.centre, u)
+        length = max(float(t.max() - t.min()), MIN_RADIUS)
         width = max(math.sqrt(max(smallest, 0.0)), MIN_RADIUS)
-        return np.array(u), min(t) - length / 2.0, max(t) + length / 2.0, width
+        return np.array(u), float(t.min()) - length / 2.0, float(t.max()) + length / 2.0, width
 
     def _along(self, u, low, high, width):
         x = self.centre + self.rng.uniform(low, high) * u
