@@ -18,8 +18,8 @@ h_dot_j = (2 / ((M-1) T)) sum_n w_n u_j^n, the same least-squares solution
 with the scaling divided out. Each tap is the correctly rounded value of the
 exact one, so it is the same bits on every machine (no BLAS or LAPACK: numpy's
 pinv of the Vandermonde matrix gave taps whose last bits depended on the CPU's
-BLAS kernels, issue 39). The exact taps are kept per (N, M); building them
-takes at most about 20 ms (N = 6, M = 512).
+BLAS kernels, issue 39). The exact taps of the last 256 (N, M) are kept;
+building them takes at most about 20 ms (N = 6, M = 512).
 They equal ``numpy.linalg.pinv``'s to about 1e-14 relative and
 ``scipy.signal.savgol_coeffs(M, N, deriv=1, delta=T, pos=M-1, use="conv")``
 only where scipy is accurate: its unscaled Vandermonde loses precision as M
@@ -45,7 +45,7 @@ from studyapp.estimators.history import fill
 from studyapp.estimators.spec import EstimatorSpec, Param
 
 
-@functools.lru_cache(maxsize=4096)
+@functools.lru_cache(maxsize=256)  # at most 25 kB each (N = 6, M = 512): a few MB
 def exact_taps(order, window):
     """(numerators, denominator): the taps at a rate of 1 Hz, oldest .. newest, as integers over one integer."""
     span = window - 1
