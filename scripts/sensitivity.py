@@ -1,0 +1,250 @@
+"""How far each quoted figure moves under one rounding step of the initial state (issue 39, item 2).
+
+    PYTHONPATH=. python scripts/sensitivity.py -o OUT [--parts breakdown,pilot,study] [--seeds 10]
+        [--tables strokes,hold,strokes-48k] [--pilot-seeds 1-6,7-12] [--max-sets N]
+
+Every figure is computed twice by the command docs/ quotes it from, once plain
+and once with the environment's ``STUDYAPP_NUDGE=1`` (studyapp/model/nudge.py:
+every simulated device starts its end-effector one rounding step, 1.7e-18 m,
+off rest), and the two are compared. What a figure does under that nudge is
+what it may do on another libm, architecture or numpy: docs/reproducibility.md
+holds the table this prints, dated, with the command.
+
+- ``breakdown``: ``studyapp breakdown --all --seeds N --json`` per table of
+  ``TABLES`` (``--tables``), plain and nudged. Per source: the median of the
+  plain F_max over seeds 0..N-1, their range, the median and largest
+  |nudged / plain - 1| of one seed, and that of the median over the seeds.
+- ``pilot``: scripts/pilot.py ``--seeds SETS`` plain and nudged; per set and
+  figure (the Fig. 7 medians, rho, the between-participant share) its value and
+  |move|.
+- ``study``: ``studyapp simulate-set`` (training and validation) plain and
+  nudged, ``studyapp evaluate`` of docs/study/params.toml on each with
+  ``--compare-paper``: each finding's verdict plain and nudged; and, with
+  ``--max-sets N`` (a reduced budget: the full search is about 20 min per seed),
+  ``studyapp optimise --seed 0 --max-sets N`` on each training set: each Table 1
+  parameter's value and |move|.
+
+The pairs of commands run two at a time (plain beside nudged). Progress
+(part, command, time so far) goes to stderr, each command's own output to
+``OUT/log/``. Writes ``OUT/sensitivity.md`` (and prints it). ``OUT`` must be new
+or empty.
+"""
+
+import argparse
+import csv
+import datetime
+import json
+import math
+import os
+import shlex
+import subprocess
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from studyapp.analysis.pilot import pilot_figures  # noqa: E402
+from studyapp.model.nudge import VARIABLE  # noqa: E402
+
+# name -> (rate, gesture, windows, sources or None for --all): docs/breakdown.md's tables
+TABLES = {"strokes": (5000, "strokes", "seconds", None),
+          "hold": (5000, "hold", "seconds", None),
+          "strokes-48k": (48000, "strokes", "seconds", ("TRUE", "LVT", "FOAW", "LEASTSQ"))}
+PARTS = ("breakdown", "pilot", "study")
+NUDGES = (0, 1)
+STARTED = time.monotonic()
+
+
+def say(text):
+    print(f"sensitivity: {text} ({time.monotonic() - STARTED:.0f} s so far)", file=sys.stderr, flush=True)
+
+
+def environment(nudge):
+    env = dict(os.environ, **{VARIABLE: str(nudge)})
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
+    return env
+
+
+def run_pair(out, name, make_argv):
+    """Run ``make_argv(nudge)`` for each nudge, side by side; exits naming the log if one fails."""
+    say(f"{name}: $ {VARIABLE}=n {shlex.join(make_argv('n'))}")
+    running = []
+    for nudge in NUDGES:
+        argv = [sys.executable if a == "python" else a for a in make_argv(nudge)]
+        if argv[:1] == ["studyapp"]:
+            argv = [sys.executable, "-m", "studyapp"] + argv[1:]
+        log = open(out / "log" / f"{name}-nudge{nudge}.log", "w")
+        running.append((nudge, log, subprocess.Popen(argv, cwd=ROOT, env=environment(nudge), stdout=log, stderr=log)))
+    for nudge, log, process in running:
+        code = process.wait()
+        log.close()
+        if code != 0:
+            sys.exit(f"sensitivity: {name} with {VARIABLE}={nudge} failed ({code}); see {log.name}")
+    say(f"{name}: done")
+
+
+def move(plain, nudged):
+    """|nudged / plain - 1|; 0 when both are the same (inf or the search's bottom included), inf when one is inf."""
+    if plain == nudged:
+        return 0.0
+    if math.isinf(plain) or math.isinf(nudged):
+        return math.inf
+    return abs(nudged / plain - 1.0)
+
+
+def pct(x):
+    return "inf" if math.isinf(x) else f"{100 * x:.2g} %" if x else "0"
+
+
+def g3(x):
+    return "> 200" if math.isinf(x) else f"{x:.3g}"
+
+
+def breakdown_part(out, table, seeds):
+    rate, gesture, windows, sources = TABLES[table]
+
+    def argv(nudge):
+        which = ["--all"] if sources is None else []
+        return ["studyapp", "breakdown", *which, "--rate", str(rate), "--seeds", str(seeds), "--first-seed", "0",
+                "--gesture", gesture, "--duration", "5", "--windows", windows, "-o", str(out / f"breakdown-{table}-nudge{nudge}.json")]
+
+    if sources is None:
+        run_pair(out, f"breakdown-{table}", argv)
+        results = [json.loads((out / f"breakdown-{table}-nudge{n}.json").read_text()) for n in NUDGES]
+    else:  # one command per source (--source), gathered
+        results = [[], []]
+        for source in sources:
+            run_pair(out, f"breakdown-{table}-{source}",
+                     lambda n, source=source: argv(n)[:2] + ["--source", source] + argv(n)[2:-1]
+                     + [str(out / f"breakdown-{table}-{source}-nudge{n}.json")])
+            for i, n in enumerate(NUDGES):
+                results[i].append(json.loads((out / f"breakdown-{table}-{source}-nudge{n}.json").read_text()))
+    lines = [f"**Breakdown F_max (N), {gesture} at {rate / 1000:g} kHz, seeds 0-{seeds - 1}** "
+             f"(`{VARIABLE}=n studyapp breakdown {'--all' if sources is None else '--source S'} --rate {rate} "
+             f"--seeds {seeds} --first-seed 0 --gesture {gesture} --duration 5 --windows {windows} --json`):", "",
+             "| source | median over seeds | range over seeds | one seed's \\|move\\|: median | max | the median's \\|move\\| |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    for plain, nudged in zip(*results):
+        p = [number(v) for v in plain["fmax"]]
+        q = [number(v) for v in nudged["fmax"]]
+        moves = [move(a, b) for a, b in zip(p, q)]
+        lines.append(f"| {plain['source']} | {g3(float(np.median(p)))} | {g3(min(p))}-{g3(max(p))} | "
+                     f"{pct(float(np.median(moves)))} | {pct(max(moves))} | {pct(move(float(np.median(p)), float(np.median(q))))} |")
+    return "\n".join(lines) + "\n"
+
+
+def number(v):
+    return math.inf if v is None or v == "inf" else float(v)
+
+
+def pilot_part(out, sets):
+    run_pair(out, "pilot", lambda n: ["python", "scripts/pilot.py", "--seeds", sets, "-o", str(out / f"pilot-nudge{n}")])
+    data = [pd.read_csv(out / f"pilot-nudge{n}" / "pilot.csv", dtype={"set": str}) for n in NUDGES]
+    lines = [f"**The in-silico pilot** (`{VARIABLE}=n PYTHONPATH=. python scripts/pilot.py --seeds {sets}`): "
+             "each set's figure plain, nudged, and |move| (the medians relative, rho and the share absolute):", "",
+             "| figure | " + " | ".join(f"seeds {s}: plain, nudged, \\|move\\|" for s in dict.fromkeys(data[0]["set"])) + " |",
+             "| --- | " + " | ".join("---" for _ in dict.fromkeys(data[0]["set"])) + " |"]
+    figures = {label: [pilot_figures(d[d["set"] == label]) for d in data] for label in dict.fromkeys(data[0]["set"])}
+    first = next(iter(figures.values()))[0]
+    for condition in first["medians"]:
+        lines.append(f"| {condition} median (N) | " + " | ".join(
+            f"{a['medians'][condition]:.3g}, {b['medians'][condition]:.3g}, {pct(move(a['medians'][condition], b['medians'][condition]))}"
+            for a, b in figures.values()) + " |")
+    lines.append("| rho against the paper's Fig. 7 order | " + " | ".join(
+        f"{a['rho']:.2f}, {b['rho']:.2f}, {abs(b['rho'] - a['rho']):.2f}" for a, b in figures.values()) + " |")
+    lines.append("| within lower than total, log10 F_max (%) | " + " | ".join(
+        f"{a['mean_within_lower_pct']:.0f}, {b['mean_within_lower_pct']:.0f}, "
+        f"{abs(b['mean_within_lower_pct'] - a['mean_within_lower_pct']):.0f}" for a, b in figures.values()) + " |")
+    responses = [d["fmax"].to_numpy(float) for d in data]
+    same = int(np.sum(responses[0] == responses[1])) if len(responses[0]) == len(responses[1]) else 0
+    lines += ["", f"{same} of {len(responses[0])} adjustment responses are the same plain and nudged."]
+    return "\n".join(lines) + "\n"
+
+
+def study_part(out, max_sets):
+    for kind, extra in (("train", []), ("valid", ["--validation"])):
+        run_pair(out, f"simulate-set-{kind}", lambda n, kind=kind, extra=extra:
+                 ["studyapp", "simulate-set", "-o", str(out / f"data-nudge{n}" / kind), *extra])
+    run_pair(out, "evaluate", lambda n: ["studyapp", "evaluate", str(out / f"data-nudge{n}" / "train"), "--params",
+                                         "docs/study/params.toml", "--validation", str(out / f"data-nudge{n}" / "valid"),
+                                         "-o", str(out / f"evaluate-nudge{n}"), "--compare-paper"])
+    found = []
+    for n in NUDGES:
+        with open(out / f"evaluate-nudge{n}" / "findings.csv", newline="") as f:
+            found.append(list(csv.DictReader(f)))
+    lines = [f"**The findings** (`{VARIABLE}=n studyapp simulate-set` (training, validation), then `studyapp evaluate "
+             "train --params docs/study/params.toml --validation valid --compare-paper`):", "",
+             "| finding | verdict plain | verdict nudged | ours plain | ours nudged |", "| --- | --- | --- | --- | --- |"]
+    for a, b in zip(*found):
+        lines.append(f"| {a['finding']} | {a['verdict']} | {b['verdict']} | {short(a['ours'])} | {short(b['ours'])} |")
+    if max_sets:
+        run_pair(out, "optimise", lambda n: ["studyapp", "optimise", str(out / f"data-nudge{n}" / "train"), "-o",
+                                             str(out / f"optimise-nudge{n}.toml"), "--seed", "0", "--workers", "1",
+                                             "--max-sets", str(max_sets), "--quiet"])
+        tuned = [tomllib.loads((out / f"optimise-nudge{n}.toml").read_text()) for n in NUDGES]
+        lines += ["", f"**Table 1's parameters, a reduced search** (`{VARIABLE}=n studyapp optimise train --seed 0 "
+                  f"--max-sets {max_sets}`; the quoted ones come from the full search, about 20 min per seed):", "",
+                  "| estimator | parameter | plain | nudged | \\|move\\| |", "| --- | --- | --- | --- | --- |"]
+        for estimator, params in tuned[0].items():
+            if estimator == "provenance" or not isinstance(params, dict):
+                continue
+            for name, value in params.items():
+                if isinstance(value, (int, float)) and not isinstance(value, bool):
+                    other = tuned[1][estimator][name]
+                    lines.append(f"| {estimator} | {name} | {value:.4g} | {other:.4g} | {pct(move(float(value), float(other)))} |")
+    return "\n".join(lines) + "\n"
+
+
+def short(text, n=60):
+    text = " ".join(str(text).split())
+    return text if len(text) <= n else text[:n - 3] + "..."
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("-o", "--output", required=True, help="a new or empty folder")
+    parser.add_argument("--parts", default=",".join(PARTS), help=f"comma separated, of {', '.join(PARTS)}")
+    parser.add_argument("--seeds", type=int, default=10, help="breakdown seeds 0..N-1 (default 10)")
+    parser.add_argument("--tables", default="strokes", help=f"breakdown tables, comma separated, of {', '.join(TABLES)}")
+    parser.add_argument("--pilot-seeds", default="1-6,7-12", help="scripts/pilot.py's --seeds (default 1-6,7-12)")
+    parser.add_argument("--max-sets", type=int, default=0, help="also optimise each training set, this many sets per "
+                                                                 "estimator (0, the default: no optimise)")
+    args = parser.parse_args(argv)
+    parts = [p.strip() for p in args.parts.split(",")]
+    tables = [t.strip() for t in args.tables.split(",")]
+    for label, chosen, allowed in (("--parts", parts, PARTS), ("--tables", tables, TABLES)):
+        bad = [c for c in chosen if c not in allowed]
+        if bad:
+            parser.exit(2, f"sensitivity: error: {label} {bad[0]!r}: allowed are {', '.join(allowed)}\n")
+    if not 1 <= args.seeds <= 100 or args.max_sets < 0:
+        parser.exit(2, f"sensitivity: error: --seeds {args.seeds} / --max-sets {args.max_sets}: allowed are "
+                       "1 to 100 seeds and 0 or more sets\n")
+    out = Path(args.output)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        parser.exit(2, f"sensitivity: error: -o {out}: not empty; allowed is a new or empty folder\n")
+    (out / "log").mkdir(parents=True)
+    command = "PYTHONPATH=. python scripts/sensitivity.py " + shlex.join(
+        ["-o", str(out), "--parts", ",".join(parts), "--seeds", str(args.seeds), "--tables", ",".join(tables),
+         "--pilot-seeds", args.pilot_seeds, "--max-sets", str(args.max_sets)])
+    sections = [f"Generated on {datetime.date.today().isoformat()} by `{command}`."]
+    if "breakdown" in parts:
+        sections += [breakdown_part(out, table, args.seeds) for table in tables]
+    if "pilot" in parts:
+        sections.append(pilot_part(out, args.pilot_seeds))
+    if "study" in parts:
+        sections.append(study_part(out, args.max_sets))
+    text = "\n".join(sections)
+    (out / "sensitivity.md").write_text(text)
+    print(text, end="")
+    say("done")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
