@@ -1,7 +1,7 @@
 """How far each quoted figure moves under one rounding step of the initial state (issue 39, item 2).
 
     PYTHONPATH=. python scripts/sensitivity.py -o OUT [--parts breakdown,pilot,study] [--seeds 10]
-        [--tables strokes,hold,strokes-48k] [--pilot-seeds 1-6,7-12] [--max-sets N]
+        [--tables strokes,hold,strokes-48k] [--sources S,...] [--pilot-seeds 1-6,7-12] [--max-sets N]
 
 Every figure is computed twice by the command docs/ quotes it from, once plain
 and once with the environment's ``STUDYAPP_NUDGE=1`` (studyapp/model/nudge.py:
@@ -14,6 +14,11 @@ holds the table this prints, dated, with the command.
   ``TABLES`` (``--tables``), plain and nudged. Per source: the median of the
   plain F_max over seeds 0..N-1, their range, the median and largest
   |nudged / plain - 1| of one seed, and that of the median over the seeds.
+- ``signals``: docs/model.md's "paper's signals" (scripts/model_figures.py's
+  ``paper_signals`` at 12.1 and 7.7 N, ``loop_pitch`` at 5, 20, 48 kHz) on the
+  quoted seed and the next N - 1, plain and nudged (this script again,
+  ``--signals-json N``, under each nudge): per figure its quoted seed's value,
+  the median and range over the seeds, and the median and largest |move|.
 - ``pilot``: scripts/pilot.py ``--seeds SETS`` plain and nudged; per set and
   figure (the Fig. 7 medians, rho, the between-participant share) its value and
   |move|.
@@ -56,9 +61,10 @@ from studyapp.model.nudge import VARIABLE  # noqa: E402
 TABLES = {"strokes": (5000, "strokes", "seconds", None),
           "hold": (5000, "hold", "seconds", None),
           "strokes-48k": (48000, "strokes", "seconds", ("TRUE", "LVT", "FOAW", "LEASTSQ"))}
-PARTS = ("breakdown", "pilot", "study")
+PARTS = ("breakdown", "signals", "pilot", "study")
 NUDGES = (0, 1)
 STARTED = time.monotonic()
+PIPE = "\\|"  # a | inside a Markdown table's cell
 
 
 def say(text):
@@ -72,7 +78,13 @@ def environment(nudge):
 
 
 def run_pair(out, name, make_argv):
-    """Run ``make_argv(nudge)`` for each nudge, side by side; exits naming the log if one fails."""
+    """Run ``make_argv(nudge)`` for each nudge, side by side; exits naming the log if one fails.
+
+    A pair that succeeded leaves ``OUT/log/NAME.done``; with ``--resume`` it is not run again."""
+    done = out / "log" / f"{name}.done"
+    if done.exists():
+        say(f"{name}: done before (--resume)")
+        return
     say(f"{name}: $ {VARIABLE}=n {shlex.join(make_argv('n'))}")
     running = []
     for nudge in NUDGES:
@@ -86,6 +98,7 @@ def run_pair(out, name, make_argv):
         log.close()
         if code != 0:
             sys.exit(f"sensitivity: {name} with {VARIABLE}={nudge} failed ({code}); see {log.name}")
+    done.write_text("")
     say(f"{name}: done")
 
 
@@ -106,8 +119,9 @@ def g3(x):
     return "> 200" if math.isinf(x) else f"{x:.3g}"
 
 
-def breakdown_part(out, table, seeds):
+def breakdown_part(out, table, seeds, only=None):
     rate, gesture, windows, sources = TABLES[table]
+    sources = only or sources
 
     def argv(nudge):
         which = ["--all"] if sources is None else []
@@ -143,6 +157,40 @@ def number(v):
     return math.inf if v is None or v == "inf" else float(v)
 
 
+def signal_values(seeds):
+    """{figure: [value per seed]} of docs/model.md's paper's signals, seeds from each one's quoted seed on."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import model_figures as mf
+    values = {}
+    for k in range(seeds):
+        for fmax, index in mf.PAPER_SIGNALS:
+            dvdt, high, at_max = mf.paper_signals(fmax, index, mf.TRAINING["seed"] * 1000 + index + k)
+            for name, v in ((f"max |dv/dt| at {fmax:g} N (m/s^2)", dvdt), (f"RMS above 100 Hz at {fmax:g} N (mm/s)", high),
+                            (f"FOAW at its maximum window at {fmax:g} N (%)", at_max)):
+                values.setdefault(name, []).append(v)
+        for rate in mf.PITCH_RATES:
+            values.setdefault(f"pitch at {rate / 1000:g} kHz, LVT at 2 N (Hz)", []).append(mf.loop_pitch(rate, k))
+        print(f"sensitivity: signals, seed {k + 1}/{seeds} done", file=sys.stderr, flush=True)
+    return values
+
+
+def signals_part(out, seeds):
+    run_pair(out, "signals", lambda n: ["python", "scripts/sensitivity.py", "--signals-json", str(seeds), "-o",
+                                        str(out / f"signals-nudge{n}.json")])
+    plain, nudged = (json.loads((out / f"signals-nudge{n}.json").read_text()) for n in NUDGES)
+    lines = [f"**The paper's signals** (docs/model.md; `{VARIABLE}=n PYTHONPATH=. python scripts/sensitivity.py "
+             f"--signals-json {seeds} -o FILE`: scripts/model_figures.py's functions on the quoted seed and the next "
+             f"{seeds - 1}):", "",
+             "| figure | quoted seed | median over seeds | range over seeds | one seed's \\|move\\|: median | max |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    for name, p in plain.items():
+        moves = [move(a, b) for a, b in zip(p, nudged[name])]
+        shown = name.replace("|", PIPE)
+        lines.append(f"| {shown} | {p[0]:.4g} | {float(np.median(p)):.4g} | {min(p):.4g}-{max(p):.4g} | "
+                     f"{pct(float(np.median(moves)))} | {pct(max(moves))} |")
+    return "\n".join(lines) + "\n"
+
+
 def pilot_part(out, sets):
     run_pair(out, "pilot", lambda n: ["python", "scripts/pilot.py", "--seeds", sets, "-o", str(out / f"pilot-nudge{n}")])
     data = [pd.read_csv(out / f"pilot-nudge{n}" / "pilot.csv", dtype={"set": str}) for n in NUDGES]
@@ -161,9 +209,16 @@ def pilot_part(out, sets):
     lines.append("| within lower than total, log10 F_max (%) | " + " | ".join(
         f"{a['mean_within_lower_pct']:.0f}, {b['mean_within_lower_pct']:.0f}, "
         f"{abs(b['mean_within_lower_pct'] - a['mean_within_lower_pct']):.0f}" for a, b in figures.values()) + " |")
-    responses = [d["fmax"].to_numpy(float) for d in data]
-    same = int(np.sum(responses[0] == responses[1])) if len(responses[0]) == len(responses[1]) else 0
-    lines += ["", f"{same} of {len(responses[0])} adjustment responses are the same plain and nudged."]
+    key = ["participant", "condition", "trial"]
+    both = data[0].merge(data[1], on=key, suffixes=("", "_nudged"))
+    moved = both.groupby("participant").apply(lambda d: float(np.mean(d["fmax"] != d["fmax_nudged"])),
+                                              include_groups=False)
+    medians = both.groupby(["participant", "condition"]).apply(
+        lambda d: move(float(np.median(d["fmax"])), float(np.median(d["fmax_nudged"]))), include_groups=False)
+    lines += ["", f"Of {len(both)} adjustment responses {int(np.sum(both['fmax'] == both['fmax_nudged']))} are the same "
+              f"plain and nudged. One participant's share of moved responses: median {pct(float(moved.median()))}, "
+              f"largest {pct(float(moved.max()))}; the move of one participant's median in one condition: median "
+              f"{pct(float(medians.median()))}, largest {pct(float(medians.max()))}."]
     return "\n".join(lines) + "\n"
 
 
@@ -174,13 +229,23 @@ def study_part(out, max_sets):
     run_pair(out, "evaluate", lambda n: ["studyapp", "evaluate", str(out / f"data-nudge{n}" / "train"), "--params",
                                          "docs/study/params.toml", "--validation", str(out / f"data-nudge{n}" / "valid"),
                                          "-o", str(out / f"evaluate-nudge{n}"), "--compare-paper"])
+    quoted = tomllib.loads((ROOT / "docs" / "study" / "params.toml").read_text())["objective"]
+    objective = [json.loads((out / f"evaluate-nudge{n}" / "evaluation.json").read_text())["estimators"] for n in NUDGES]
+    lines = [f"**The objective of docs/study/params.toml** (`{VARIABLE}=n studyapp simulate-set -o train`, then "
+             "`studyapp evaluate train --params docs/study/params.toml`; params.toml's [objective] is what `optimise` "
+             "found on its data set):", "",
+             "| estimator | params.toml's | plain | nudged | \\|move\\| | \\|plain / params.toml's - 1\\| |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    for name, value in quoted.items():
+        a, b = objective[0][name]["objective"], objective[1][name]["objective"]
+        lines.append(f"| {name} | {value:.6g} | {a:.6g} | {b:.6g} | {pct(move(a, b))} | {pct(move(value, a))} |")
     found = []
     for n in NUDGES:
         with open(out / f"evaluate-nudge{n}" / "findings.csv", newline="") as f:
             found.append(list(csv.DictReader(f)))
-    lines = [f"**The findings** (`{VARIABLE}=n studyapp simulate-set` (training, validation), then `studyapp evaluate "
+    lines += ["", f"**The findings** (`{VARIABLE}=n studyapp simulate-set` (training, validation), then `studyapp evaluate "
              "train --params docs/study/params.toml --validation valid --compare-paper`):", "",
-             "| finding | verdict plain | verdict nudged | ours plain | ours nudged |", "| --- | --- | --- | --- | --- |"]
+              "| finding | verdict plain | verdict nudged | ours plain | ours nudged |", "| --- | --- | --- | --- | --- |"]
     for a, b in zip(*found):
         lines.append(f"| {a['finding']} | {a['verdict']} | {b['verdict']} | {short(a['ours'])} | {short(b['ours'])} |")
     if max_sets:
@@ -192,7 +257,7 @@ def study_part(out, max_sets):
                   f"--max-sets {max_sets}`; the quoted ones come from the full search, about 20 min per seed):", "",
                   "| estimator | parameter | plain | nudged | \\|move\\| |", "| --- | --- | --- | --- | --- |"]
         for estimator, params in tuned[0].items():
-            if estimator == "provenance" or not isinstance(params, dict):
+            if estimator in ("provenance", "objective") or not isinstance(params, dict):
                 continue
             for name, value in params.items():
                 if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -212,10 +277,16 @@ def main(argv=None):
     parser.add_argument("--parts", default=",".join(PARTS), help=f"comma separated, of {', '.join(PARTS)}")
     parser.add_argument("--seeds", type=int, default=10, help="breakdown seeds 0..N-1 (default 10)")
     parser.add_argument("--tables", default="strokes", help=f"breakdown tables, comma separated, of {', '.join(TABLES)}")
+    parser.add_argument("--sources", help="breakdown: only these sources, comma separated (default: each table's)")
     parser.add_argument("--pilot-seeds", default="1-6,7-12", help="scripts/pilot.py's --seeds (default 1-6,7-12)")
+    parser.add_argument("--resume", action="store_true", help="OUT holds an interrupted run: skip the pairs it finished")
+    parser.add_argument("--signals-json", type=int, metavar="N", help=argparse.SUPPRESS)  # the signals part's worker
     parser.add_argument("--max-sets", type=int, default=0, help="also optimise each training set, this many sets per "
                                                                  "estimator (0, the default: no optimise)")
     args = parser.parse_args(argv)
+    if args.signals_json:
+        Path(args.output).write_text(json.dumps(signal_values(args.signals_json)))
+        return 0
     parts = [p.strip() for p in args.parts.split(",")]
     tables = [t.strip() for t in args.tables.split(",")]
     for label, chosen, allowed in (("--parts", parts, PARTS), ("--tables", tables, TABLES)):
@@ -226,15 +297,18 @@ def main(argv=None):
         parser.exit(2, f"sensitivity: error: --seeds {args.seeds} / --max-sets {args.max_sets}: allowed are "
                        "1 to 100 seeds and 0 or more sets\n")
     out = Path(args.output)
-    if out.exists() and (not out.is_dir() or any(out.iterdir())):
-        parser.exit(2, f"sensitivity: error: -o {out}: not empty; allowed is a new or empty folder\n")
-    (out / "log").mkdir(parents=True)
+    if not args.resume and out.exists() and (not out.is_dir() or any(out.iterdir())):
+        parser.exit(2, f"sensitivity: error: -o {out}: not empty; allowed is a new or empty folder (or --resume)\n")
+    (out / "log").mkdir(parents=True, exist_ok=True)
     command = "PYTHONPATH=. python scripts/sensitivity.py " + shlex.join(
         ["-o", str(out), "--parts", ",".join(parts), "--seeds", str(args.seeds), "--tables", ",".join(tables),
-         "--pilot-seeds", args.pilot_seeds, "--max-sets", str(args.max_sets)])
+         "--pilot-seeds", args.pilot_seeds, "--max-sets", str(args.max_sets)]
+        + (["--sources", args.sources] if args.sources else []))
     sections = [f"Generated on {datetime.date.today().isoformat()} by `{command}`."]
     if "breakdown" in parts:
-        sections += [breakdown_part(out, table, args.seeds) for table in tables]
+        sections += [breakdown_part(out, table, args.seeds, args.sources and args.sources.split(",")) for table in tables]
+    if "signals" in parts:
+        sections.append(signals_part(out, args.seeds))
     if "pilot" in parts:
         sections.append(pilot_part(out, args.pilot_seeds))
     if "study" in parts:
