@@ -247,7 +247,7 @@ def study_part(out, max_sets):
              "train --params docs/study/params.toml --validation valid --compare-paper`):", "",
               "| finding | verdict plain | verdict nudged | ours plain | ours nudged |", "| --- | --- | --- | --- | --- |"]
     for a, b in zip(*found):
-        lines.append(f"| {a['finding']} | {a['verdict']} | {b['verdict']} | {short(a['ours'])} | {short(b['ours'])} |")
+        lines.append(f"| {short(a['finding'], 200)} | {a['verdict']} | {b['verdict']} | {short(a['ours'])} | {short(b['ours'])} |")
     if max_sets:
         run_pair(out, "optimise", lambda n: ["studyapp", "optimise", str(out / f"data-nudge{n}" / "train"), "-o",
                                              str(out / f"optimise-nudge{n}.toml"), "--seed", "0", "--workers", "1",
@@ -267,8 +267,9 @@ def study_part(out, max_sets):
 
 
 def short(text, n=60):
+    """``text`` on one line, at most ``n`` characters, its | escaped for a Markdown cell."""
     text = " ".join(str(text).split())
-    return text if len(text) <= n else text[:n - 3] + "..."
+    return (text if len(text) <= n else text[:n - 3] + "...").replace("|", PIPE)
 
 
 def main(argv=None):

@@ -47,6 +47,13 @@ REDONE = {("strokes", 5000.0, "seconds"): ("TRUE", "LVT", "LOWPASS", "KALLEV"),
 TABLES = list(REDONE)  # the tables docs/breakdown.md holds, in its order (issue 30: bowing at 5 and 48 kHz)
 
 
+def seeds_of(row, args):
+    """The row's seeds: its ``seeds_used`` or, in a table made before that column, the command's."""
+    if "seeds_used" in row:
+        return [int(s) for s in row["seeds_used"].split(";")]
+    return list(range(args.first_seed, args.first_seed + args.seeds))
+
+
 def key(args):
     return args.gesture, args.rate, args.windows
 
