@@ -132,6 +132,8 @@ GENERATORS_AFTER_BREAKDOWN = (
     Generator("pilot", "docs/experiment.md (The simulated participant: the in-silico pilot), docs/study/pilot.csv",
               ((PY, "scripts/pilot.py", "--seeds", "1-6,7-12", "-o", "{out}/pilot"),),
               {"pilot/pilot.csv": "docs/study/pilot.csv"}),
+    Generator("blas-kernels", "docs/reproducibility.md (The same bits under every BLAS kernel)",
+              ((PY, "scripts/blas_kernels.py"),)),
     Generator("sensitivity", "docs/reproducibility.md (Sensitivity to one rounding); scripts/quoted_figures.py's spreads",
               ((PY, "scripts/sensitivity.py", "-o", "{out}/sensitivity", "--parts", "breakdown,signals,pilot,study",
                 "--seeds", "10", "--tables", "strokes,hold"),

@@ -44,7 +44,9 @@ best, shrunk to the strip's width, reaches the pocket with a chance of order
 F_g, as judged, was within ``ELITE * max(|F_best|, 1)`` of the lane's best.
 With ``ridge`` f > 0, once the elite holds ``MIN_ELITE`` points, a proposal is
 with probability f a ridge draw, along the elite's principal axis u (the
-eigenvector of its covariance with the largest eigenvalue):
+eigenvector of its covariance with the largest eigenvalue, its largest
+component positive; principal_axis.py computes it without BLAS or LAPACK, so
+the draws are the same bits on every machine):
 
     x = c + t u + z,   t ~ U(t_min - s/2, t_max + s/2),   z ~ N(0, lambda_min I) less its u part,
 
@@ -61,7 +63,11 @@ The search is pure: ``propose()`` draws from its own seeded generator and
 ``report(params, improved, ...)`` updates it; it never evaluates anything.
 """
 
+import math
+
 import numpy as np
+
+from studyapp.evaluation import principal_axis
 
 START_RADIUS = 0.25
 MIN_RADIUS = 1e-4
@@ -126,19 +132,18 @@ class AdaptiveSearch:
         """(u, t_low, t_high, width) of the lane's elite (module docstring), or None while it has too few points."""
         if self.ridge <= 0.0 or len(self.elite) < MIN_ELITE:
             return None
-        points = np.array(self.elite)[:, :-1]
-        values, vectors = np.linalg.eigh(np.atleast_2d(np.cov(points.T)))
-        u = vectors[:, -1]
-        t = (points - self.centre) @ u
+        points = [p[:-1] for p in self.elite]
+        u, smallest = principal_axis.principal_axis(points)
+        t = principal_axis.projections(points, self.centre, u)
         length = max(float(t.max() - t.min()), MIN_RADIUS)
-        width = max(float(np.sqrt(max(values[0], 0.0))), MIN_RADIUS)
-        return u, float(t.min()) - length / 2.0, float(t.max()) + length / 2.0, width
+        width = max(math.sqrt(max(smallest, 0.0)), MIN_RADIUS)
+        return np.array(u), float(t.min()) - length / 2.0, float(t.max()) + length / 2.0, width
 
     def _along(self, u, low, high, width):
         x = self.centre + self.rng.uniform(low, high) * u
         if len(u) > 1:
             z = self.rng.normal(0.0, width, len(u))
-            x = x + z - (z @ u) * u
+            x = x + z - principal_axis.dot(z, u) * u
         return _reflect(x)
 
     def _draw(self, point):

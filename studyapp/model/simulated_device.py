@@ -29,8 +29,10 @@ hand and the mechanics feel u[k]. The default link is ideal: u[k] = F[k].
 
 Over one step the pair moves exactly
 (the zero-order-hold discretisation, Phi = exp(A T) and
-Gamma = int_0^T exp(A s) ds B, computed once with scipy.linalg.expm), so the
-stiff grip is stable at every rate:
+Gamma = int_0^T exp(A s) ds B, computed once by zoh.py in a fixed order of
+float operations, not with scipy.linalg.expm, whose BLAS products round
+differently on different CPUs: issue 39), so the stiff grip is stable at
+every rate:
 
     s[k+1] = Phi s[k] + Gamma (u[k], F_arm[k]).
 
@@ -65,10 +67,9 @@ puts the handle at rest at 0, keeping every output finite, and sets ``fault``.
 
 import numpy as np
 from numba import njit
-from scipy.linalg import expm
 
 from studyapp.estimators.dispatch import step_guarded
-from studyapp.model import calibration, contact_mic, control, hand, nudge as rounding, sensors, stability
+from studyapp.model import calibration, contact_mic, control, hand, nudge as rounding, sensors, stability, zoh
 from studyapp.model.device import DeviceLimits, HapticDevice
 from studyapp.model.gestures import Hold
 from studyapp.model.link import IDEAL, Link, step as link_step
@@ -86,16 +87,13 @@ N_STATE = 7
 
 def discretise(m_e, m_h, k_g, b_g, t):
     """(Phi, Gamma) of the end-effector and hand on the grip over a step of ``t`` s (zero-order hold)."""
-    a = np.array([[0.0, 1.0, 0.0, 0.0],
-                  [-k_g / m_e, -b_g / m_e, k_g / m_e, b_g / m_e],
-                  [0.0, 0.0, 0.0, 1.0],
-                  [k_g / m_h, b_g / m_h, -k_g / m_h, -b_g / m_h]])
-    b = np.array([[0.0, 0.0], [1.0 / m_e, 0.0], [0.0, 0.0], [0.0, 1.0 / m_h]])
-    big = np.zeros((6, 6))
-    big[:4, :4] = a * t
-    big[:4, 4:] = b * t
-    e = expm(big)
-    return e[:4, :4], e[:4, 4:]
+    a = [[0.0, 1.0, 0.0, 0.0],
+         [-k_g / m_e, -b_g / m_e, k_g / m_e, b_g / m_e],
+         [0.0, 0.0, 0.0, 1.0],
+         [k_g / m_h, b_g / m_h, -k_g / m_h, -b_g / m_h]]
+    b = [[0.0, 0.0], [1.0 / m_e, 0.0], [0.0, 0.0], [0.0, 1.0 / m_h]]
+    phi, gamma = zoh.discretise(a, b, float(t))
+    return np.array(phi), np.array(gamma)
 
 
 @njit(cache=True, inline="always")

@@ -46,8 +46,8 @@ def test_leastsq_equals_savgol(rate, order, window):
     np.testing.assert_allclose(out[window - 1:], expected[window - 1:], rtol=0, atol=1e-9 * scale)
 
 
-def exact_taps(order, window):
-    """LEASTSQ's taps per sample in exact rational arithmetic: taps[j] multiplies x_{k-j}.
+def exact_taps_fractions(order, window):
+    """LEASTSQ's taps per sample in exact rational arithmetic (fractions): taps[j] multiplies x_{k-j}.
 
     The degree-``order`` least-squares polynomial through x_{k-j} at t = -j (j = 0 .. M-1) has
     coefficients c = G^-1 A^T x with G = A^T A, A[j, a] = (-j)^a; its derivative at t = 0 is c_1,
@@ -64,7 +64,12 @@ def exact_taps(order, window):
                 f = rows[r][c] / rows[c][c]
                 rows[r] = [x - f * y for x, y in zip(rows[r], rows[c])]
     w = [rows[a][n] / rows[a][a] for a in range(n)]  # row 1 of G^-1 (G is symmetric)
-    return np.array([float(sum(w[a] * (-j) ** a for a in range(n))) for j in range(window)])
+    return [sum(w[a] * (-j) ** a for a in range(n)) for j in range(window)]
+
+
+def exact_taps(order, window):
+    """The exact taps rounded to floats."""
+    return np.array([float(t) for t in exact_taps_fractions(order, window)])
 
 
 @pytest.mark.parametrize("order, window", [(1, 2), (2, 33), (4, 512), (5, 400), (6, 257), (6, 512)])
@@ -75,6 +80,31 @@ def test_leastsq_taps_equal_the_exact_rational_taps(order, window):
     exact = exact_taps(order, window)
     scale = np.abs(exact).max()
     np.testing.assert_allclose(taps(order, window, 1.0), exact, rtol=0, atol=1e-13 * scale)
+
+
+@pytest.mark.parametrize("order, window", [(1, 2), (2, 33), (3, 100), (6, 7), (6, 512)])
+def test_leastsq_taps_are_the_exact_taps_correctly_rounded(order, window):
+    """Issue 39: each tap is the exact rational tap times the rate, rounded once, so its bits depend on no BLAS."""
+    from fractions import Fraction
+
+    from studyapp.estimators.leastsq import taps
+
+    exact = exact_taps_fractions(order, window)
+    for rate in (1000.0, 5000.0, 44_100.0, 96_000.0):
+        assert taps(order, window, rate).tolist() == [float(t * Fraction(rate)) for t in exact]
+
+
+@pytest.mark.parametrize("order, window", [(1, 2), (2, 33), (4, 257), (6, 7), (6, 100)])
+def test_leastsq_taps_equal_numpys_pseudo_inverse_to_1e_13(order, window):
+    """The taps as numpy's pinv of the scaled Vandermonde matrix gives them (the code before issue 39; its bits
+    depend on the CPU's BLAS kernels): at most 1.8e-14 of the largest tap apart (measured 2026-11-28)."""
+    from studyapp.estimators.leastsq import taps
+
+    h = (window - 1) / 2.0
+    a = np.vander((np.arange(window) - h) / h, order + 1, increasing=True)
+    pinv = (np.arange(order + 1.0) @ np.linalg.pinv(a))[::-1] * (5000.0 / h)
+    ours = taps(order, window, 5000.0)
+    assert np.abs(ours - pinv).max() <= 1e-13 * np.abs(pinv).max()
 
 
 @pytest.mark.parametrize("rate", [1000.0, 96_000.0])
