@@ -1,7 +1,7 @@
 """How far each quoted figure moves under one rounding step of the initial state (issue 39, item 2).
 
-    PYTHONPATH=. python scripts/sensitivity.py -o OUT [--parts breakdown,pilot,study] [--seeds 10]
-        [--tables strokes,hold,strokes-48k] [--sources S,...] [--pilot-seeds 1-6,7-12] [--max-sets N]
+    PYTHONPATH=. python scripts/sensitivity.py -o OUT [--parts breakdown,signals,pilot,study] [--seeds 10]
+        [--tables strokes,hold,strokes-48k] [--sources S,...] [--pilot-seeds 1-6,7-12] [--max-sets N] [--resume]
 
 Every figure is computed twice by the command docs/ quotes it from, once plain
 and once with the environment's ``STUDYAPP_NUDGE=1`` (studyapp/model/nudge.py:
@@ -24,7 +24,8 @@ holds the table this prints, dated, with the command.
   |move|.
 - ``study``: ``studyapp simulate-set`` (training and validation) plain and
   nudged, ``studyapp evaluate`` of docs/study/params.toml on each with
-  ``--compare-paper``: each finding's verdict plain and nudged; and, with
+  ``--compare-paper``: each estimator's objective (beside params.toml's) and
+  each finding's verdict, plain and nudged; and, with
   ``--max-sets N`` (a reduced budget: the full search is about 20 min per seed),
   ``studyapp optimise --seed 0 --max-sets N`` on each training set: each Table 1
   parameter's value and |move|.
@@ -32,7 +33,10 @@ holds the table this prints, dated, with the command.
 The pairs of commands run two at a time (plain beside nudged). Progress
 (part, command, time so far) goes to stderr, each command's own output to
 ``OUT/log/``. Writes ``OUT/sensitivity.md`` (and prints it). ``OUT`` must be new
-or empty.
+or empty; ``--resume`` goes on in the ``OUT`` of an interrupted run, skipping the
+pairs it finished (each leaves ``OUT/log/NAME.done``). ``make figures
+ONLY=sensitivity`` runs the command docs/reproducibility.md quotes; about 1-2 h
+of wall time on the shared two-core machine, most of it the pilot's sessions.
 """
 
 import argparse

@@ -5,11 +5,13 @@ command's settings (rate, gesture, duration) and the table's ``seeds_used``
 column say how to redo a row. The summaries (median, min, max) are checked
 against the quoted per-seed values.
 
-A few rows are checked on their first seed, as the smallest run that keeps
-the table's promise: the loop is stable at F / (1 + tol) and broken at
-F x (1 + tol), F the quoted value; two trials where the search takes eleven
-(a quoted "<= 0.05" is broken at the search's bottom, "> 200" stable at its
-top: one trial). ``tol`` is the search's own precision, sqrt(1.02) - 1
+A few rows are redone on their first seed (a search of 11 trials, or 1 where
+the quoted value is the search's bottom: the smallest run that keeps the
+table's promise; every seed of every table is ``make figures CHECK=1``) and
+held to the quoted value within ``tol``. (Two trials, stable just below and
+broken just above, would be cheaper but assume the verdict monotonic in
+F_max near the edge: at 48 kHz LVT on seed 0 is broken at 10.5 N and stable
+at 11.0 N.) ``tol`` is the search's own precision, sqrt(1.02) - 1
 (about 1 %: it returns the geometric middle of a bracket at most 1.02 wide,
 which also covers the table's three significant figures), plus the largest
 move of one seed's F_max under one rounding step of the initial
@@ -37,7 +39,8 @@ from studyapp.model import breakdown
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "breakdown.md"
 sys.path.insert(0, str(ROOT / "scripts"))
-from quoted_figures import breakdown_settings as settings, breakdown_tables as tables, breakdown_tolerance, number  # noqa: E402
+from quoted_figures import (  # noqa: E402
+    breakdown_settings as settings, breakdown_tables as tables, breakdown_tolerance, number, within)
 
 # (gesture, rate, windows) -> the sources checked on the table's first seed
 REDONE = {("strokes", 5000.0, "seconds"): ("TRUE", "LVT", "LOWPASS", "KALLEV"),
@@ -104,19 +107,9 @@ def redo_cases():
     return cases
 
 
-def broken(source, args, seed, fmax):
-    return breakdown.is_broken(source, fmax, rate=args.rate, gesture=args.gesture, duration=args.duration, seed=seed,
-                               windows=args.windows)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("source, args, seed, value", redo_cases())
 def test_a_quoted_row_holds_on_its_seed(source, args, seed, value):
-    if value <= breakdown.LOW:
-        assert broken(source, args, seed, breakdown.LOW), (source, seed)
-    elif math.isinf(value):
-        assert not broken(source, args, seed, breakdown.HIGH), (source, seed)
-    else:
-        tol = breakdown_tolerance(args.gesture, args.rate)
-        assert not broken(source, args, seed, value / (1.0 + tol)), (source, seed, value, tol)
-        assert broken(source, args, seed, value * (1.0 + tol)), (source, seed, value, tol)
+    again = breakdown.breakdown_fmax(source, rate=args.rate, gesture=args.gesture, duration=args.duration, seed=seed,
+                                     windows=args.windows)
+    assert within(again, value, breakdown_tolerance(args.gesture, args.rate)), (source, seed, again, value)
