@@ -51,3 +51,15 @@ def test_every_spread_is_measured():
                 *qf.RESPONSE_ROUNDING.values(), qf.OBJECTIVE_ROUNDING]
     assert all(isinstance(s, float) and 0.0 <= s < 1.0 for s in relative), relative
     assert 0.0 <= qf.PILOT_ROUNDING["rho"] <= 2.0 and 0.0 <= qf.PILOT_ROUNDING["share"] <= 100.0
+
+
+def test_the_pilot_table_holds_within_its_spread():
+    _, _, quoted = qf.pilot_table((ROOT / "docs" / "experiment.md").read_text())
+    assert qf.compare_pilot(quoted, quoted) == []
+    moved = {label: list(cells) for label, cells in quoted.items()}
+    moved["LVT median (N)"][0] = f"{float(quoted['LVT median (N)'][0]) * 1.015:.3g}"
+    assert qf.compare_pilot(quoted, moved) == []
+    moved["LVT median (N)"][0] = f"{float(quoted['LVT median (N)'][0]) * 1.05:.3g}"
+    moved["rho against the paper's Fig. 7 order"][1] = "0.78"
+    assert [p.split(":")[0] for p in qf.compare_pilot(quoted, moved)] == [
+        "LVT median (N), set 1", "rho against the paper's Fig. 7 order, set 2"]
