@@ -188,9 +188,10 @@ def check_breakdown(gen, folder):
     ((_, command, new_rows),) = qf.breakdown_tables(made.read_text())
     args = qf.breakdown_settings(command)
     for _, quoted_command, rows in qf.breakdown_tables((ROOT / "docs" / "breakdown.md").read_text()):
-        if quoted_command.split(" -o ")[0] == command.split(" -o ")[0]:
+        quoted = qf.breakdown_settings(quoted_command)
+        if vars(quoted) | {"output": None} == vars(args) | {"output": None}:  # the same settings, defaults filled
             return qf.compare_breakdown(rows, new_rows, args.gesture, args.rate)
-    return [f"no table of docs/breakdown.md has the command {command}"]
+    return [f"no table of docs/breakdown.md has the settings of {command}"]
 
 
 def check_signals(gen, folder):

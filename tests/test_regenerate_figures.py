@@ -117,3 +117,18 @@ def test_check_compares_a_figure_with_docs_within_its_measured_spread(tmp_path, 
         assert f"| other | {today} | ok, not compared (no measured spread) |" in summary
     err = capsys.readouterr().err
     assert f"moved beyond its spread: dvdt_12.1: {dvdt * 1.2:.0f} against the quoted {quoted['dvdt_12.1']}" in err
+
+
+def test_check_finds_the_docs_table_by_its_settings_not_its_spelling(tmp_path):
+    text = (ROOT / "docs" / "breakdown.md").read_text()
+    start = text.index("--gesture hold")
+    start = text.rindex("Generated on", 0, start)
+    table = text[start:text.index("\n\n", text.index("| source", start))]
+    spelled = table.replace("--duration 5 -o", "--duration 5 --windows seconds -o")
+    assert spelled != table
+    (tmp_path / "x.md").write_text(spelled + "\n")
+    gen = rf.Generator("breakdown-hold", "docs/breakdown.md", (("studyapp", "breakdown", "-o", "{out}/x.md"),))
+    assert rf.check_breakdown(gen, tmp_path) == []
+    (tmp_path / "x.md").write_text(spelled.replace("| LVT | 5000 | hold | 5 | 5.81", "| LVT | 5000 | hold | 5 | 6.5")
+                                   .replace("5.81; 5.81; 5.81; 5.81; 5.81", "6.5; 5.81; 5.81; 5.81; 5.81") + "\n")
+    assert [p.split(":")[0] for p in rf.check_breakdown(gen, tmp_path)] == ["LVT seed 0"]
