@@ -149,10 +149,11 @@ def band_rms(source, fmax):
     return [1e3 * np.sqrt(np.sum(p[(f >= lo) & (f < hi)]) * (f[1] - f[0])) for lo, hi in BANDS]
 
 
-def paper_signals(fmax, index):
+def paper_signals(fmax, index, seed=None):
     """(max |dv/dt| m/s^2, mm/s RMS above 100 Hz, % of samples at FOAW's maximum window) of ``velocity_lvt``
-    on the training set's recording ``index`` (LVT in the loop at ``fmax`` N, 7 s)."""
-    rec = simulate(fmax, rate=RATE, duration=7.0, source="LVT", seed=TRAINING["seed"] * 1000 + index)
+    on the training set's recording ``index`` (LVT in the loop at ``fmax`` N, 7 s; ``seed``: another seed)."""
+    seed = TRAINING["seed"] * 1000 + index if seed is None else seed
+    rec = simulate(fmax, rate=RATE, duration=7.0, source="LVT", seed=seed)
     v = rec.columns["velocity_lvt"]
     hp = signal.sosfilt(signal.butter(2, 100.0, "high", fs=RATE, output="sos"), v)
     window = window_sizes(rec.columns["position"], TABLE1["FOAW"]["window"], TABLE1["FOAW"]["margin"])
@@ -160,9 +161,9 @@ def paper_signals(fmax, index):
             float(100 * np.mean(window == TABLE1["FOAW"]["window"])))
 
 
-def loop_pitch(rate):
+def loop_pitch(rate, seed=0):
     """The string's pitch (Hz, after 0.25 s) with LVT at 2 N on 5 s of strokes at ``rate``."""
-    b = loop("LVT", 2.0, "strokes", rate).run(int(5 * rate))
+    b = loop("LVT", 2.0, "strokes", rate, seed).run(int(5 * rate))
     return pitch(b["string_velocity"][int(0.25 * rate):], rate)
 
 

@@ -1,7 +1,7 @@
 """Regenerate every figure docs/ quotes: each documented generator, in order, dated (issue 30, item 6).
 
-    make figures                                              # = the line below, OUT = figures/<UTC time>
-    PYTHONPATH=. python scripts/regenerate_figures.py [-o OUT] [--only NAME ...] [--list] [--into-docs]
+    make figures [CHECK=1]                                    # = the line below, OUT = figures/<UTC time>
+    PYTHONPATH=. python scripts/regenerate_figures.py [-o OUT] [--only NAME ...] [--list] [--into-docs] [--check]
 
 Runs the generators of ``GENERATORS`` (docs/figures.md lists each with the
 figures it gives and where docs/ quotes them) one after the other, each
@@ -20,10 +20,20 @@ docs/ shows, once the generator has succeeded; figures quoted in prose are
 updated by hand, and the quoted-figure tests (tests/test_quoted_*.py) fail
 while one no longer matches the code on its quoted seeds.
 
+``--check`` also compares each regenerated figure that has a measured
+one-rounding spread with the one docs/ quotes (scripts/quoted_figures.py:
+every seed's F_max of the breakdown tables, the paper's signals, the pilot's
+table, the study's findings and objective) and says, per generator, whether
+it holds or which figures moved beyond their spread; it exits 1 if one did.
+It is the full-size check behind the quoted-figure tests, which run each
+promise once at the smallest size that still checks it: run it before a
+change of docs/ or of the model.
+
 ``OUT`` must be new or empty: nothing is written over.
 """
 
 import argparse
+import csv
 import datetime
 import glob
 import os
@@ -35,6 +45,8 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import quoted_figures as qf
 
 ROOT = Path(__file__).resolve().parents[1]
 PY = "python"  # shown in the commands; run with this interpreter
@@ -122,6 +134,11 @@ GENERATORS_AFTER_BREAKDOWN = (
               {"pilot/pilot.csv": "docs/study/pilot.csv"}),
     Generator("blas-kernels", "docs/reproducibility.md (The same bits under every BLAS kernel)",
               ((PY, "scripts/blas_kernels.py"),)),
+    Generator("sensitivity", "docs/reproducibility.md (Sensitivity to one rounding); scripts/quoted_figures.py's spreads",
+              ((PY, "scripts/sensitivity.py", "-o", "{out}/sensitivity", "--parts", "breakdown,signals,pilot,study",
+                "--seeds", "10", "--tables", "strokes,hold"),
+               (PY, "scripts/sensitivity.py", "-o", "{out}/sensitivity-48k", "--parts", "breakdown", "--seeds", "10",
+                "--tables", "strokes-48k", "--sources", "LVT"))),
 )
 
 
@@ -164,6 +181,46 @@ def run_generator(gen, out, log):
     return True
 
 
+def check_breakdown(gen, folder):
+    """The regenerated table against docs/breakdown.md's with the same command, seed by seed."""
+    (words,) = gen.steps
+    made = folder / Path(words[-1].replace("{out}", str(folder))).name
+    ((_, command, new_rows),) = qf.breakdown_tables(made.read_text())
+    args = qf.breakdown_settings(command)
+    for _, quoted_command, rows in qf.breakdown_tables((ROOT / "docs" / "breakdown.md").read_text()):
+        quoted = qf.breakdown_settings(quoted_command)
+        if vars(quoted) | {"output": None} == vars(args) | {"output": None}:  # the same settings, defaults filled
+            return qf.compare_breakdown(rows, new_rows, args.gesture, args.rate)
+    return [f"no table of docs/breakdown.md has the settings of {command}"]
+
+
+def check_signals(gen, folder):
+    quoted = qf.quoted_signals(qf.signals_paragraph((ROOT / "docs" / "model.md").read_text()))
+    return qf.compare_signals(quoted, qf.printed_signals((folder / "output.md").read_text()))
+
+
+def check_pilot(gen, folder):
+    _, _, quoted = qf.pilot_table((ROOT / "docs" / "experiment.md").read_text())
+    _, _, new = qf.pilot_table((folder / "pilot" / "pilot.md").read_text())
+    return qf.compare_pilot(quoted, new)
+
+
+def check_study(gen, folder):
+    with open(folder / "results" / "findings.csv", newline="") as f:
+        new = list(csv.reader(f))[1:]
+    with open(ROOT / "docs" / "study" / "findings.csv", newline="") as f:
+        quoted = list(csv.reader(f))[1:]
+    return [f"finding {a[0]!r}: {a[-1]} against the quoted {b[-1]}" for a, b in zip(new, quoted)
+            if a[-1] != b[-1] and a[0] not in qf.FLIPPING_FINDINGS]
+
+
+def check_of(gen):
+    """The comparison of ``gen``'s figures with docs/ (None: no figure of it has a measured spread)."""
+    if gen.name.startswith("breakdown-"):
+        return check_breakdown
+    return {"model-signals": check_signals, "pilot": check_pilot, "study": check_study}.get(gen.name)
+
+
 def main(argv=None):
     every = generators()
     names = [g.name for g in every]
@@ -172,6 +229,8 @@ def main(argv=None):
     parser.add_argument("--only", nargs="+", metavar="NAME", help="these generators only (see --list)")
     parser.add_argument("--list", action="store_true", help="list the generators and their commands; run nothing")
     parser.add_argument("--into-docs", action="store_true", help="copy each generated file over the docs/ file it regenerates")
+    parser.add_argument("--check", action="store_true",
+                        help="compare the regenerated figures with docs/ within their measured one-rounding spread")
     args = parser.parse_args(argv)
     unknown = [n for n in args.only or [] if n not in names]
     if unknown:
@@ -198,11 +257,23 @@ def main(argv=None):
             log.write(f"Generated on {today} by `{commands}`.\n\n")
             ok = run_generator(gen, folder, log)
         seconds = time.monotonic() - t0
+        status = "ok" if ok else "FAILED"
+        if ok and args.check:
+            compare = check_of(gen)
+            problems = compare(gen, folder) if compare else None
+            status = "ok, not compared (no measured spread)" if problems is None else (
+                "ok, holds" if not problems else f"MOVED ({len(problems)})")
+            with open(folder / "output.md", "a") as log:
+                log.write("".join(f"- moved beyond its spread: {p}\n" for p in problems or []))
+            for p in problems or []:
+                print(f"figures:   moved beyond its spread: {p}", file=sys.stderr, flush=True)
+            if problems:
+                failed.append(gen.name)
         if ok and args.into_docs:
             for made, doc in gen.files.items():
                 shutil.copyfile(folder / made, ROOT / doc)
-        summary.append(f"| {gen.name} | {today} | {'ok' if ok else 'FAILED'} | {seconds:.0f} | `{commands}` |")
-        print(f"figures:   {gen.name} {'done' if ok else 'FAILED (see ' + str(folder / 'output.md') + ')'} in {seconds:.0f} s",
+        summary.append(f"| {gen.name} | {today} | {status} | {seconds:.0f} | `{commands}` |")
+        print(f"figures:   {gen.name} {status if ok else 'FAILED (see ' + str(folder / 'output.md') + ')'} in {seconds:.0f} s",
               file=sys.stderr, flush=True)
         if not ok:
             failed.append(gen.name)

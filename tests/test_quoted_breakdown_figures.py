@@ -1,60 +1,53 @@
-"""docs/breakdown.md's tables still give what the code gives on the seeds they quote (issue 30, item 7).
+"""docs/breakdown.md's tables hold for the code, within what one rounding moves them (issues 30 item 7, 39).
 
 Each table is headed by "Generated on DATE by `studyapp breakdown ...`"; the
 command's settings (rate, gesture, duration) and the table's ``seeds_used``
-column say how to redo a row. A few rows are redone on one quoted seed each
-(the search is deterministic on a seed) and compared with the quoted value
-within the search's own precision: it returns the geometric middle of a
-bracket at most 1.02 wide, so sqrt(1.02) - 1 (about 1 %), which also covers
-the table's rounding to three significant figures. The summaries (median,
-min, max) are checked against the quoted per-seed values.
+column say how to redo a row. The summaries (median, min, max) are checked
+against the quoted per-seed values.
+
+A few rows are redone on their first seed (a search of 11 trials, or 1 where
+the quoted value is the search's bottom: the smallest run that keeps the
+table's promise; every seed of every table is ``make figures CHECK=1``) and
+held to the quoted value within ``tol``. (Two trials, stable just below and
+broken just above, would be cheaper but assume the verdict monotonic in
+F_max near the edge: at 48 kHz LVT on seed 0 is broken at 10.5 N and stable
+at 11.0 N.) ``tol`` is the search's own precision, sqrt(1.02) - 1
+(about 1 %: it returns the geometric middle of a bracket at most 1.02 wide,
+which also covers the table's three significant figures), plus the largest
+move of one seed's F_max under one rounding step of the initial
+state, over the table's sources and seeds 0-9, as docs/reproducibility.md
+("Sensitivity to one rounding") measured it on 2026-11-28 with
+``PYTHONPATH=. python scripts/sensitivity.py -o OUT --parts breakdown --seeds 10
+--tables strokes,hold`` (and ``--tables strokes-48k --sources LVT``). The
+loop amplifies one rounding (another BLAS, libm or CPU gives one) into a
+few per cent of one seed's breakdown, so a tighter test would hold one
+machine's last bits, not the model. The spreads and the tables' parser are
+scripts/quoted_figures.py's (``BREAKDOWN_ROUNDING``). The full searches on every quoted seed
+are ``make figures CHECK=1`` (scripts/regenerate_figures.py --check).
 """
 
-import argparse
 import datetime
 import math
-import re
-import shlex
 import statistics
+import sys
 from pathlib import Path
 
 import pytest
 
 from studyapp.model import breakdown
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "breakdown.md"
-PRECISION = math.sqrt(1.02) - 1.0
-# (gesture, rate, windows) -> the sources redone on the table's first seed
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "breakdown.md"
+sys.path.insert(0, str(ROOT / "scripts"))
+from quoted_figures import (  # noqa: E402
+    breakdown_settings as settings, breakdown_tables as tables, breakdown_tolerance, number, within)
+
+# (gesture, rate, windows) -> the sources checked on the table's first seed
 REDONE = {("strokes", 5000.0, "seconds"): ("TRUE", "LVT", "LOWPASS", "KALLEV"),
-          ("strokes", 48000.0, "seconds"): ("TRUE", "LVT", "FOAW", "LEASTSQ"),
-          ("strokes", 48000.0, "samples"): ("LVT", "FOAW", "LEASTSQ"),
+          ("strokes", 48000.0, "seconds"): ("LVT",),
+          ("strokes", 48000.0, "samples"): ("FOAW",),
           ("hold", 5000.0, "seconds"): ("LVT", "KALPOS")}
 TABLES = list(REDONE)  # the tables docs/breakdown.md holds, in its order (issue 30: bowing at 5 and 48 kHz)
-
-
-def number(cell):
-    """A Markdown cell's F_max: "> 200" is inf, "<= 0.05" the search's bottom."""
-    cell = cell.strip()
-    if cell.startswith(">"):
-        return math.inf
-    return float(cell.lstrip("<= "))
-
-
-def settings(command):
-    """The settings of a quoted ``studyapp breakdown`` command, the CLI's defaults where it leaves them out."""
-    words = shlex.split(command)
-    assert words[:2] == ["studyapp", "breakdown"], command
-    p = argparse.ArgumentParser()
-    p.add_argument("--all", action="store_true")
-    p.add_argument("--source")
-    p.add_argument("--rate", type=float, default=5000.0)
-    p.add_argument("--seeds", type=int, default=5)
-    p.add_argument("--first-seed", type=int, default=0)
-    p.add_argument("--gesture", default="strokes")
-    p.add_argument("--duration", type=float, default=5.0)
-    p.add_argument("--windows", default="seconds")
-    p.add_argument("-o", "--output")
-    return p.parse_args(words[2:])
 
 
 def seeds_of(row, args):
@@ -62,22 +55,6 @@ def seeds_of(row, args):
     if "seeds_used" in row:
         return [int(s) for s in row["seeds_used"].split(";")]
     return list(range(args.first_seed, args.first_seed + args.seeds))
-
-
-def tables(text):
-    """[(date, command, [row dict])] for each "Generated on DATE by `COMMAND`" and the table after it."""
-    found = []
-    for match in re.finditer(r"Generated on (\d{4}-\d\d-\d\d) by `([^`]+)`", text):
-        lines = text[match.end():].splitlines()
-        start = next(i for i, line in enumerate(lines) if line.startswith("|"))
-        block = []
-        for line in lines[start:]:
-            if not line.startswith("|"):
-                break
-            block.append([cell.strip() for cell in line.strip().strip("|").split("|")])
-        header, rows = block[0], block[2:]
-        found.append((match.group(1), match.group(2), [dict(zip(header, row)) for row in rows]))
-    return found
 
 
 def key(args):
@@ -132,7 +109,7 @@ def redo_cases():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("source, args, seed, value", redo_cases())
-def test_a_quoted_row_is_what_the_code_gives_on_its_seed(source, args, seed, value):
+def test_a_quoted_row_holds_on_its_seed(source, args, seed, value):
     again = breakdown.breakdown_fmax(source, rate=args.rate, gesture=args.gesture, duration=args.duration, seed=seed,
                                      windows=args.windows)
-    assert again == pytest.approx(value, rel=PRECISION), (source, seed, again, value)
+    assert within(again, value, breakdown_tolerance(args.gesture, args.rate)), (source, seed, again, value)

@@ -6,14 +6,21 @@ is four commands: ``simulate-set`` (train and validation), ``optimise``
 params.toml and the two CSVs, and docs/evaluation.md prints the CSVs as
 Markdown by the script it shows. The normal suite checks that chain's cheap
 links: ``paper_comparison.csv``'s ``ours`` is params.toml's value, and each
-CSV row is in docs/evaluation.md as that script prints it. The slow tests redo the data set and check it is
-the one params.toml was tuned on (its ``recording_sha256``), and that
-``evaluate`` of params.toml on it gives findings.csv. ``optimise`` itself
-(minutes of CPU) is left to ``make figures ONLY=study``.
+CSV row is in docs/evaluation.md as that script prints it. The slow tests redo the data set once (training
+and validation, shared) and ``evaluate`` params.toml on it: the data set is the one params.toml was tuned
+on when every recording params.toml names is made and params.toml's ``[objective]`` (what ``optimise``
+found on its recordings) is what ``evaluate`` gives within the objective's measured one-rounding spread;
+and the findings' verdicts are findings.csv's, but for those that one rounding step of the initial state
+was measured to flip. Neither holds bits: the recordings' SHA-256 (params.toml's ``recording_sha256``)
+differ on a machine whose BLAS or libm rounds once differently, and the stick-slip loop makes that a
+few per cent of a recording near breakdown. The spreads are docs/reproducibility.md's ("Sensitivity to
+one rounding", 2026-11-28, ``PYTHONPATH=. python scripts/sensitivity.py -o OUT --parts study``),
+kept in scripts/quoted_figures.py (``OBJECTIVE_ROUNDING``, ``FLIPPING_FINDINGS``). ``optimise`` itself
+(about 20 min of CPU per seed) is left to ``make figures ONLY=study CHECK=1``.
 """
 
 import csv
-import hashlib
+import json
 import subprocess
 import sys
 import tomllib
@@ -23,6 +30,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = ROOT / "docs" / "study"
+sys.path.insert(0, str(ROOT / "scripts"))
+from quoted_figures import FLIPPING_FINDINGS, OBJECTIVE_ROUNDING, within  # noqa: E402
 
 
 def rows(name):
@@ -60,26 +69,38 @@ def test_evaluation_md_prints_the_csvs_as_its_script_does():
             assert "| " + " | ".join(printed(c) for c in row) + " |" in section, (name, row[:2])
 
 
-def simulate_set(folder, *extra):
-    subprocess.run([sys.executable, "-m", "studyapp", "simulate-set", "-o", str(folder), *extra],
-                   check=True, capture_output=True, cwd=ROOT)
+def studyapp(*args):
+    subprocess.run([sys.executable, "-m", "studyapp", *map(str, args)], check=True, capture_output=True, cwd=ROOT)
+
+
+@pytest.fixture(scope="module")
+def evaluated(tmp_path_factory):
+    """simulate-set (training, validation), then evaluate of params.toml on them with --compare-paper."""
+    folder = tmp_path_factory.mktemp("study")
+    studyapp("simulate-set", "-o", folder / "train")
+    studyapp("simulate-set", "-o", folder / "valid", "--validation")
+    studyapp("evaluate", folder / "train", "--params", STUDY / "params.toml", "--validation", folder / "valid",
+             "-o", folder / "results", "--compare-paper")
+    return folder
 
 
 @pytest.mark.slow
-def test_the_data_set_is_the_one_params_was_tuned_on(tmp_path):
-    simulate_set(tmp_path / "train")
-    provenance = params()["provenance"]
-    for recorded, digest in zip(provenance["recordings"], provenance["recording_sha256"]):
-        again = hashlib.sha256((tmp_path / "train" / Path(recorded).name).read_bytes()).hexdigest()
-        assert again == digest, recorded
+def test_the_data_set_is_the_one_params_was_tuned_on(evaluated):
+    tuned = params()
+    made = sorted(p.name for p in (evaluated / "train").glob("*.npz"))
+    assert made == sorted(Path(r).name for r in tuned["provenance"]["recordings"])
+    again = json.loads((evaluated / "results" / "evaluation.json").read_text())["estimators"]
+    for name, objective in tuned["objective"].items():
+        assert within(again[name]["objective"], objective, OBJECTIVE_ROUNDING), (name, again[name]["objective"], objective)
 
 
 @pytest.mark.slow
-def test_evaluate_of_the_tuned_params_gives_the_quoted_findings(tmp_path):
-    simulate_set(tmp_path / "train")
-    simulate_set(tmp_path / "valid", "--validation")
-    subprocess.run([sys.executable, "-m", "studyapp", "evaluate", str(tmp_path / "train"), "--params",
-                    str(STUDY / "params.toml"), "--validation", str(tmp_path / "valid"), "-o", str(tmp_path / "results"),
-                    "--compare-paper"], check=True, capture_output=True, cwd=ROOT)
-    with open(tmp_path / "results" / "findings.csv", newline="") as f:
-        assert list(csv.reader(f)) == rows("findings.csv")
+def test_evaluate_of_the_tuned_params_gives_the_quoted_findings(evaluated):
+    with open(evaluated / "results" / "findings.csv", newline="") as f:
+        header, *again = list(csv.reader(f))
+    quoted_header, *quoted = rows("findings.csv")
+    assert header == quoted_header and [r[:2] for r in again] == [r[:2] for r in quoted]
+    verdict = header.index("verdict")
+    for new, old in zip(again, quoted):
+        if new[0] not in FLIPPING_FINDINGS:
+            assert new[verdict] == old[verdict], (new[0], new[verdict], old[verdict])

@@ -91,3 +91,44 @@ def test_a_run_writes_each_output_dated_with_its_command_and_a_summary(tmp_path,
     assert f"| good | {today} | ok |" in summary and f"| bad | {today} | FAILED |" in summary
     err = capsys.readouterr().err
     assert "[1/2] good" in err and "[2/2] bad" in err and "failed: bad" in err
+
+
+def test_check_compares_a_figure_with_docs_within_its_measured_spread(tmp_path, monkeypatch, capsys):
+    import quoted_figures as qf
+    quoted = qf.quoted_signals(qf.signals_paragraph((ROOT / "docs" / "model.md").read_text()))
+
+    def printed(dvdt):
+        return (f"data set at 12.1 N: max |dv/dt| {dvdt:.0f} m/s^2, above 100 Hz 26.5 mm/s RMS, FOAW at its maximum "
+                f"window {quoted['foaw_12.1']} % of samples\n"
+                f"data set at 7.7 N: max |dv/dt| 46 m/s^2, above 100 Hz {quoted['high_7.7']} mm/s RMS, FOAW at its "
+                f"maximum window {quoted['foaw_7.7']} % of samples\n"
+                + "".join(f"pitch at {r} Hz, LVT at 2 N on strokes: {p} Hz\n"
+                          for r, p in zip((5000, 20000, 48000), quoted["pitch"])))
+
+    today = datetime.date.today().isoformat()
+    dvdt = float(quoted["dvdt_12.1"])
+    for i, (value, code, status) in enumerate(((dvdt * 1.03, 0, "ok, holds"), (dvdt * 1.2, 1, "MOVED (1)"))):
+        gen = rf.Generator("model-signals", "docs/model.md", ((rf.PY, "-c", f"print({printed(value)!r})"),))
+        other = rf.Generator("other", "nowhere", ((rf.PY, "-c", "print(1)"),))
+        monkeypatch.setattr(rf, "generators", lambda gen=gen, other=other: [gen, other])
+        assert rf.main(["-o", str(tmp_path / f"out{i}"), "--check"]) == code
+        summary = (tmp_path / f"out{i}" / "figures.md").read_text()
+        assert f"| model-signals | {today} | {status} |" in summary
+        assert f"| other | {today} | ok, not compared (no measured spread) |" in summary
+    err = capsys.readouterr().err
+    assert f"moved beyond its spread: dvdt_12.1: {dvdt * 1.2:.0f} against the quoted {quoted['dvdt_12.1']}" in err
+
+
+def test_check_finds_the_docs_table_by_its_settings_not_its_spelling(tmp_path):
+    text = (ROOT / "docs" / "breakdown.md").read_text()
+    start = text.index("--gesture hold")
+    start = text.rindex("Generated on", 0, start)
+    table = text[start:text.index("\n\n", text.index("| source", start))]
+    spelled = table.replace("--duration 5 -o", "--duration 5 --windows seconds -o")
+    assert spelled != table
+    (tmp_path / "x.md").write_text(spelled + "\n")
+    gen = rf.Generator("breakdown-hold", "docs/breakdown.md", (("studyapp", "breakdown", "-o", "{out}/x.md"),))
+    assert rf.check_breakdown(gen, tmp_path) == []
+    (tmp_path / "x.md").write_text(spelled.replace("| LVT | 5000 | hold | 5 | 5.81", "| LVT | 5000 | hold | 5 | 6.5")
+                                   .replace("5.81; 5.81; 5.81; 5.81; 5.81", "6.5; 5.81; 5.81; 5.81; 5.81") + "\n")
+    assert [p.split(":")[0] for p in rf.check_breakdown(gen, tmp_path)] == ["LVT seed 0"]

@@ -84,6 +84,7 @@ class Simulation:
             "broken": bool(self.broken),  # the stability monitor flagged breakdown at some block
             "model": calibration.describe(),
             "link": self.link.describe(loop.rate),
+            "nudge": int(getattr(loop.device, "nudge", 0)),  # rounding steps off rest at the start (model/nudge.py)
         }
 
 

@@ -57,6 +57,10 @@ across one sample when read sample by sample.
 
 No accelerometer (filter, noise) when ``accelerometer=False``: it reads 0.
 
+``nudge`` (n rounding steps; nudge.py, default the environment's
+``STUDYAPP_NUDGE``, 0) starts the end-effector at n * spacing(travel) instead
+of 0: the one-rounding probe of docs/reproducibility.md.
+
 A non-finite hand force (a gesture that overflows) makes the hand let go and
 puts the handle at rest at 0, keeping every output finite, and sets ``fault``.
 """
@@ -65,7 +69,7 @@ import numpy as np
 from numba import njit
 
 from studyapp.estimators.dispatch import step_guarded
-from studyapp.model import calibration, contact_mic, control, hand, sensors, stability, zoh
+from studyapp.model import calibration, contact_mic, control, hand, nudge as rounding, sensors, stability, zoh
 from studyapp.model.device import DeviceLimits, HapticDevice
 from studyapp.model.gestures import Hold
 from studyapp.model.link import IDEAL, Link, step as link_step
@@ -218,11 +222,12 @@ class SimulatedDevice(HapticDevice):
     """The simulated device and the virtual hand holding it (calibration.py documents the constants).
 
     ``seed`` seeds the sensors' noise and the link's draws; ``accelerometer=False`` leaves the accelerometer out
-    (it reads 0); ``link`` (a link.LinkSpec, default ideal) is the link between the host and the device.
+    (it reads 0); ``link`` (a link.LinkSpec, default ideal) is the link between the host and the device;
+    ``nudge``: the end-effector starts n rounding steps off rest (nudge.py; None: ``STUDYAPP_NUDGE``, default 0).
     """
 
     def __init__(self, rate, mass=calibration.DEVICE_MASS, limits=DeviceLimits(), *, hand_impedance=None,
-                 sensor_spec=None, seed=0, accelerometer=True, link=None):
+                 sensor_spec=None, seed=0, accelerometer=True, link=None, nudge=None):
         self.rate = float(rate)
         self.mass = float(mass)
         self.limits = limits
@@ -243,6 +248,8 @@ class SimulatedDevice(HapticDevice):
         self._dp[DP_PHI:DP_GAMMA] = phi.ravel()
         self._dp[DP_GAMMA:] = gamma.ravel()
         self._ds = np.zeros(N_STATE)
+        self.nudge = rounding.steps_from_environment() if nudge is None else rounding.check_steps(nudge)
+        self._ds[DS_X] = rounding.initial_position(limits.travel, self.nudge)
         self._hp = self.hand.params(self.mass + self.hand.mass, self.rate)
         self._snp = self.sensor_spec.params(self.rate)
         self._sns = np.zeros(sensors.N_STATE)
