@@ -9,7 +9,9 @@ PARAMS.toml record (each calls it; none lists versions of its own): a flat dict 
   llvmlite, pandas, ...), as installed (``importlib.metadata``: what ``requirements.lock`` pins);
 - ``machine`` (``platform.machine()``) and ``cpu_model`` (``/proc/cpuinfo``'s "model name");
 - ``numpy_blas`` and ``scipy_blas``: the OpenBLAS each of them runs, with the kernels it chose for this
-  CPU, and ``numpy_simd``, the CPU features numpy's own loops dispatch to.
+  CPU, and ``numpy_simd``, the CPU features numpy's own loops dispatch to;
+- ``env_STUDYAPP_...``: each studyapp setting taken from the environment, as set (``STUDYAPP_NUDGE``
+  among them, which starts a simulation one rounding step off rest: an output made so must say so).
 
 Why the BLAS at run time: OpenBLAS built with DYNAMIC_ARCH picks its kernels by CPU (or by
 ``OPENBLAS_CORETYPE``), and what goes through BLAS differs in the last bits from one kernel set to
@@ -56,6 +58,7 @@ def _environment():
     info["machine"] = platform.machine()
     info["cpu_model"] = cpu_model()
     info.update(blas())
+    info.update({f"env_{name}": value for name, value in sorted(os.environ.items()) if name.startswith("STUDYAPP_")})
     return info
 
 

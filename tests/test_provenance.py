@@ -35,3 +35,18 @@ def test_environment_is_a_copy_for_the_caller():
     mine = environment()
     mine["numpy_version"] = "changed"
     assert environment()["numpy_version"] != "changed"
+
+
+def test_a_studyapp_setting_from_the_environment_is_recorded(monkeypatch):
+    """A run nudged one rounding step (STUDYAPP_NUDGE, model/nudge.py) must not pass for a plain one."""
+    from studyapp import provenance
+
+    monkeypatch.setenv("STUDYAPP_NUDGE", "1")
+    monkeypatch.delenv("STUDYAPP_GROUP_SHARED", raising=False)
+    provenance._environment.cache_clear()
+    try:
+        info = provenance.environment()
+    finally:
+        provenance._environment.cache_clear()
+    assert info["env_STUDYAPP_NUDGE"] == "1"
+    assert "env_STUDYAPP_GROUP_SHARED" not in info
