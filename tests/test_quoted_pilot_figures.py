@@ -24,8 +24,6 @@ ONLY=pilot CHECK=1``.
 """
 
 import inspect
-import re
-import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -42,11 +40,10 @@ from studyapp.model.fmax_knob import KNOB_MAX
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
-from quoted_figures import RESPONSE_ROUNDING, within  # noqa: E402
+from quoted_figures import RESPONSE_ROUNDING, pilot_table, within  # noqa: E402
 
 DOC = ROOT / "docs" / "experiment.md"
 CSV = ROOT / "docs" / "study" / "pilot.csv"
-HEADER = r"Generated on (\d{4}-\d\d-\d\d) by `PYTHONPATH=\. python scripts/pilot\.py ([^`]+)`"
 
 sys.path.insert(0, str(ROOT / "scripts"))
 from pilot import parse_sets  # noqa: E402
@@ -54,19 +51,8 @@ from pilot import parse_sets  # noqa: E402
 
 def quoted_table(text):
     """(date, seed sets, {row label: [cell per set]}) of the pilot's table in ``text``."""
-    match = re.search(HEADER, text)
-    assert match, "docs/experiment.md has no dated pilot table"
-    words = shlex.split(match.group(2))
-    sets = parse_sets(words[words.index("--seeds") + 1])
-    lines = text[match.end():].splitlines()
-    start = next(i for i, line in enumerate(lines) if line.startswith("|"))
-    rows = {}
-    for line in lines[start + 2:]:
-        if not line.startswith("|"):
-            break
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        rows[cells[0]] = cells[1:]
-    return match.group(1), sets, rows
+    date, words, rows = pilot_table(text)
+    return date, parse_sets(words[words.index("--seeds") + 1]), rows
 
 
 def decimals(cell):
