@@ -310,6 +310,7 @@ class Info:
     watchdog_ms: int
     ramp_ms_min: int
     channels: tuple = SI_CHANNELS
+    loop_tail: bytes = b""  # version 2: the loop section after the channels (loop_messages.LoopInfo)
 
     def check(self):
         for name, bits in (("protocol_version", 16), ("firmware_major", 8), ("firmware_minor", 8),
@@ -326,6 +327,8 @@ class Info:
                f"1..{largest} (a SENSORS frame of these channels within {PAYLOAD_MAX} bytes)")
         _text("INFO.name", self.name)
         _text("INFO.serial", self.serial)
+        _check(self.protocol_version >= 2 or not self.loop_tail, "INFO loop section", len(self.loop_tail),
+               "none in version 1")
 
     def pack(self, seq=0):
         self.check()
@@ -337,7 +340,7 @@ class Info:
                                 self.watchdog_ms, self.ramp_ms_min, len(self.channels))
         for c in self.channels:
             out += CHANNEL.pack(c.kind, c.format, c.gain, c.offset)
-        return bytes(out)
+        return bytes(out + self.loop_tail)
 
     @classmethod
     def parse(cls, payload):
@@ -350,10 +353,12 @@ class Info:
         *limits, n = INFO_LIMITS.unpack_from(body, at)
         at += INFO_LIMITS.size
         _check(1 <= n <= MAX_CHANNELS, "INFO.channel_count", n, f"1..{MAX_CHANNELS}")
-        _check(len(body) == at + n * CHANNEL.size, "INFO body length", len(body),
-               f"{at + n * CHANNEL.size} bytes for {n} channels")
+        end = at + n * CHANNEL.size
+        if head[0] < 2:
+            _check(len(body) == end, "INFO body length", len(body), f"{end} bytes for {n} channels")
+        _short(cls, "channels", body, at, n * CHANNEL.size)
         channels = tuple(Channel(*CHANNEL.unpack_from(body, at + i * CHANNEL.size)) for i in range(n))
-        message = cls(*head, name, serial, *limits, channels)
+        message = cls(*head, name, serial, *limits, channels, bytes(body[end:]))
         message.check()
         return message
 
