@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import scipy.fft
 from scipy.io import wavfile
 
 from studyapp.engine.signal_chain import CEILING_DBFS, FADE_S
@@ -157,7 +158,10 @@ def _has_tone(x, rate):
     """True if ``x`` is mostly one steady sine (the level check's tone)."""
     if x.size < rate * 0.1:
         return False
-    spectrum = np.abs(np.fft.rfft(x * np.hanning(x.size))) ** 2
+    # the longest prefix of a length the FFT factors quickly (within a few per cent of the span): an
+    # awkward length (a large prime factor) takes seconds on a page minutes long
+    x = x[:scipy.fft.prev_fast_len(x.size, real=True)]
+    spectrum = np.abs(scipy.fft.rfft(x * np.hanning(x.size))) ** 2
     k = int(np.argmax(spectrum))
     return spectrum[max(k - 3, 0):k + 4].sum() > 0.9 * spectrum.sum()
 
