@@ -11,7 +11,8 @@ on a real device's per-sample interface, the optimiser's side-by-side
 kernels, the estimator bank and benchmark, the metric (one-off and the
 optimiser's memorised reference), the stability monitor on a recording,
 FOAW's window sizes, the audio resampler and the scope's envelope; and it
-builds the device emulator's C core (studyapp/device/c_core.py). Every
+builds the device emulator's C core (studyapp/device/c_core.py) and the
+estimators in C (studyapp/device/c_estimators.py). Every
 later process loads the compiled code from the cache; a warm cache makes
 this take a few seconds. ``make run`` and ``make test`` call it.
 
@@ -109,13 +110,15 @@ def signal_paths():
 
 
 def device_core():
-    """The device protocol's C core (firmware/studyapp_device.c), which the device emulator runs when it builds;
-    without a C compiler the emulator runs the Python core and says so."""
-    from studyapp.device import c_core
-    try:
-        c_core.build()
-    except c_core.BuildError:
-        pass
+    """The device protocol's C core (firmware/studyapp_device.c), which the device emulator runs when it builds
+    (without a C compiler the emulator runs the Python core and says so), and the estimators in C
+    (firmware/studyapp_estimators.h, studyapp/device/c_estimators.py)."""
+    from studyapp.device import c_core, c_estimators
+    for build in (c_core.build, c_estimators.build):
+        try:
+            build()
+        except c_core.BuildError:
+            pass
 
 
 # the longest first: a pool of two then ends about together
