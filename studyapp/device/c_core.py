@@ -1,5 +1,8 @@
 """The C core (firmware/studyapp_device.c), built with the system's C compiler and run through ctypes.
 
+``build_library(name, sources)`` builds any of firmware/'s C libraries the same
+way (the device core here, the loop in c_loop.py).
+
 The same interface as firmware.py's ``Firmware`` (rx, sample, needs_force,
 actuate, tx, streaming, busy, counters), so the emulator runs either and the
 tests hold the two equal byte for byte. ``build()`` compiles the C file
@@ -24,6 +27,7 @@ from studyapp.device.device_side import SafetyConfig
 SOURCE_DIR = Path(__file__).resolve().parents[2] / "firmware"
 SOURCES = ("studyapp_device.c", "studyapp_device.h")
 FLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fPIC", "-shared")
+LIBS = ("-lm",)  # after the sources: the C maths library, for the cores that call it
 COUNTERS = ("now", "armed", "streaming", "fault", "late", "lost", "corrupt", "missing")
 TX_CHUNK = 1 << 14
 
@@ -37,34 +41,42 @@ def cache_dir():
     return base / "studyapp" / "device"
 
 
-def build():
-    """The path of the compiled core, compiling it first if this version of the sources has none."""
-    missing = [s for s in SOURCES if not (SOURCE_DIR / s).is_file()]
+def build_library(name, sources):
+    """The path of the shared library ``name`` compiled from ``sources`` (file names in firmware/; the .c ones are
+    compiled, every one is hashed), compiling it first if this version of the sources has none."""
+    missing = [s for s in sources if not (SOURCE_DIR / s).is_file()]
     if missing:
         raise BuildError(f"{SOURCE_DIR / missing[0]} not found (a source checkout of studyapp has it)")
     compiler = os.environ.get("CC") or "cc"
     if shutil.which(compiler) is None:
         raise BuildError(f"no C compiler {compiler!r} (install the Debian packages gcc and libc6-dev)")
-    digest = hashlib.sha1(" ".join((compiler,) + FLAGS).encode())
-    for s in SOURCES:
+    digest = hashlib.sha1(" ".join((compiler,) + FLAGS + LIBS).encode())
+    for s in sources:
+        digest.update(s.encode())
         digest.update((SOURCE_DIR / s).read_bytes())
-    target = cache_dir() / digest.hexdigest()[:16] / "studyapp_device.so"
+    target = cache_dir() / digest.hexdigest()[:16] / f"{name}.so"
     if target.is_file():
         return target
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
     os.close(fd)
+    units = [str(SOURCE_DIR / s) for s in sources if s.endswith(".c")]
     try:
-        r = subprocess.run([compiler, *FLAGS, "-o", tmp, str(SOURCE_DIR / SOURCES[0])], capture_output=True,
-                           text=True, timeout=120)
+        r = subprocess.run([compiler, *FLAGS, "-o", tmp, *units, *LIBS], capture_output=True, text=True,
+                           timeout=120)
         if r.returncode != 0:
             first = (r.stderr.strip().splitlines() or ["no message"])[0]
-            raise BuildError(f"{compiler} failed on {SOURCES[0]}: {first}")
+            raise BuildError(f"{compiler} failed on {', '.join(s for s in sources if s.endswith('.c'))}: {first}")
         os.replace(tmp, target)  # atomic: a process running at once loads a whole library or builds its own
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
     return target
+
+
+def build():
+    """The path of the compiled device core (``build_library`` of ``SOURCES``)."""
+    return build_library("studyapp_device", SOURCES)
 
 
 def _load(path):
