@@ -1,17 +1,16 @@
 """The C core (firmware/studyapp_device.c), built with the system's C compiler and run through ctypes.
 
-``build_library(name, sources)`` builds any of firmware/'s C libraries the same
-way (the device core here, the loop in c_loop.py).
-
 The same interface as firmware.py's ``Firmware`` (rx, sample, needs_force,
 actuate, tx, streaming, busy, counters), so the emulator runs either and the
 tests hold the two equal byte for byte. ``build()`` compiles the C file
 once into the user's cache (``$XDG_CACHE_HOME/studyapp/device/<hash of the
 sources and flags>/``, the compiler from ``$CC`` or ``cc``; the Debian
 packages gcc and libc6-dev, scripts/system-deps.txt) and returns the shared
-library's path; a second process finds it there. C99, -O2, no contraction
-of a * b + c into a fused multiply-add (``-ffp-contract=off``), so the
-floating point is the same as Python's, operation for operation.
+library's path; a second process finds it there. ``build_library`` does the
+same for any set of firmware/ sources (the estimators: c_estimators.py).
+C99, -O2, no contraction of a * b + c into a fused multiply-add
+(``-ffp-contract=off``), so the floating point is the same as Python's and
+numba's, operation for operation.
 """
 
 import ctypes
@@ -27,7 +26,7 @@ from studyapp.device.device_side import SafetyConfig
 SOURCE_DIR = Path(__file__).resolve().parents[2] / "firmware"
 SOURCES = ("studyapp_device.c", "studyapp_device.h")
 FLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fPIC", "-shared")
-LIBS = ("-lm",)  # after the sources: the C maths library, for the cores that call it
+LIBS = ("-lm",)  # after the sources: the C maths library (sqrt, fabs, copysign, isfinite's kin)
 COUNTERS = ("now", "armed", "streaming", "fault", "late", "lost", "corrupt", "missing")
 TX_CHUNK = 1 << 14
 
@@ -41,9 +40,18 @@ def cache_dir():
     return base / "studyapp" / "device"
 
 
+def build():
+    """The path of the compiled core, compiling it first if this version of the sources has none."""
+    return build_library("studyapp_device", SOURCES)
+
+
 def build_library(name, sources):
-    """The path of the shared library ``name`` compiled from ``sources`` (file names in firmware/; the .c ones are
-    compiled, every one is hashed), compiling it first if this version of the sources has none."""
+    """The path of the shared library ``name``.so built from ``sources`` (file names in firmware/), compiling it
+    first if this version of the sources has none.
+
+    Every ``.c`` of ``sources`` is compiled into the one library; every file of ``sources`` (headers too)
+    goes into the hash that names its folder in the cache, with the compiler and ``FLAGS``.
+    """
     missing = [s for s in sources if not (SOURCE_DIR / s).is_file()]
     if missing:
         raise BuildError(f"{SOURCE_DIR / missing[0]} not found (a source checkout of studyapp has it)")
@@ -52,31 +60,25 @@ def build_library(name, sources):
         raise BuildError(f"no C compiler {compiler!r} (install the Debian packages gcc and libc6-dev)")
     digest = hashlib.sha1(" ".join((compiler,) + FLAGS + LIBS).encode())
     for s in sources:
-        digest.update(s.encode())
         digest.update((SOURCE_DIR / s).read_bytes())
     target = cache_dir() / digest.hexdigest()[:16] / f"{name}.so"
     if target.is_file():
         return target
+    units = [s for s in sources if s.endswith(".c")]
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
     os.close(fd)
-    units = [str(SOURCE_DIR / s) for s in sources if s.endswith(".c")]
     try:
-        r = subprocess.run([compiler, *FLAGS, "-o", tmp, *units, *LIBS], capture_output=True, text=True,
-                           timeout=120)
+        r = subprocess.run([compiler, *FLAGS, "-o", tmp, *(str(SOURCE_DIR / s) for s in units), *LIBS],
+                           capture_output=True, text=True, timeout=120)
         if r.returncode != 0:
             first = (r.stderr.strip().splitlines() or ["no message"])[0]
-            raise BuildError(f"{compiler} failed on {', '.join(s for s in sources if s.endswith('.c'))}: {first}")
+            raise BuildError(f"{compiler} failed on {', '.join(units)}: {first}")
         os.replace(tmp, target)  # atomic: a process running at once loads a whole library or builds its own
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
     return target
-
-
-def build():
-    """The path of the compiled device core (``build_library`` of ``SOURCES``)."""
-    return build_library("studyapp_device", SOURCES)
 
 
 def _load(path):
