@@ -177,7 +177,7 @@ static const sd_loop_hooks HOOKS = {valid, frame, streaming, sample, actuated};
 
 int sd_attach_loop(sd_device *d, sl_loop *L) {
     uint32_t i;
-    if (!d->loop_mode || L->n_est != d->n_est) return -1;
+    if (!d->loop_mode || L->n_est != d->n_est || sl_check(L) != 0) return -1;
     for (i = 0; i < d->n_est; i++)
         if (L->kinds[i] != (int64_t)d->kinds[i]) return -1;
     d->loop = L;

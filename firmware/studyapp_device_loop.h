@@ -25,7 +25,7 @@
 #include "studyapp_device.h"
 #include "studyapp_loop.h"
 
-/* 0 on success; -1 if the device's INFO has no device loop or L's estimators are not INFO's */
+/* 0 on success; -1 if the INFO has no device loop, L's estimators are not INFO's, or sl_check(L) fails */
 int sd_attach_loop(sd_device *d, sl_loop *L);
 
 /* control id in effect, CONTROLs queued, ALIVE's seen, the loop's fault code */

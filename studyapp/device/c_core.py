@@ -115,11 +115,11 @@ def library():
 
 
 class CCore:
-    """The C firmware core for the device described by ``info`` (messages.Info)."""
+    """The C firmware core for the device described by ``info`` (messages.Info); ``lib``: a library built with it."""
 
-    def __init__(self, info):
+    def __init__(self, info, lib=None):
         self.info = info
-        self._lib = library()
+        self._lib = lib or library()
         self._state = ctypes.create_string_buffer(self._lib.sd_sizeof())
         payload = info.pack(0)
         alpha = SafetyConfig.from_info(info).rms_alpha
