@@ -12,8 +12,8 @@ kernels, the estimator bank and benchmark, the metric (one-off and the
 optimiser's memorised reference), the stability monitor on a recording,
 FOAW's window sizes, the audio resampler and the scope's envelope; and it
 builds the device emulator's C core (studyapp/device/c_core.py) and the
-loop in C (studyapp/device/c_loop.py). Every
-later process loads the compiled code from the cache; a warm cache makes
+estimators and the loop in C (studyapp/device/c_estimators.py, c_loop.py).
+Every later process loads the compiled code from the cache; a warm cache makes
 this take a few seconds. ``make run`` and ``make test`` call it.
 
 The parts run in two processes at once (``--jobs``), one per core of a
@@ -118,10 +118,11 @@ def signal_paths():
 
 def device_core():
     """The device protocol's C core (firmware/studyapp_device.c), which the device emulator runs when it builds
-    (without a C compiler the emulator runs the Python core and says so), and the loop in C with its
-    estimators (firmware/studyapp_loop.c, device/c_loop.py)."""
-    from studyapp.device import c_core, c_loop
-    for build in (c_core.build, c_loop.build):
+    (without a C compiler the emulator runs the Python core and says so), the estimators in C
+    (firmware/studyapp_estimators.h, studyapp/device/c_estimators.py) and the loop in C with them
+    (firmware/studyapp_loop.h, studyapp/device/c_loop.py)."""
+    from studyapp.device import c_core, c_estimators, c_loop
+    for build in (c_core.build, c_estimators.build, c_loop.build):
         try:
             build()
         except c_core.BuildError:
