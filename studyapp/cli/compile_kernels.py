@@ -120,9 +120,10 @@ def device_core():
     """The device protocol's C core (firmware/studyapp_device.c), which the device emulator runs when it builds
     (without a C compiler the emulator runs the Python core and says so), the estimators in C
     (firmware/studyapp_estimators.h, studyapp/device/c_estimators.py) and the loop in C with them
-    (firmware/studyapp_loop.h, studyapp/device/c_loop.py)."""
-    from studyapp.device import c_core, c_estimators, c_loop
-    for build in (c_core.build, c_estimators.build, c_loop.build):
+    (firmware/studyapp_loop.h, studyapp/device/c_loop.py), and the device core with that loop, which
+    ``device-emulator --loop device`` runs (firmware/studyapp_device_loop.h, studyapp/device/c_loop_core.py)."""
+    from studyapp.device import c_core, c_estimators, c_loop, c_loop_core
+    for build in (c_core.build, c_estimators.build, c_loop.build, c_loop_core.build):
         try:
             build()
         except c_core.BuildError:

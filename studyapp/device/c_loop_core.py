@@ -22,13 +22,16 @@ LOOP_COUNTERS = ("control", "queued", "seen", "loop_fault")
 _LIB = None
 
 
+def build():
+    """The path of the device core and the loop in one library (built on first use, then cached)."""
+    return c_core.build_library(NAME, SOURCES + tuple(s for s in c_loop.sources() if s not in SOURCES))
+
+
 def library():
-    """The device core and the loop in one library (built on first use, then cached)."""
     global _LIB
     if _LIB is None:
-        sources = SOURCES + tuple(s for s in c_loop.sources() if s not in SOURCES)
         try:
-            lib = c_core._load(c_core.build_library(NAME, sources))
+            lib = c_core._load(build())
         except OSError as exc:
             raise BuildError(f"cannot load the C device loop: {exc}") from None
         ptr = ctypes.c_void_p
