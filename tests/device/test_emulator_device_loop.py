@@ -115,3 +115,44 @@ def test_lockstep_device_loop_equals_the_model(tmp_path, seed):
     for i, (_, fmax) in enumerate(segments):
         f = np.abs(force[i * SEGMENT:(i + 1) * SEGMENT])
         assert 0.1 * fmax < f.max() <= fmax * (1 + 1e-12)
+
+
+def test_clocked_device_loop_streams_and_its_keepalive_watchdog_trips(tmp_path):
+    """Clocked (5 kHz on its own clock): TELEMETRY without a gap, a CONTROL in effect from its tag (or, if it
+    arrived late, from the sample after it arrived, counted late), and once the host's ALIVE stops, the force
+    at 0 within K + D - 1 samples of the last one (FAULT WATCHDOG's sample and detail, device time)."""
+    keepalive_ms = 50
+    k_samples, d_samples = keepalive_ms * RATE // 1000, RATE // 1000
+    link = tmp_path / "dev"
+    proc = start_emulator(link, "--loop", "device", "--keepalive-ms", str(keepalive_ms))
+    host = LoopHost(link)
+    rows, control, fault = [], None, None
+    try:
+        host.send(msg.Hello(lm.LOOP_VERSION))
+        host.wait(msg.Info)
+        host.send(msg.Arm(0), msg.Start(PACKET, PACKET))
+        host.wait(msg.State, where=lambda m: m.streaming)
+        while len(rows) < RATE // 2:
+            for m in host.poll(1.0):
+                if isinstance(m, lm.Telemetry):
+                    assert m.sample == (rows[0][0] + len(rows) if rows else m.sample)
+                    rows += [(m.sample + i, *r) for i, r in enumerate(m.rows)]
+                    if control is None:
+                        control = lm.Control(1, m.sample + 25 + RATE // 100, -2, 1, 1, 2.0, 1.0)
+                        host.send(control)
+                    host.send(lm.Alive(m.sample + len(m.rows)))
+        fault = host.wait(msg.Fault, timeout=5.0, where=lambda m: m.code == msg.WATCHDOG)
+        host.poll(0.2)
+        after = [(t.sample + i, *r) for t in host.inbox if isinstance(t, lm.Telemetry) for i, r in enumerate(t.rows)]
+        host.send(msg.Stop())
+    finally:
+        host.close()
+        stats = stop_emulator(proc)
+    ids = np.array([r[-1] for r in rows])
+    first = rows[int(np.flatnonzero(ids == 1)[0])][0]
+    assert ids[0] == 0 and np.all(ids[np.flatnonzero(ids == 1)[0]:] == 1)
+    assert (first == control.sample and stats["late"] == 0) or (first > control.sample and stats["late"] == 1)
+    assert any(r[5] != 0.0 for r in rows)  # bowing at 2 N / peak: a force
+    assert 0 < fault.sample - fault.detail <= k_samples + d_samples - 1
+    assert all(r[5] == 0.0 for r in after if r[0] >= fault.sample)
+    assert stats["armed"] == 0 and stats["fault"] == msg.WATCHDOG
