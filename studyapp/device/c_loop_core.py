@@ -16,7 +16,7 @@ from studyapp.device import c_core, c_loop
 from studyapp.device.c_core import BuildError, CCore
 
 NAME = "studyapp_device_loop"
-SOURCES = ("studyapp_device.c", "studyapp_device.h", "studyapp_device_loop.c", "studyapp_device_loop.h")
+SOURCES = c_core.SOURCES + ("studyapp_device_loop.c", "studyapp_device_loop.h")
 LOOP_COUNTERS = ("control", "queued", "seen", "loop_fault")
 
 _LIB = None
