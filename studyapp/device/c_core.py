@@ -2,8 +2,8 @@
 
 The same interface as firmware.py's ``Firmware`` (rx, sample, needs_force,
 actuate, tx, streaming, busy, counters), so the emulator runs either and the
-tests hold the two equal byte for byte. ``build()`` compiles the C file
-once into the user's cache (``$XDG_CACHE_HOME/studyapp/device/<hash of the
+tests hold the two equal byte for byte. ``build()`` compiles the C files
+(``SOURCES``) once into the user's cache (``$XDG_CACHE_HOME/studyapp/device/<hash of the
 sources and flags>/``, the compiler from ``$CC`` or ``cc``; the Debian
 packages gcc and libc6-dev, scripts/system-deps.txt) and returns the shared
 library's path; a second process finds it there. ``build_library`` does the
@@ -24,8 +24,9 @@ from pathlib import Path
 from studyapp.device.device_side import SafetyConfig
 
 SOURCE_DIR = Path(__file__).resolve().parents[2] / "firmware"
-SOURCES = ("studyapp_device.c", "studyapp_device.h")
+SOURCES = ("studyapp_device.c", "studyapp_device_link.c", "studyapp_device.h", "studyapp_bytes.h")
 FLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fPIC", "-shared")
+LIBS = ("-lm",)  # after the sources: the C maths library (sqrt, fabs, copysign, isfinite's kin)
 COUNTERS = ("now", "armed", "streaming", "fault", "late", "lost", "corrupt", "missing")
 TX_CHUNK = 1 << 14
 
@@ -57,7 +58,7 @@ def build_library(name, sources):
     compiler = os.environ.get("CC") or "cc"
     if shutil.which(compiler) is None:
         raise BuildError(f"no C compiler {compiler!r} (install the Debian packages gcc and libc6-dev)")
-    digest = hashlib.sha1(" ".join((compiler,) + FLAGS).encode())
+    digest = hashlib.sha1(" ".join((compiler,) + FLAGS + LIBS).encode())
     for s in sources:
         digest.update((SOURCE_DIR / s).read_bytes())
     target = cache_dir() / digest.hexdigest()[:16] / f"{name}.so"
@@ -68,8 +69,8 @@ def build_library(name, sources):
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
     os.close(fd)
     try:
-        r = subprocess.run([compiler, *FLAGS, "-o", tmp, *(str(SOURCE_DIR / s) for s in units)], capture_output=True,
-                           text=True, timeout=120)
+        r = subprocess.run([compiler, *FLAGS, "-o", tmp, *(str(SOURCE_DIR / s) for s in units), *LIBS],
+                           capture_output=True, text=True, timeout=120)
         if r.returncode != 0:
             first = (r.stderr.strip().splitlines() or ["no message"])[0]
             raise BuildError(f"{compiler} failed on {', '.join(units)}: {first}")
@@ -114,11 +115,11 @@ def library():
 
 
 class CCore:
-    """The C firmware core for the device described by ``info`` (messages.Info)."""
+    """The C firmware core for the device described by ``info`` (messages.Info); ``lib``: a library built with it."""
 
-    def __init__(self, info):
+    def __init__(self, info, lib=None):
         self.info = info
-        self._lib = library()
+        self._lib = lib or library()
         self._state = ctypes.create_string_buffer(self._lib.sd_sizeof())
         payload = info.pack(0)
         alpha = SafetyConfig.from_info(info).rms_alpha
