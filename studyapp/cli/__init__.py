@@ -18,7 +18,8 @@ import sys
 
 from studyapp import __version__
 from studyapp.cli import (
-    analyse, bench, breakdown, compile_kernels, demo, device_emulator, estimate, estimators, evaluate, export, gui, live, notes, optimise, plan, run,
+    analyse, bench, breakdown, compile_kernels, demo, device_emulator, estimate, estimators, evaluate, export, firmware_params, gui, live,
+    notes, optimise, plan, run,
     simulate, simulate_set, tradeoff,
 )
 from studyapp.cli.number_options import finite_float, integer
@@ -26,7 +27,7 @@ from studyapp.errors import EngineError, UserError
 
 # the sub-commands' modules, in the order shown by --help
 COMMANDS = [gui, demo, estimators, estimate, simulate, simulate_set, breakdown, optimise, evaluate, tradeoff, live, run,
-            plan, notes, export, analyse, bench, compile_kernels, device_emulator]
+            plan, notes, export, analyse, bench, compile_kernels, device_emulator, firmware_params]
 
 
 class UsageError(UserError):
