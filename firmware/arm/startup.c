@@ -1,0 +1,38 @@
+/* Reset for the harness on a Cortex-M7 (qemu-system-arm -M mps2-an500, or a board with the same map):
+ * the vector table (initial stack pointer, then the handlers), and a reset handler that copies .data from
+ * its load address, zeroes .bss, turns the FPU on and calls main.
+ *
+ * The FPU: coprocessors CP10 and CP11 get full access in CPACR (bits 20-23) before any floating-point
+ * instruction runs (the loop is all double precision: -mfpu=fpv5-d16 -mfloat-abi=hard). FPSCR keeps its
+ * reset value from FPDSCR: round to nearest, no flush to zero (FZ = 0) and no default NaN (DN = 0), the IEEE
+ * arithmetic the loop's bit-for-bit equality with x86-64 needs (studyapp_estimators.h, "Maths library").
+ * A fault of any kind reports through semihosting and stops with exit status 3. */
+#include <stdint.h>
+
+#include "semihost.h"
+
+extern uint32_t __data_start, __data_end, __data_load, __bss_start, __bss_end, __stack_top;
+int main(void);
+
+#define CPACR (*(volatile uint32_t *)0xE000ED88u)
+
+void reset_handler(void)
+{
+    uint32_t *src = &__data_load, *dst = &__data_start;
+    while (dst < &__data_end) *dst++ = *src++;
+    for (dst = &__bss_start; dst < &__bss_end; dst++) *dst = 0;
+    CPACR |= 0xFu << 20;
+    __asm volatile("dsb\n\tisb" ::: "memory");
+    sh_exit(main());
+}
+
+static void fault_handler(void)
+{
+    sh_write0("harness: processor fault\n");
+    sh_exit(3);
+}
+
+__attribute__((section(".vectors"), used)) static const void *const vectors[16] = {
+    &__stack_top, (const void *)reset_handler, (const void *)fault_handler, (const void *)fault_handler,
+    (const void *)fault_handler, (const void *)fault_handler, (const void *)fault_handler,
+};
