@@ -1,0 +1,180 @@
+/* The loop on a Cortex-M7, fed a recorded sensor stream: reads the loop's arrays and the stream from the
+ * host through semihosting, runs sl_sample once per sample as a firmware's sample interrupt would, and
+ * writes every sample's outputs back, with the SysTick ticks each sample took.
+ *
+ * Files, in the emulator's current directory, little-endian (scripts/arm_loop.py writes and reads them):
+ *   arm_in.bin     header: uint32 magic "SLA1", n_est, est_s_width, est_p_width, line, n_samples, 0, 0;
+ *                  then float64 ctl, state, lp, ls, int64 kinds, float64 est_s, est_p (row-major), sp,
+ *                  ss, bridge, nut (studyapp_loop.h's sl_loop), then n_samples x (x_m, a_m, v_m) float64
+ *   arm_out.bin    n_samples x (sl_out's 7 members, then the n_est estimates) float64
+ *   arm_ticks.bin  n_samples uint32: SysTick ticks around sl_sample
+ *   arm_state.bin  the arrays after the last sample, in arm_in.bin's order (ctl to nut)
+ *   arm_meta.bin   uint32: calibration instructions, their ticks, the ticks of an empty interval
+ *
+ * Counting. SysTick counts the processor clock (CLKSOURCE = 1) down from 2^24 - 1: on a real M7 that is
+ * cycles. Under qemu with -icount shift=S every instruction advances virtual time by 2^S ns and SysTick
+ * follows the board's 25 MHz clock in virtual time, so ticks measure executed instructions. The harness
+ * calibrates the ratio on a loop of exactly 2 x CAL_LOOPS instructions (subs, bne: the difference of two
+ * lengths, so the call's own instructions cancel) and measures an empty interval (two reads in a row),
+ * which it subtracts; instructions = (ticks - empty) x calibration instructions / calibration ticks.
+ * Exit status: 0, or 2 for a bad or missing input file, 3 for a processor fault (startup.c). */
+#include <stdint.h>
+
+#include "../studyapp_loop.h"
+#include "semihost.h"
+
+#define MAGIC 0x31414c53u /* "SLA1" */
+#define CHUNK 256u        /* samples read, run and written per semihosting transfer */
+#define CAL_LOOPS 100000u
+
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+
+extern uint8_t __arena_start, __arena_end;
+static uint8_t *arena_next = &__arena_start;
+
+static void *take(uint32_t bytes)
+{
+    uint8_t *p = arena_next;
+    bytes = (bytes + 7u) & ~7u;
+    if ((uint32_t)(&__arena_end - p) < bytes) return 0;
+    arena_next = p + bytes;
+    return p;
+}
+
+static uint32_t ticks_since(uint32_t t0) { return (t0 - SYST_CVR) & 0xFFFFFFu; }
+
+static void spin(uint32_t n)
+{
+    __asm volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n) : : "cc");
+}
+
+static uint32_t spin_ticks(uint32_t n)
+{
+    uint32_t t0 = SYST_CVR;
+    spin(n);
+    return ticks_since(t0);
+}
+
+static void put_number(const char *label, uint64_t v)
+{
+    char digits[21];
+    int d = 20;
+    digits[20] = 0;
+    do {
+        digits[--d] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v);
+    sh_write0(label);
+    sh_write0(digits + d);
+    sh_write0("\n");
+}
+
+static int fail(const char *why)
+{
+    sh_write0("harness: ");
+    sh_write0(why);
+    sh_write0("\n");
+    return 2;
+}
+
+typedef struct {
+    void *at;
+    uint32_t bytes;
+} span;
+
+int main(void)
+{
+    uint32_t head[8], n, i, k, n_spans, cal_ticks, empty;
+    uint64_t sum = 0, max = 0;
+    int in, out, tick_file;
+    sl_loop L;
+    sl_out o;
+    span spans[11];
+    double *sensors, *rows;
+    uint32_t *ticks;
+
+    SYST_RVR = 0xFFFFFFu;
+    SYST_CVR = 0u;
+    SYST_CSR = 5u; /* enable, processor clock, no interrupt */
+
+    in = sh_open("arm_in.bin", 0);
+    if (in < 0) return fail("cannot open arm_in.bin");
+    if (sh_read(in, head, sizeof head) || head[0] != MAGIC) return fail("arm_in.bin: no SLA1 header");
+    L.n_est = head[1];
+    L.est_s_width = head[2];
+    L.est_p_width = head[3];
+    L.line = head[4];
+    n = head[5];
+    spans[0] = (span){L.ctl = take(SL_N_CONTROL * 8u), SL_N_CONTROL * 8u};
+    spans[1] = (span){L.state = take(SL_N_LOOP_STATE * 8u), SL_N_LOOP_STATE * 8u};
+    spans[2] = (span){(void *)(L.lp = take(SL_N_LIMIT_PARAMS * 8u)), SL_N_LIMIT_PARAMS * 8u};
+    spans[3] = (span){L.ls = take(SL_N_LIMIT_STATE * 8u), SL_N_LIMIT_STATE * 8u};
+    spans[4] = (span){(void *)(L.kinds = take(L.n_est * 8u)), L.n_est * 8u};
+    spans[5] = (span){L.est_s = take(L.n_est * L.est_s_width * 8u), L.n_est * L.est_s_width * 8u};
+    spans[6] = (span){(void *)(L.est_p = take(L.n_est * L.est_p_width * 8u)), L.n_est * L.est_p_width * 8u};
+    spans[7] = (span){(void *)(L.sp = take(SL_N_STRING_PARAMS * 8u)), SL_N_STRING_PARAMS * 8u};
+    spans[8] = (span){L.ss = take(SL_N_STRING_STATE * 8u), SL_N_STRING_STATE * 8u};
+    spans[9] = (span){L.bridge = take(L.line * 8u), L.line * 8u};
+    spans[10] = (span){L.nut = take(L.line * 8u), L.line * 8u};
+    n_spans = 11;
+    sensors = take(CHUNK * 3u * 8u);
+    rows = take(CHUNK * (SL_N_OUT + L.n_est) * 8u);
+    ticks = take(CHUNK * 4u);
+    if (!sensors || !rows || !ticks || !L.nut) return fail("arm_in.bin: the arrays do not fit the arena");
+    for (i = 0; i < n_spans; i++)
+        if (sh_read(in, spans[i].at, spans[i].bytes)) return fail("arm_in.bin: shorter than its header says");
+    if (sl_check(&L) != 0) return fail("arm_in.bin: the arrays fail sl_check");
+
+    out = sh_open("arm_out.bin", 1);
+    tick_file = sh_open("arm_ticks.bin", 1);
+    if (out < 0 || tick_file < 0) return fail("cannot write arm_out.bin or arm_ticks.bin");
+    empty = ticks_since(SYST_CVR);
+    for (k = 0; k < n; k += CHUNK) {
+        uint32_t m = n - k < CHUNK ? n - k : CHUNK;
+        if (sh_read(in, sensors, m * 3u * 8u)) return fail("arm_in.bin: fewer samples than its header says");
+        for (i = 0; i < m; i++) {
+            double *row = rows + i * (SL_N_OUT + L.n_est);
+            const double *s = sensors + 3u * i;
+            uint32_t t0 = SYST_CVR;
+            sl_sample(&L, k + i, s[0], s[1], s[2], &o, row + SL_N_OUT);
+            ticks[i] = ticks_since(t0);
+            row[0] = o.force;
+            row[1] = o.source_velocity;
+            row[2] = o.string_velocity;
+            row[3] = o.bridge_velocity;
+            row[4] = o.v_delta;
+            row[5] = o.stick;
+            row[6] = o.friction;
+            sum += ticks[i] - empty;
+            if (ticks[i] - empty > max) max = ticks[i] - empty;
+        }
+        if (sh_write(out, rows, m * (SL_N_OUT + L.n_est) * 8u) || sh_write(tick_file, ticks, m * 4u))
+            return fail("cannot write the outputs");
+    }
+    sh_close(in);
+    sh_close(out);
+    sh_close(tick_file);
+
+    out = sh_open("arm_state.bin", 1);
+    if (out < 0) return fail("cannot write arm_state.bin");
+    for (i = 0; i < n_spans; i++)
+        if (sh_write(out, spans[i].at, spans[i].bytes)) return fail("cannot write arm_state.bin");
+    sh_close(out);
+
+    cal_ticks = spin_ticks(2u * CAL_LOOPS) - spin_ticks(CAL_LOOPS);
+    head[0] = 2u * CAL_LOOPS;
+    head[1] = cal_ticks;
+    head[2] = empty;
+    out = sh_open("arm_meta.bin", 1);
+    if (out < 0 || sh_write(out, head, 3u * 4u)) return fail("cannot write arm_meta.bin");
+    sh_close(out);
+
+    put_number("samples: ", n);
+    if (n && cal_ticks) {
+        put_number("instructions per sample, mean x 100: ", sum * 200u * CAL_LOOPS / cal_ticks / n);
+        put_number("instructions per sample, max: ", max * 2u * CAL_LOOPS / cal_ticks);
+    }
+    return 0;
+}
