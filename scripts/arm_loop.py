@@ -162,8 +162,9 @@ def differing(a, b):
     """(samples whose bits differ, max |a - b|) of two float64 arrays of one shape (column = sample)."""
     a, b = np.atleast_2d(a), np.atleast_2d(b)
     bits = a.view(np.uint64) != b.view(np.uint64)
-    both = np.isfinite(a) & np.isfinite(b)
-    diff = np.abs(np.where(both, a, 0.0) - np.where(both, b, 0.0))
+    with np.errstate(invalid="ignore"):
+        diff = np.where(bits, np.abs(a - b), 0.0)
+    diff[bits & ~np.isfinite(diff)] = np.inf  # a NaN or an infinity on one side only, or two NaNs' bits
     return int(bits.any(axis=0).sum()), float(diff.max(initial=0.0))
 
 
@@ -178,33 +179,38 @@ def array_bytes(arrays):
     return int(sum(a.nbytes for a in arrays[:N_ARRAYS]))
 
 
-def compare_one(elf, rate, seconds, condition, fmax, seed, estimators, shift, workdir):
-    """One rate and condition: the comparison's figures (a dict)."""
-    stream, numba_run, names = record(rate, seconds, condition, fmax, seed, estimators)
+def compare_stream(elf, make_arrays, stream, shift, workdir):
+    """ARM against x86 on one sensor stream, each on fresh arrays from ``make_arrays()``: the figures (a dict)."""
     n = stream[0].shape[0]
-    arm_arrays = new_loop(rate, condition, fmax, seed, estimators).control.arrays
+    arm_arrays = make_arrays()
     write_input(Path(workdir) / "arm_in.bin", arm_arrays, stream)
     t0 = time.perf_counter()
     console = run_qemu(elf, workdir, shift)
     qemu_s = time.perf_counter() - t0
     arm_out, arm_est, ticks, arm_final, meta = read_outputs(workdir, n, arm_arrays)
-    x86_out, x86_est, x86_final = x86_outputs(new_loop(rate, condition, fmax, seed, estimators).control.arrays,
-                                              stream)
+    x86_out, x86_est, x86_final = x86_outputs(make_arrays(), stream)
     rows = {name: differing(arm_out[i], x86_out[i]) for i, name in enumerate(OUT_ROWS)}
     rows["estimates"] = differing(arm_est, x86_est)
-    final = [differing(a.reshape(1, -1).astype(np.float64) if a.dtype != np.float64 else a.reshape(1, -1),
-                       b.reshape(1, -1).astype(np.float64) if b.dtype != np.float64 else b.reshape(1, -1))[0]
-             for a, b in zip(arm_final, x86_final)]
-    numba = {
-        "force": differing(arm_out[0], numba_run["force"]),
-        "string_velocity": differing(arm_out[2], numba_run["string_velocity"]),
-        "estimates": differing(arm_est, numba_run["estimates"]),
-    }
+    final = sum(int(np.count_nonzero(a.reshape(-1).view(np.uint64) != b.reshape(-1).view(np.uint64)))
+                for a, b in zip(arm_final, x86_final))
     insn = instructions(ticks, meta)
-    return {"rate": rate, "condition": condition, "n": n, "rows": rows, "final_words_differing": sum(final),
-            "numba": numba, "insn_mean": float(insn.mean()), "insn_median": float(np.median(insn)),
-            "insn_max": float(insn.max()), "meta": [int(v) for v in meta], "console": console,
-            "bytes": array_bytes(arm_arrays), "names": names, "qemu_s": qemu_s}
+    return {"n": n, "rows": rows, "final_words_differing": final, "arm_out": arm_out, "arm_est": arm_est,
+            "insn_mean": float(insn.mean()), "insn_median": float(np.median(insn)), "insn_max": float(insn.max()),
+            "meta": [int(v) for v in meta], "console": console, "bytes": array_bytes(arm_arrays), "qemu_s": qemu_s}
+
+
+def compare_one(elf, rate, seconds, condition, fmax, seed, estimators, shift, workdir):
+    """One rate and condition: record the stream, compare ARM with x86, and ARM with the numba loop that recorded it."""
+    stream, numba_run, names = record(rate, seconds, condition, fmax, seed, estimators)
+    r = compare_stream(elf, lambda: new_loop(rate, condition, fmax, seed, estimators).control.arrays, stream,
+                       shift, workdir)
+    r["numba"] = {
+        "force": differing(r["arm_out"][0], numba_run["force"]),
+        "string_velocity": differing(r["arm_out"][2], numba_run["string_velocity"]),
+        "estimates": differing(r["arm_est"], numba_run["estimates"]),
+    }
+    r.update(rate=rate, condition=condition, names=names)
+    return r
 
 
 def load(insn_per_sample, rate, clock=CLOCK_HZ):

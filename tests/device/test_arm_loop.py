@@ -1,0 +1,81 @@
+"""The loop cross-compiled for a Cortex-M7 and run under qemu (scripts/arm_loop.py, firmware/arm) against the same
+loop on this machine: every sample's outputs and the arrays after the last, bit for bit, computed in the same run.
+
+Needs the Debian packages of scripts/system-deps-arm.txt (``make arm`` installs them; CI does not): skipped
+without them. The bad-input test runs everywhere.
+"""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+import arm_loop  # noqa: E402
+
+MISSING = arm_loop.missing_tools()
+needs_arm = pytest.mark.skipif(bool(MISSING), reason=f"the ARM toolchain is not installed (missing "
+                               f"{', '.join(MISSING)}: make arm installs scripts/system-deps-arm.txt)")
+
+
+@pytest.fixture(scope="module")
+def elf(tmp_path_factory):
+    return arm_loop.build(tmp_path_factory.mktemp("arm-build"))
+
+
+@pytest.fixture(scope="module")
+def protocol():
+    return arm_loop.conditions()
+
+
+@needs_arm
+@pytest.mark.parametrize("rate, condition, fmax, seed", [(5000.0, "KALFOAW", 1.0, 0), (20000.0, "LEVANT", 4.0, 1),
+                                                         (96000.0, "LVT", 0.5, 2), (3000.0, "FOAW", 20.0, 3)])
+def test_arm_equals_x86_and_the_numba_loop_that_recorded_the_stream(elf, protocol, tmp_path, rate, condition, fmax,
+                                                                    seed):
+    r = arm_loop.compare_one(elf, rate, 0.05, condition, fmax, seed, protocol[1], 6, tmp_path)
+    assert r["n"] == round(0.05 * rate)
+    assert {name: v[0] for name, v in r["rows"].items()} == {name: 0 for name in r["rows"]}
+    assert r["final_words_differing"] == 0
+    assert {name: v[0] for name, v in r["numba"].items()} == {"force": 0, "string_velocity": 0, "estimates": 0}
+    assert np.any(r["arm_out"][0] != 0.0)  # the loop bowed: a force to compare
+
+
+@needs_arm
+def test_bad_sensor_samples_take_the_same_guard_and_fault_path_on_both(elf, protocol, tmp_path):
+    """NaN, inf and out-of-bound samples: the estimators' guard replaces them, the loop latches its fault."""
+    rate = 5000.0
+    stream, _, _ = arm_loop.record(rate, 0.04, "KALLEV", 1.0, 0, protocol[1])
+    x, a, v = (s.copy() for s in stream)
+    v[50] = np.inf
+    x[60] = 2.0  # beyond the guard's 1 m
+    x[120] = np.nan  # latches the sensor fault: the force is 0 from here on
+    r = arm_loop.compare_stream(elf, lambda: arm_loop.new_loop(rate, "KALLEV", 1.0, 0, protocol[1]).control.arrays,
+                                (x, a, v), 6, tmp_path)
+    assert {name: v[0] for name, v in r["rows"].items()} == {name: 0 for name in r["rows"]}
+    assert r["final_words_differing"] == 0
+    assert np.all(r["arm_out"][0, 120:] == 0.0) and np.any(r["arm_out"][0, :120] != 0.0)
+
+
+@needs_arm
+def test_systick_under_icount_counts_instructions(elf, protocol, tmp_path):
+    """The calibration loop's 2 x 100000 instructions (subs, bne) read as 2^S ns / 40 ns each (25 MHz SysTick)."""
+    stream, _, _ = arm_loop.record(5000.0, 0.01, "LVT", 1.0, 0, protocol[1])
+    for shift in (5, 6, 7):
+        r = arm_loop.compare_stream(elf, lambda: arm_loop.new_loop(5000.0, "LVT", 1.0, 0, protocol[1]).control.arrays,
+                                    stream, shift, tmp_path)
+        insns, ticks, empty = r["meta"]
+        assert insns == 200000
+        assert abs(ticks * 40 / 2 ** shift - insns) <= 1  # each read within a tick: one instruction in all
+        assert empty * 40 / 2 ** shift <= 10  # two reads in a row: a few instructions
+        assert 1000 < r["insn_median"] < 20000
+
+
+def test_bad_input_is_one_line_and_exit_2():
+    done = subprocess.run([sys.executable, str(ROOT / "scripts" / "arm_loop.py"), "--conditions", "NOPE"],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 2 and "--conditions 'NOPE': allowed are" in done.stderr
+    assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
