@@ -14,6 +14,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
+import arm_insn_mix  # noqa: E402
 import arm_loop  # noqa: E402
 
 MISSING = arm_loop.missing_tools()
@@ -73,6 +74,23 @@ def test_systick_under_icount_counts_instructions(elf, protocol, tmp_path):
         assert abs(ticks * 40 / 2 ** shift - insns) <= 4
         assert empty * 40 / 2 ** shift <= 10  # two reads in a row: a few instructions
         assert 1000 < r["insn_median"] < 20000
+
+
+@needs_arm
+def test_the_trace_counts_what_systick_counts_but_the_harness_call(elf, protocol, tmp_path):
+    """Two independent counts: SysTick under icount around the call, and qemu's log of every executed instruction
+    from sl_sample's entry to its return. They differ by the harness's own instructions in SysTick's window (the
+    arguments, the call, the second read): one constant, whatever the rate or the condition."""
+    offsets = []
+    for rate, condition in ((5000.0, "KALFOAW"), (20000.0, "LVT"), (96000.0, "LEVANT")):
+        stream, _, _ = arm_loop.record(rate, 50 / rate, condition, 1.0, 0, protocol[1])
+        make = lambda: arm_loop.new_loop(rate, condition, 1.0, 0, protocol[1]).control.arrays  # noqa: E731
+        counted = arm_loop.compare_stream(elf, make, stream, 6, tmp_path)["insn_mean"]
+        n, by_class, _, _, _ = arm_insn_mix.mix(elf, stream, make, tmp_path)
+        traced = sum(by_class.values()) / n
+        offsets.append(counted - traced)
+    assert 0 < offsets[0] < 20
+    assert max(offsets) - min(offsets) < 0.1  # a tick's rounding over 50 samples
 
 
 def test_bad_input_is_one_line_and_exit_2():
