@@ -77,15 +77,19 @@ def object_sizes(build_dir):
 
 
 def library_calls(build_dir):
-    """[(symbol, library)]: what the loop's objects take from the toolchain's libraries (the link map's
-    "Archive member included" list: the member, then the object and symbol that pulled it in)."""
-    lines = (Path(build_dir) / "harness.map").read_text().split("\n\n")[0].splitlines()[1:]
-    calls = []
-    for member, by in zip(lines[::2], lines[1::2]):
-        who, _, symbol = by.strip().rpartition(" ")
-        if Path(who).name.startswith("studyapp_"):
-            calls.append((symbol.strip("()"), Path(member.split("(")[0]).name))
-    return calls
+    """The symbols the loop's objects need from outside themselves (arm-none-eabi-nm -u): the toolchain's."""
+    objs = [str(p) for p in Path(build_dir).glob("studyapp_*.o")]
+    own = subprocess.run(["arm-none-eabi-nm", "--defined-only", *objs], capture_output=True, text=True, check=True)
+    need = subprocess.run(["arm-none-eabi-nm", "-u", *objs], capture_output=True, text=True, check=True)
+    defined = {line.split()[-1] for line in own.stdout.splitlines() if len(line.split()) == 3}
+    return sorted({line.split()[-1] for line in need.stdout.splitlines() if line.strip().startswith("U ")} - defined)
+
+
+def stack_bound(build_dir):
+    """Bytes of stack the loop can take at most: every function's frame added up (-fstack-usage's .su files;
+    the loop has no recursion, so no chain of calls takes more)."""
+    return sum(int(line.split("\t")[1]) for su in Path(build_dir).glob("studyapp_*.su")
+               for line in su.read_text().splitlines() if line.strip())
 
 
 def conditions():
@@ -175,8 +179,12 @@ def instructions(ticks, meta):
 
 
 def array_bytes(arrays):
-    """The RAM of the loop's arrays (bytes): ctl to nut, as a firmware holds them."""
-    return int(sum(a.nbytes for a in arrays[:N_ARRAYS]))
+    """The RAM of the loop's arrays (bytes), as a firmware holds them: {part: bytes} and the total."""
+    ctl, state, lp, ls, kinds, est_s, est_p, sp, ss, bridge, nut = arrays[:N_ARRAYS]
+    parts = {"estimator states": est_s.nbytes, "estimator parameters": est_p.nbytes + kinds.nbytes,
+             "delay lines": bridge.nbytes + nut.nbytes,
+             "control, limits, string": sum(a.nbytes for a in (ctl, state, lp, ls, sp, ss))}
+    return {k: int(v) for k, v in parts.items()}
 
 
 def compare_stream(elf, make_arrays, stream, shift, workdir):
@@ -196,6 +204,7 @@ def compare_stream(elf, make_arrays, stream, shift, workdir):
     insn = instructions(ticks, meta)
     return {"n": n, "rows": rows, "final_words_differing": final, "arm_out": arm_out, "arm_est": arm_est,
             "insn_mean": float(insn.mean()), "insn_median": float(np.median(insn)), "insn_max": float(insn.max()),
+            "insn_first": float(insn[0]), "insn_max_after_first": float(insn[1:].max(initial=0.0)),
             "meta": [int(v) for v in meta], "console": console, "bytes": array_bytes(arm_arrays), "qemu_s": qemu_s}
 
 
@@ -218,7 +227,7 @@ def load(insn_per_sample, rate, clock=CLOCK_HZ):
     return insn_per_sample * rate / clock
 
 
-def report(results, sizes, calls, shift):
+def report(results, sizes, calls, stack, shift):
     loop_text = sum(v[0] for v in sizes.values())
     loop_data = sum(v[1] for v in sizes.values())
     loop_bss = sum(v[2] for v in sizes.values())
@@ -227,7 +236,8 @@ def report(results, sizes, calls, shift):
         f"loads at {CLOCK_HZ / 1e6:.0f} MHz, one instruction a cycle",
         "",
         "| rate (Hz) | condition | samples | ARM = x86 (samples differing, max abs diff) | ARM = numba "
-        "(force, string, estimates) | instructions/sample median (mean, max) | load at max | arrays (bytes) |",
+        "(force, string, estimates) | instructions/sample: median, max after the first (the first) | load at the "
+        "max | arrays (bytes) |",
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for r in results:
@@ -235,14 +245,17 @@ def report(results, sizes, calls, shift):
         numba = ", ".join(str(v[0]) for v in r["numba"].values())
         lines.append(
             f"| {r['rate']:g} | {r['condition']} | {r['n']} | {worst[0]} ({worst[1]:.3g}); "
-            f"final arrays {r['final_words_differing']} | {numba} | {r['insn_median']:.0f} ({r['insn_mean']:.0f}, "
-            f"{r['insn_max']:.0f}) | {100 * load(r['insn_max'], r['rate']):.1f} % | {r['bytes']} |")
+            f"final arrays {r['final_words_differing']} | {numba} | {r['insn_median']:.0f}, "
+            f"{r['insn_max_after_first']:.0f} ({r['insn_first']:.0f}) | {100 * load(r['insn_max'], r['rate']):.1f} % | "
+            f"{sum(r['bytes'].values())} |")
     lines += [
         "",
+        *(f"arrays at {r['rate']:g} Hz: " + ", ".join(f"{k} {v} B" for k, v in r["bytes"].items())
+          for r in {r["rate"]: r for r in results}.values()),
         f"loop code (arm-none-eabi-size of {len(sizes)} objects, -O2): text {loop_text} B, data {loop_data} B, "
-        f"bss {loop_bss} B",
+        f"bss {loop_bss} B; stack at most {stack} B (every frame added up)",
         "the loop's calls into the toolchain's libraries: "
-        + (", ".join(f"{sym} ({lib})" for sym, lib in calls) or "none"),
+        + (", ".join(calls) or "none"),
         f"instruction calibration: {results[0]['meta'][0]} instructions = {results[0]['meta'][1]} ticks "
         f"(expected 2^{shift} ns / 40 ns = {2 ** shift / 40:g} instructions a tick); empty interval "
         f"{results[0]['meta'][2]} ticks",
@@ -308,7 +321,7 @@ def main(argv=None):
                                 workdir)
             say(f"  qemu {r['qemu_s']:.1f} s; {r['insn_median']:.0f} instructions a sample")
             results.append(r)
-    print(report(results, object_sizes(build_dir), library_calls(build_dir), args.shift))
+    print(report(results, object_sizes(build_dir), library_calls(build_dir), stack_bound(build_dir), args.shift))
     equal = all(v[0] == 0 for r in results for v in r["rows"].values()) and \
         all(r["final_words_differing"] == 0 for r in results)
     return 0 if equal else 1
