@@ -86,7 +86,7 @@ def test_the_trace_counts_what_systick_counts_but_the_harness_call(elf, protocol
         stream, _, _ = arm_loop.record(rate, 50 / rate, condition, 1.0, 0, protocol[1])
         make = lambda: arm_loop.new_loop(rate, condition, 1.0, 0, protocol[1]).control.arrays  # noqa: E731
         counted = arm_loop.compare_stream(elf, make, stream, 6, tmp_path)["insn_mean"]
-        n, by_class, _, _, _ = arm_insn_mix.mix(elf, stream, make, tmp_path)
+        n, by_class, _, _, _, _ = arm_insn_mix.mix(elf, stream, make, tmp_path)
         traced = sum(by_class.values()) / n
         offsets.append(counted - traced)
     assert 0 < offsets[0] < 20
@@ -98,3 +98,29 @@ def test_bad_input_is_one_line_and_exit_2():
                           capture_output=True, text=True, cwd=ROOT)
     assert done.returncode == 2 and "--conditions 'NOPE': allowed are" in done.stderr
     assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
+
+
+def test_the_in_order_model_against_closed_forms():
+    """scripts/arm_insn_mix.py's model: independent integer instructions pair (n/2 cycles), a chain of dependent
+    double multiplies waits 7 cycles a link, double loads issue alone, a double add pairs with an integer one."""
+    cycles = arm_insn_mix.in_order_cycles
+    independent = [("add", f"r{2 * (i % 4)}, r{2 * (i % 4) + 1}, #1") for i in range(100)]
+    assert cycles(independent) == 50
+    assert cycles([("vmul.f64", "d0, d0, d1")] * 10) == 9 * 7 + 1
+    assert cycles([("vldr", f"d{i % 8}, [r3, #{8 * i}]") for i in range(10)]) == 10
+    assert cycles([("vadd.f64", "d0, d1, d2"), ("add", "r0, r1, #1")] * 10) == 10
+    assert cycles([("vadd.f64", "d0, d1, d2"), ("vadd.f64", "d3, d4, d5")] * 10) == 20  # one FP op a cycle
+    assert cycles([("vmla.f64", "d7, d5, d6")] * 3) == 2 * 11 + 1  # the accumulator is a source
+    # the branch waits a cycle for the flags, then pairs with the next subs: 1 + 5 cycles
+    assert cycles([("subs", "r3, #1"), ("bne.n", "1b")] * 5) == 6
+
+
+def test_the_classes_and_the_flags_of_a_mnemonic():
+    assert arm_insn_mix.split_mnemonic("lsls") == ("lsl", True, False)  # not lsl + the condition "ls"
+    assert arm_insn_mix.split_mnemonic("movls") == ("mov", False, True)
+    assert arm_insn_mix.split_mnemonic("bics") == ("bic", True, False)
+    assert arm_insn_mix.classify("vpop", "{d8-d13}")[1:3] == ("alone", 6)
+    assert arm_insn_mix.classify("vdiv.f64", "d0, d1, d2")[0] == "double divide and square root"
+    assert arm_insn_mix.classify("bic", "r1, r2")[0] == "integer and other"
+    assert arm_insn_mix.classify("pop", "{r4, pc}")[0] == "branches"
+    assert arm_insn_mix.classify("ldr", "r0, [pc, #20]")[0] == "integer and other"
