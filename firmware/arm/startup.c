@@ -3,9 +3,10 @@
  * its load address, zeroes .bss, turns the FPU on and calls main.
  *
  * The FPU: coprocessors CP10 and CP11 get full access in CPACR (bits 20-23) before any floating-point
- * instruction runs (the loop is all double precision: -mfpu=fpv5-d16 -mfloat-abi=hard). FPSCR keeps its
- * reset value from FPDSCR: round to nearest, no flush to zero (FZ = 0) and no default NaN (DN = 0), the IEEE
- * arithmetic the loop's bit-for-bit equality with x86-64 needs (studyapp_estimators.h, "Maths library").
+ * instruction runs (the loop is all double precision: -mfpu=fpv5-d16 -mfloat-abi=hard). Then FPSCR and FPDSCR
+ * (the value every new floating-point context starts from) are set to 0, whatever a boot loader left: round
+ * to nearest, no flush to zero (FZ = 0) and no default NaN (DN = 0), the IEEE arithmetic the loop's
+ * bit-for-bit equality with x86-64 needs (studyapp_estimators.h, "Maths library").
  * A fault of any kind reports through semihosting and stops with exit status 3. */
 #include <stdint.h>
 
@@ -15,6 +16,7 @@ extern uint32_t __data_start, __data_end, __data_load, __bss_start, __bss_end, _
 int main(void);
 
 #define CPACR (*(volatile uint32_t *)0xE000ED88u)
+#define FPDSCR (*(volatile uint32_t *)0xE000EF3Cu)
 
 void reset_handler(void)
 {
@@ -23,6 +25,8 @@ void reset_handler(void)
     for (dst = &__bss_start; dst < &__bss_end; dst++) *dst = 0;
     CPACR |= 0xFu << 20;
     __asm volatile("dsb\n\tisb" ::: "memory");
+    FPDSCR = 0u;
+    __asm volatile("vmsr fpscr, %0" : : "r"(0u) : "memory");
     sh_exit(main());
 }
 
