@@ -226,9 +226,9 @@ def trace(elf, workdir):
     return log
 
 
-def mix(elf, stream, make_arrays, workdir):
-    """(samples, {class: count}, {function: count}, issue bound, serial bound, in-order model's cycles), all but
-    samples summed over the samples."""
+def mix(elf, stream, make_arrays, workdir, model=True):
+    """(samples, {class: count}, {function: count}, issue bound, serial bound, in-order model's cycles or None
+    when not ``model``), all but samples summed over the samples."""
     arm_loop.write_input(Path(workdir) / "arm_in.bin", make_arrays(), stream)
     log = trace(elf, workdir)
     table = disassembly(elf)
@@ -239,7 +239,8 @@ def mix(elf, stream, make_arrays, workdir):
     with open(log) as lines:
         for pc in loop_instructions(lines, table, entry):
             func, mnemonic, operands = table[pc]
-            executed.append((mnemonic, operands))
+            if model:
+                executed.append((mnemonic, operands))
             cls, issue, n, cycles = classify(mnemonic, operands)
             by_class[cls] += 1
             by_function[func] += 1
@@ -249,7 +250,7 @@ def mix(elf, stream, make_arrays, workdir):
             serial += cycles
     log.unlink()
     issue_bound = alone + max(fp, (fp + paired) / 2)
-    return stream[0].shape[0], by_class, by_function, issue_bound, serial, in_order_cycles(executed)
+    return stream[0].shape[0], by_class, by_function, issue_bound, serial, in_order_cycles(executed) if model else None
 
 
 def main(argv=None):

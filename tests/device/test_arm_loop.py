@@ -77,6 +77,7 @@ def test_systick_under_icount_counts_instructions(elf, protocol, tmp_path):
 
 
 @needs_arm
+@pytest.mark.slow
 def test_the_trace_counts_what_systick_counts_but_the_harness_call(elf, protocol, tmp_path):
     """Two independent counts: SysTick under icount around the call, and qemu's log of every executed instruction
     from sl_sample's entry to its return. They differ by the harness's own instructions in SysTick's window (the
@@ -86,17 +87,24 @@ def test_the_trace_counts_what_systick_counts_but_the_harness_call(elf, protocol
         stream, _, _ = arm_loop.record(rate, 50 / rate, condition, 1.0, 0, protocol[1])
         make = lambda: arm_loop.new_loop(rate, condition, 1.0, 0, protocol[1]).control.arrays  # noqa: E731
         counted = arm_loop.compare_stream(elf, make, stream, 6, tmp_path)["insn_mean"]
-        n, by_class, _, _, _, _ = arm_insn_mix.mix(elf, stream, make, tmp_path)
+        n, by_class, _, _, _, _ = arm_insn_mix.mix(elf, stream, make, tmp_path, model=False)
         traced = sum(by_class.values()) / n
         offsets.append(counted - traced)
     assert 0 < offsets[0] < 20
     assert max(offsets) - min(offsets) < 0.1  # a tick's rounding over 50 samples
 
 
-def test_bad_input_is_one_line_and_exit_2():
-    done = subprocess.run([sys.executable, str(ROOT / "scripts" / "arm_loop.py"), "--conditions", "NOPE"],
-                          capture_output=True, text=True, cwd=ROOT)
-    assert done.returncode == 2 and "--conditions 'NOPE': allowed are" in done.stderr
+@pytest.mark.parametrize("script, args, says", [
+    ("arm_loop.py", ["--conditions", "NOPE"], "--conditions 'NOPE': allowed are"),
+    ("arm_loop.py", ["--rates", "abc"], "--rates 'abc'"),
+    ("arm_loop.py", ["--seconds", "0"], "--seconds 0.0: allowed is"),
+    ("arm_insn_mix.py", ["--condition", "NOPE"], "--condition 'NOPE': allowed are"),
+    ("arm_insn_mix.py", ["--samples", "0"], "--samples 0: allowed is"),
+])
+def test_bad_input_is_one_line_and_exit_2(script, args, says):
+    done = subprocess.run([sys.executable, str(ROOT / "scripts" / script), *args], capture_output=True, text=True,
+                          cwd=ROOT)
+    assert done.returncode == 2 and says in done.stderr
     assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
 
 
