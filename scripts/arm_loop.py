@@ -39,7 +39,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 FIRMWARE = ROOT / "firmware" / "arm"
 PROTOCOL = ROOT / "protocols" / "sinclair2014.toml"
-TOOLS = ("make", "arm-none-eabi-gcc", "arm-none-eabi-size", "qemu-system-arm")
+TOOLS = ("make", "arm-none-eabi-gcc", "arm-none-eabi-size", "arm-none-eabi-nm", "arm-none-eabi-objdump",
+         "qemu-system-arm")
 CLOCK_HZ = 600e6  # the Cortex-M7 a lab would buy (the STM32H7 and i.MX RT parts run it at 480-600 MHz)
 MAGIC = 0x31414C53  # "SLA1", harness.c
 N_OUT = 7  # sl_out's members, harness.c's first columns
