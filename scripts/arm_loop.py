@@ -41,7 +41,7 @@ FIRMWARE = ROOT / "firmware" / "arm"
 PROTOCOL = ROOT / "protocols" / "sinclair2014.toml"
 TOOLS = ("make", "arm-none-eabi-gcc", "arm-none-eabi-size", "arm-none-eabi-nm", "arm-none-eabi-objdump",
          "qemu-system-arm")
-CLOCK_HZ = 600e6  # the Cortex-M7 a lab would buy (the STM32H7 and i.MX RT parts run it at 480-600 MHz)
+CLOCK_HZ = 600e6  # the Cortex-M7 clock issue 40 asks about
 MAGIC = 0x31414C53  # "SLA1", harness.c
 N_OUT = 7  # sl_out's members, harness.c's first columns
 OUT_ROWS = ("force", "source_velocity", "string_velocity", "bridge_velocity", "v_delta", "stick", "friction")
@@ -234,7 +234,7 @@ def report(results, sizes, calls, stack, shift):
     loop_bss = sum(v[2] for v in sizes.values())
     lines = [
         f"qemu-system-arm -M mps2-an500 (Cortex-M7, fpv5-d16, hard float), -icount shift={shift}; "
-        f"loads at {CLOCK_HZ / 1e6:.0f} MHz, one instruction a cycle",
+        f"loads at {CLOCK_HZ / 1e6:.0f} MHz, one instruction a cycle (optimistic: scripts/arm_insn_mix.py's cycles)",
         "",
         "| rate (Hz) | condition | samples | ARM = x86 (samples differing, max abs diff) | ARM = numba "
         "(force, string, estimates) | instructions/sample: median, max after the first (the first) | load at the "
