@@ -291,7 +291,8 @@ def main(argv=None):
     print("\n| function | per sample |\n| --- | --- |")
     for func, count in by_function.most_common():
         print(f"| {func} | {count / n:.1f} |")
-    print("\n| cycles a sample | cycles | per instruction | load at 5 kHz | at 20 kHz |\n| --- | --- | --- | --- | --- |")
+    print("\n| cycles a sample | cycles | per instruction | load at 5 kHz | at 20 kHz |")
+    print("| --- | --- | --- | --- | --- |")
     for name, cycles in (("issue bound", issue), ("in-order model", model), ("serial bound", serial)):
         loads = [100 * cycles / n * rate / arm_loop.CLOCK_HZ for rate in (5000.0, 20000.0)]
         print(f"| {name} | {cycles / n:.0f} | {cycles / total:.2f} | {loads[0]:.1f} % | {loads[1]:.1f} % |")

@@ -46,6 +46,8 @@ MAGIC = 0x31414C53  # "SLA1", harness.c
 N_OUT = 7  # sl_out's members, harness.c's first columns
 OUT_ROWS = ("force", "source_velocity", "string_velocity", "bridge_velocity", "v_delta", "stick", "friction")
 N_ARRAYS = 11  # ctl .. nut: the part of Control.arrays the C loop owns (studyapp_loop.h)
+RESET_STRING = 0xFFFFFFFF  # an event's "what" that puts the string at rest (harness.c)
+EVENT = np.dtype([("k", "<u4"), ("what", "<u4"), ("value", "<f8")])
 
 
 def say(text):
@@ -115,10 +117,12 @@ def record(rate, seconds, condition, fmax, seed, estimators):
     return (result["position"], result["acceleration"], result["velocity_lvt"]), result, loop.names
 
 
-def write_input(path, arrays, stream):
+def write_input(path, arrays, stream, events=()):
+    """harness.c's arm_in.bin: the arrays, the control events (k, what, value) in sample order, the stream."""
     ctl, state, lp, ls, kinds, est_s, est_p, sp, ss, bridge, nut = arrays[:N_ARRAYS]
     n = stream[0].shape[0]
-    head = np.array([MAGIC, kinds.shape[0], est_s.shape[1], est_p.shape[1], bridge.shape[0], n, 0, 0], np.uint32)
+    head = np.array([MAGIC, kinds.shape[0], est_s.shape[1], est_p.shape[1], bridge.shape[0], n, len(events), 0],
+                    np.uint32)
     with open(path, "wb") as f:
         f.write(head.astype("<u4").tobytes())
         for a in (ctl, state, lp, ls):
@@ -126,6 +130,7 @@ def write_input(path, arrays, stream):
         f.write(kinds.astype("<i8").tobytes())
         for a in (est_s, est_p, sp, ss, bridge, nut):
             f.write(np.ascontiguousarray(a).astype("<f8").tobytes())
+        f.write(np.array(list(events), EVENT).tobytes())
         f.write(np.column_stack(stream).astype("<f8").tobytes())
 
 
@@ -155,11 +160,22 @@ def read_outputs(workdir, n, arrays):
     return rows[:, :N_OUT].T, rows[:, N_OUT:].T, ticks, final, meta
 
 
-def x86_outputs(arrays, stream):
+def x86_outputs(arrays, stream, events=()):
+    """The C loop on this machine over the stream, the events applied before their samples as harness.c does."""
     from studyapp.device.c_loop import CLoop
 
     c = CLoop(arrays)
-    out, est = c.run(*stream)
+    n = stream[0].shape[0]
+    out, est = np.empty((N_OUT, n)), np.empty((c.n_est, n))
+    cuts = sorted({int(k) for k, _, _ in events if k < n} | {0, n})
+    for a, b in zip(cuts, cuts[1:]):
+        for k, what, value in events:
+            if k == a:
+                if what == RESET_STRING:
+                    c.reset_string()
+                else:
+                    arrays[0][what] = value
+        out[:, a:b], est[:, a:b] = c.run(*(s[a:b] for s in stream), k0=a)
     return out, est, arrays[:N_ARRAYS]
 
 
@@ -188,16 +204,18 @@ def array_bytes(arrays):
     return {k: int(v) for k, v in parts.items()}
 
 
-def compare_stream(elf, make_arrays, stream, shift, workdir):
-    """ARM against x86 on one sensor stream, each on fresh arrays from ``make_arrays()``: the figures (a dict)."""
+def compare_stream(elf, make_arrays, stream, shift, workdir, events=()):
+    """ARM against x86 on one sensor stream and its control events (k, what, value; harness.c), each on fresh
+    arrays from ``make_arrays()``: the figures (a dict)."""
     n = stream[0].shape[0]
+    events = sorted(events, key=lambda e: e[0])  # stable: events of one sample act in the order given
     arm_arrays = make_arrays()
-    write_input(Path(workdir) / "arm_in.bin", arm_arrays, stream)
+    write_input(Path(workdir) / "arm_in.bin", arm_arrays, stream, events)
     t0 = time.perf_counter()
     console = run_qemu(elf, workdir, shift)
     qemu_s = time.perf_counter() - t0
     arm_out, arm_est, ticks, arm_final, meta = read_outputs(workdir, n, arm_arrays)
-    x86_out, x86_est, x86_final = x86_outputs(make_arrays(), stream)
+    x86_out, x86_est, x86_final = x86_outputs(make_arrays(), stream, events)
     rows = {name: differing(arm_out[i], x86_out[i]) for i, name in enumerate(OUT_ROWS)}
     rows["estimates"] = differing(arm_est, x86_est)
     final = sum(int(np.count_nonzero(a.reshape(-1).view(np.uint64) != b.reshape(-1).view(np.uint64)))

@@ -3,9 +3,12 @@
  * writes every sample's outputs back, with the SysTick ticks each sample took.
  *
  * Files, in the emulator's current directory, little-endian (scripts/arm_loop.py writes and reads them):
- *   arm_in.bin     header: uint32 magic "SLA1", n_est, est_s_width, est_p_width, line, n_samples, 0, 0;
- *                  then float64 ctl, state, lp, ls, int64 kinds, float64 est_s, est_p (row-major), sp,
- *                  ss, bridge, nut (studyapp_loop.h's sl_loop), then n_samples x (x_m, a_m, v_m) float64
+ *   arm_in.bin     header: uint32 magic "SLA1", n_est, est_s_width, est_p_width, line, n_samples,
+ *                  n_events, 0; then float64 ctl, state, lp, ls, int64 kinds, float64 est_s, est_p
+ *                  (row-major), sp, ss, bridge, nut (studyapp_loop.h's sl_loop); then n_events control
+ *                  events in sample order, each uint32 k, uint32 what, float64 value: before sample k,
+ *                  ctl[what] = value, or the string at rest (sl_reset_string) for what = RESET_STRING, as
+ *                  the host's CONTROL frames act; then n_samples x (x_m, a_m, v_m) float64
  *   arm_out.bin    n_samples x (sl_out's 7 members, then the n_est estimates) float64
  *   arm_ticks.bin  n_samples uint32: SysTick ticks around sl_sample
  *   arm_state.bin  the arrays after the last sample, in arm_in.bin's order (ctl to nut)
@@ -26,6 +29,8 @@
 #define MAGIC 0x31414c53u /* "SLA1" */
 #define CHUNK 256u        /* samples read, run and written per semihosting transfer */
 #define CAL_LOOPS 100000u
+#define RESET_STRING 0xFFFFFFFFu
+#define MAX_EVENTS 4096u
 
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
 #define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
@@ -84,9 +89,14 @@ typedef struct {
     uint32_t bytes;
 } span;
 
+typedef struct {
+    uint32_t k, what;
+    double value;
+} event;
+
 int main(void)
 {
-    uint32_t head[8], n, i, k, n_spans, cal_ticks, empty;
+    uint32_t head[8], n, i, k, n_spans, cal_ticks, empty, n_events, next = 0;
     uint64_t sum = 0, max = 0;
     int in, out, tick_file;
     sl_loop L;
@@ -94,6 +104,7 @@ int main(void)
     span spans[11];
     double *sensors, *rows;
     uint32_t *ticks;
+    event *events;
 
     SYST_RVR = 0xFFFFFFu;
     SYST_CVR = 0u;
@@ -107,6 +118,8 @@ int main(void)
     L.est_p_width = head[3];
     L.line = head[4];
     n = head[5];
+    n_events = head[6];
+    if (n_events > MAX_EVENTS) return fail("arm_in.bin: more control events than MAX_EVENTS");
     spans[0] = (span){L.ctl = take(SL_N_CONTROL * 8u), SL_N_CONTROL * 8u};
     spans[1] = (span){L.state = take(SL_N_LOOP_STATE * 8u), SL_N_LOOP_STATE * 8u};
     spans[2] = (span){(void *)(L.lp = take(SL_N_LIMIT_PARAMS * 8u)), SL_N_LIMIT_PARAMS * 8u};
@@ -122,9 +135,14 @@ int main(void)
     sensors = take(CHUNK * 3u * 8u);
     rows = take(CHUNK * (SL_N_OUT + L.n_est) * 8u);
     ticks = take(CHUNK * 4u);
-    if (!sensors || !rows || !ticks || !L.nut) return fail("arm_in.bin: the arrays do not fit the arena");
+    events = take(MAX_EVENTS * sizeof(event));
+    if (!sensors || !rows || !ticks || !events || !L.nut) return fail("arm_in.bin: the arrays do not fit the arena");
     for (i = 0; i < n_spans; i++)
         if (sh_read(in, spans[i].at, spans[i].bytes)) return fail("arm_in.bin: shorter than its header says");
+    if (sh_read(in, events, n_events * sizeof(event))) return fail("arm_in.bin: fewer events than its header says");
+    for (i = 0; i < n_events; i++)
+        if ((events[i].what >= SL_N_CONTROL && events[i].what != RESET_STRING) || (i && events[i].k < events[i - 1].k))
+            return fail("arm_in.bin: an event out of order or of no control");
     if (sl_check(&L) != 0) return fail("arm_in.bin: the arrays fail sl_check");
 
     out = sh_open("arm_out.bin", 1);
@@ -137,7 +155,14 @@ int main(void)
         for (i = 0; i < m; i++) {
             double *row = rows + i * (SL_N_OUT + L.n_est);
             const double *s = sensors + 3u * i;
-            uint32_t t0 = SYST_CVR;
+            uint32_t t0;
+            for (; next < n_events && events[next].k == k + i; next++) {
+                if (events[next].what == RESET_STRING)
+                    sl_reset_string(&L);
+                else
+                    L.ctl[events[next].what] = events[next].value;
+            }
+            t0 = SYST_CVR;
             sl_sample(&L, k + i, s[0], s[1], s[2], &o, row + SL_N_OUT);
             ticks[i] = ticks_since(t0);
             row[0] = o.force;

@@ -62,6 +62,29 @@ def test_bad_sensor_samples_take_the_same_guard_and_fault_path_on_both(elf, prot
 
 
 @needs_arm
+def test_control_events_act_at_their_sample_on_both(elf, protocol, tmp_path):
+    """The host's CONTROL frames as the device applies them before a sample: F_max, source, bowing, force scale,
+    a string reset; ARM and x86 equal bit for bit, and each event seen where it acts."""
+    from studyapp.model import control
+
+    rate = 5000.0
+    stream, _, names = arm_loop.record(rate, 0.1, "KALFOAW", 2.0, 0, protocol[1])
+    peak = arm_loop.new_loop(rate, "KALFOAW", 2.0, 0, protocol[1]).string.peak_friction()
+    events = [(100, control.C_GAIN, 5.0 / peak), (150, control.C_SOURCE, names.index("LEVANT")),
+              (200, control.C_BOWING, 0.0), (250, control.C_BOWING, 1.0), (250, arm_loop.RESET_STRING, 0.0),
+              (300, control.C_FORCE_SCALE, 0.5), (350, control.C_SOURCE, -2.0), (400, control.C_GAIN, 20.0 / peak)]
+    r = arm_loop.compare_stream(elf, lambda: arm_loop.new_loop(rate, "KALFOAW", 2.0, 0, protocol[1]).control.arrays,
+                                stream, 6, tmp_path, events)
+    assert {name: v[0] for name, v in r["rows"].items()} == {name: 0 for name in r["rows"]}
+    assert r["final_words_differing"] == 0
+    force, source = r["arm_out"][0], r["arm_out"][1]
+    assert np.all(force[200:250] == 0.0) and np.any(force[250:300] != 0.0)  # the bow lifted, then down again
+    assert np.array_equal(source[350:], stream[2][350:])  # LVT drives the bow from sample 350
+    assert np.array_equal(source[150:350], r["arm_est"][names.index("LEVANT"), 150:350])
+    assert np.abs(force[400:]).max() > np.abs(force[:100]).max()  # F_max 20 N against 2 N
+
+
+@needs_arm
 def test_systick_under_icount_counts_instructions(elf, protocol, tmp_path):
     """The calibration loop's 2 x 100000 instructions (subs, bne) read as 2^S ns / 40 ns each (25 MHz SysTick)."""
     stream, _, _ = arm_loop.record(5000.0, 0.01, "LVT", 1.0, 0, protocol[1])
