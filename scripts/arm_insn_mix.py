@@ -6,8 +6,8 @@ scripts/arm_loop.py counts instructions with qemu's -icount and the harness's Sy
 second, independent way and sorts them: qemu runs the same harness on a recorded stream with one instruction a
 translation block and logs every block it executes (-singlestep -d exec,nochain), so the log holds every
 executed instruction's address; each address is looked up in arm-none-eabi-objdump's disassembly of the ELF.
-The instructions from sl_sample's first until the return to the harness's main are the loop's (the
-estimators, the string and the libgcc helpers they call included).
+The instructions from sl_sample's first until the return to the harness (its ``timed``) are the loop's
+(the estimators, the string and the libgcc helpers they call included).
 
 From the mix, two bounds on the cycles of a sample on a real Cortex-M7, from LLVM's scheduling model of the
 core (llvm/lib/Target/ARM/ARMScheduleM7.td: dual issue; double-precision arithmetic, loads and stores issue
@@ -40,6 +40,7 @@ FUNCTION = re.compile(r"^([0-9a-f]+) <(.+)>:")
 LATENCY = {"vdiv": 30, "vsqrt": 30, "vmul": 7, "vnmul": 7, "vmla": 11, "vmls": 11, "vnmla": 11, "vnmls": 11,
            "vfma": 11, "vfms": 11}
 MISPREDICT = 4
+CALLERS = ("timed", "main")  # harness.c's functions around sl_sample's call
 BRANCH = re.compile(r"^(b|bl|bx|blx)(eq|ne|cs|cc|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|hs|lo)?(\.[nw])?$")
 CLASSES = ("double divide and square root", "double arithmetic, compare, convert, move",
            "double loads and stores", "FP flags to the core (vmrs)", "branches", "integer and other")
@@ -200,7 +201,7 @@ def in_order_cycles(instructions):
 
 
 def loop_instructions(trace_lines, table, entry):
-    """Per executed instruction of the loop: its address (from sl_sample's entry until main runs again)."""
+    """Per executed instruction of the loop: its address (from sl_sample's entry until the harness runs again)."""
     inside = False
     for line in trace_lines:
         if not line.startswith("Trace"):
@@ -208,7 +209,7 @@ def loop_instructions(trace_lines, table, entry):
         pc = int(line.split("[", 1)[1].split("/", 2)[1], 16)
         if pc == entry:
             inside = True
-        elif inside and table[pc][0] == "main":
+        elif inside and table[pc][0] in CALLERS:
             inside = False
         if inside:
             yield pc

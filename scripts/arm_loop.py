@@ -190,9 +190,10 @@ def differing(a, b):
 
 
 def instructions(ticks, meta):
-    """Instructions of each sample from its SysTick ticks (harness.c: calibration and the empty interval)."""
-    cal_insns, cal_ticks, empty = (int(v) for v in meta)
-    return (ticks.astype(np.float64) - empty) * cal_insns / cal_ticks
+    """sl_sample's instructions in each sample from its SysTick ticks (harness.c: the calibration, the window's
+    own ticks over its empty calls, the empty call's own instructions)."""
+    cal_insns, cal_ticks, empty, reps, no_sample = (int(v) for v in meta)
+    return (ticks.astype(np.float64) - empty / reps) * cal_insns / cal_ticks + no_sample
 
 
 def array_bytes(arrays):
@@ -276,8 +277,8 @@ def report(results, sizes, calls, stack, shift):
         "the loop's calls into the toolchain's libraries: "
         + (", ".join(calls) or "none"),
         f"instruction calibration: {results[0]['meta'][0]} instructions = {results[0]['meta'][1]} ticks "
-        f"(expected 2^{shift} ns / 40 ns = {2 ** shift / 40:g} instructions a tick); empty interval "
-        f"{results[0]['meta'][2]} ticks",
+        f"(expected 2^{shift} ns / 40 ns = {2 ** shift / 40:g} instructions a tick); the window's own "
+        f"{results[0]['meta'][2] / results[0]['meta'][3]:.2f} ticks (an empty call's), subtracted",
     ]
     return "\n".join(lines)
 

@@ -12,14 +12,18 @@
  *   arm_out.bin    n_samples x (sl_out's 7 members, then the n_est estimates) float64
  *   arm_ticks.bin  n_samples uint32: SysTick ticks around sl_sample
  *   arm_state.bin  the arrays after the last sample, in arm_in.bin's order (ctl to nut)
- *   arm_meta.bin   uint32: calibration instructions, their ticks, the ticks of an empty interval
+ *   arm_meta.bin   uint32: calibration instructions, their ticks, the ticks of EMPTY_REPS empty calls,
+ *                  EMPTY_REPS, NO_SAMPLE_INSNS
  *
  * Counting. SysTick counts the processor clock (CLKSOURCE = 1) down from 2^24 - 1: on a real M7 that is
  * cycles. Under qemu with -icount shift=S every instruction advances virtual time by 2^S ns and SysTick
  * follows the board's 25 MHz clock in virtual time, so ticks measure executed instructions. The harness
  * calibrates the ratio on a loop of exactly 2 x CAL_LOOPS instructions (subs, bne: the difference of two
- * lengths, so the call's own instructions cancel) and measures an empty interval (two reads in a row),
- * which it subtracts; instructions = (ticks - empty) x calibration instructions / calibration ticks.
+ * lengths, so the call's own instructions cancel). Each sample is timed by one function (timed) calling
+ * sl_sample through a pointer; the same function calling no_sample, whose body is one instruction, times
+ * the window's own instructions (the reads, the arguments, the call), which the host subtracts:
+ * sl_sample's instructions = (ticks - empty) x calibration instructions / calibration ticks
+ * + NO_SAMPLE_INSNS, empty being the mean of EMPTY_REPS timed calls of no_sample.
  * Exit status: 0, or 2 for a bad or missing input file, 3 for a processor fault (startup.c). */
 #include <stdint.h>
 
@@ -29,6 +33,8 @@
 #define MAGIC 0x31414c53u /* "SLA1" */
 #define CHUNK 256u        /* samples read, run and written per semihosting transfer */
 #define CAL_LOOPS 100000u
+#define EMPTY_REPS 64u
+#define NO_SAMPLE_INSNS 1u /* no_sample's body: bx lr (x_m, its result, is already in d0) */
 #define RESET_STRING 0xFFFFFFFFu
 #define MAX_EVENTS 4096u
 
@@ -59,6 +65,25 @@ static uint32_t spin_ticks(uint32_t n)
 {
     uint32_t t0 = SYST_CVR;
     spin(n);
+    return ticks_since(t0);
+}
+
+typedef double (*sample_fn)(sl_loop *, uint32_t, double, double, double, sl_out *, double *);
+
+/* a sample that does nothing, for the window's own cost: returns its first double where it came in */
+static double __attribute__((noipa)) no_sample(sl_loop *L, uint32_t k, double x_m, double a_m, double v_m,
+                                               sl_out *o, double *est)
+{
+    (void)L, (void)k, (void)a_m, (void)v_m, (void)o, (void)est;
+    return x_m;
+}
+
+/* SysTick ticks of one call of f on the sensor sample s: the same code whichever f */
+static uint32_t __attribute__((noipa)) timed(sample_fn f, sl_loop *L, uint32_t k, const double *s, sl_out *o,
+                                             double *est)
+{
+    uint32_t t0 = SYST_CVR;
+    f(L, k, s[0], s[1], s[2], o, est);
     return ticks_since(t0);
 }
 
@@ -96,8 +121,8 @@ typedef struct {
 
 int main(void)
 {
-    uint32_t head[8], n, i, k, n_spans, cal_ticks, empty, n_events, next = 0;
-    uint64_t sum = 0, max = 0;
+    uint32_t head[8], n, i, k, n_spans, cal_ticks, empty = 0, n_events, next = 0, max = 0;
+    uint64_t sum = 0;
     int in, out, tick_file;
     sl_loop L;
     sl_out o;
@@ -148,23 +173,21 @@ int main(void)
     out = sh_open("arm_out.bin", 1);
     tick_file = sh_open("arm_ticks.bin", 1);
     if (out < 0 || tick_file < 0) return fail("cannot write arm_out.bin or arm_ticks.bin");
-    empty = ticks_since(SYST_CVR);
+    for (i = 0; i < 3u * CHUNK; i++) sensors[i] = 0.0;
+    for (i = 0; i < EMPTY_REPS; i++) empty += timed(no_sample, &L, 0, sensors, &o, rows + SL_N_OUT);
     for (k = 0; k < n; k += CHUNK) {
         uint32_t m = n - k < CHUNK ? n - k : CHUNK;
         if (sh_read(in, sensors, m * 3u * 8u)) return fail("arm_in.bin: fewer samples than its header says");
         for (i = 0; i < m; i++) {
             double *row = rows + i * (SL_N_OUT + L.n_est);
             const double *s = sensors + 3u * i;
-            uint32_t t0;
             for (; next < n_events && events[next].k == k + i; next++) {
                 if (events[next].what == RESET_STRING)
                     sl_reset_string(&L);
                 else
                     L.ctl[events[next].what] = events[next].value;
             }
-            t0 = SYST_CVR;
-            sl_sample(&L, k + i, s[0], s[1], s[2], &o, row + SL_N_OUT);
-            ticks[i] = ticks_since(t0);
+            ticks[i] = timed(sl_sample, &L, k + i, s, &o, row + SL_N_OUT);
             row[0] = o.force;
             row[1] = o.source_velocity;
             row[2] = o.string_velocity;
@@ -172,8 +195,8 @@ int main(void)
             row[4] = o.v_delta;
             row[5] = o.stick;
             row[6] = o.friction;
-            sum += ticks[i] - empty;
-            if (ticks[i] - empty > max) max = ticks[i] - empty;
+            sum += ticks[i];
+            if (ticks[i] > max) max = ticks[i];
         }
         if (sh_write(out, rows, m * (SL_N_OUT + L.n_est) * 8u) || sh_write(tick_file, ticks, m * 4u))
             return fail("cannot write the outputs");
@@ -192,14 +215,20 @@ int main(void)
     head[0] = 2u * CAL_LOOPS;
     head[1] = cal_ticks;
     head[2] = empty;
+    head[3] = EMPTY_REPS;
+    head[4] = NO_SAMPLE_INSNS;
     out = sh_open("arm_meta.bin", 1);
-    if (out < 0 || sh_write(out, head, 3u * 4u)) return fail("cannot write arm_meta.bin");
+    if (out < 0 || sh_write(out, head, 5u * 4u)) return fail("cannot write arm_meta.bin");
     sh_close(out);
 
     put_number("samples: ", n);
-    if (n && cal_ticks) {
-        put_number("instructions per sample, mean x 100: ", sum * 200u * CAL_LOOPS / cal_ticks / n);
-        put_number("instructions per sample, max: ", max * 2u * CAL_LOOPS / cal_ticks);
+    if (n && cal_ticks && sum * EMPTY_REPS > (uint64_t)n * empty) {
+        /* the mean in hundredths: (sum / n - empty / EMPTY_REPS) x 2 CAL_LOOPS / cal_ticks + NO_SAMPLE_INSNS */
+        uint64_t net = sum * EMPTY_REPS - (uint64_t)n * empty;
+        put_number("instructions per sample, mean x 100: ",
+                   net * 200u * CAL_LOOPS / cal_ticks / EMPTY_REPS / n + 100u * NO_SAMPLE_INSNS);
+        put_number("instructions per sample, max: ",
+                   ((uint64_t)max * EMPTY_REPS - empty) * 2u * CAL_LOOPS / cal_ticks / EMPTY_REPS + NO_SAMPLE_INSNS);
     }
     return 0;
 }
