@@ -22,7 +22,7 @@ the condition's one the source):
    length: firmware/arm/harness.c) and prints the CPU load they imply at 600 MHz;
 
 and prints the sizes (arm-none-eabi-size of the loop's objects; the arrays' bytes at each rate). The table
-goes to stdout, progress to stderr. Exit 1 when an ARM output differs from x86's, 2 on bad input.
+goes to stdout, progress to stderr. Exit 1 when an ARM output differs from x86's or numba's, 2 on bad input.
 """
 
 import argparse
@@ -298,11 +298,22 @@ def parse_args(argv):
 
 def check_args(args, allowed):
     from studyapp.estimators.spec import validate_rate
+    from studyapp.model import calibration
+    from studyapp.model.loop import check_fmax
+    from studyapp.model.playable import check_playable
 
     try:
         rates = [validate_rate(float(r)) for r in args.rates.split(",")]
+        for rate in rates:
+            check_playable(rate, calibration.F0)
     except Exception as exc:  # noqa: BLE001 (a rate's own message is the one line to show)
         raise ValueError(f"--rates {args.rates!r}: {exc}") from None
+    try:
+        check_fmax(args.fmax)
+    except Exception as exc:  # noqa: BLE001
+        raise ValueError(f"--fmax: {exc}") from None
+    if args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: allowed is a whole number >= 0")
     names = allowed if args.conditions == "all" else args.conditions.split(",")
     bad = [c for c in names if c not in allowed]
     if bad:
@@ -342,7 +353,7 @@ def main(argv=None):
             say(f"  qemu {r['qemu_s']:.1f} s; {r['insn_median']:.0f} instructions a sample")
             results.append(r)
     print(report(results, object_sizes(build_dir), library_calls(build_dir), stack_bound(build_dir), args.shift))
-    equal = all(v[0] == 0 for r in results for v in r["rows"].values()) and \
+    equal = all(v[0] == 0 for r in results for v in (*r["rows"].values(), *r["numba"].values())) and \
         all(r["final_words_differing"] == 0 for r in results)
     return 0 if equal else 1
 

@@ -118,6 +118,8 @@ def test_the_trace_counts_what_systick_counts(elf, protocol, tmp_path):
     ("arm_loop.py", ["--conditions", "NOPE"], "--conditions 'NOPE': allowed are"),
     ("arm_loop.py", ["--rates", "abc"], "--rates 'abc'"),
     ("arm_loop.py", ["--seconds", "0"], "--seconds 0.0: allowed is"),
+    ("arm_loop.py", ["--rates", "1000"], "--rates '1000': rate 1000 Hz with f0"),
+    ("arm_loop.py", ["--fmax", "-1"], "--fmax: fmax = -1.0: allowed is"),
     ("arm_insn_mix.py", ["--condition", "NOPE"], "--condition 'NOPE': allowed are"),
     ("arm_insn_mix.py", ["--samples", "0"], "--samples 0: allowed is"),
 ])
