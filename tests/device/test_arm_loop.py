@@ -154,3 +154,14 @@ def test_the_classes_and_the_flags_of_a_mnemonic():
     assert arm_insn_mix.classify("bic", "r1, r2")[0] == "integer and other"
     assert arm_insn_mix.classify("pop", "{r4, pc}")[0] == "branches"
     assert arm_insn_mix.classify("ldr", "r0, [pc, #20]")[0] == "integer and other"
+
+
+def test_the_arm_build_compiles_what_the_host_build_links():
+    """firmware/arm/Makefile's LOOP names the C files of studyapp/device/c_loop.py's build: a file added there and
+    not here would leave the ARM build short of a symbol."""
+    from studyapp.device import c_loop
+
+    line = next(ln for ln in (ROOT / "firmware" / "arm" / "Makefile").read_text().splitlines()
+                if ln.startswith("LOOP ="))
+    assert sorted(f"{name}.c" for name in line.split("=", 1)[1].split()) == \
+        sorted(s for s in c_loop.sources() if s.endswith(".c"))
