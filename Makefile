@@ -7,7 +7,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 LOCK := requirements.lock
 
-.PHONY: run test setup lock clean figures
+.PHONY: run test setup lock clean figures arm
 
 # the exact versions and hashes of the lock (pip and setuptools among them), then the package itself
 # with no dependencies of its own, built by the locked setuptools; again whenever the lock changes
@@ -47,6 +47,15 @@ FIGURES ?= figures/$(shell date -u +%Y-%m-%dT%H%M%S)
 figures: $(STAMP)
 	$(VENV)/bin/studyapp compile
 	PYTHONPATH=. $(PY) scripts/regenerate_figures.py -o $(FIGURES) $(if $(ONLY),--only $(ONLY)) $(if $(CHECK),--check)
+
+# the loop on an ARM Cortex-M7 under qemu (docs/firmware-arm.md): installs the cross compiler, newlib and
+# qemu-system-arm (scripts/system-deps-arm.txt, about 800 MB; only here: setup and CI never do), then compares
+# the ARM loop with this machine's bit for bit and counts its instructions: make arm [ARGS="--seconds 2"]
+arm: $(STAMP)
+	@scripts/install-system-deps scripts/system-deps-arm.txt
+	$(VENV)/bin/studyapp compile
+	PYTHONPATH=. $(PY) scripts/arm_loop.py $(ARGS)
+	PYTHONPATH=. $(PY) scripts/arm_insn_mix.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info
