@@ -36,6 +36,6 @@ def test_both_cores_run_in_one_run_and_give_the_same_bits(monkeypatch, capsys):
     assert result["same_bits"] is True
     assert result["samples"] == 5000 and len(result["bank"]) == 14
     for core in ("c", "numba"):
-        assert set(result["cores"][core]) == {"loop_ns_per_sample", "bank_ns_per_sample"}
+        assert set(result["cores"][core]) == {"loop_ns_per_sample", "controller_ns_per_sample", "bank_ns_per_sample"}
         assert all(value > 0.0 for value in result["cores"][core].values())
     assert "bench loop: repeat 1 of 1" in captured.err
