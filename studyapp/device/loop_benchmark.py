@@ -134,7 +134,8 @@ def _cpu_ns(fn):
 
 def measure(rate, cores, seconds=None, repeats=None, progress=True):
     """({core: {"loop_ns_per_sample", "controller_ns_per_sample", "bank_ns_per_sample"}} (medians), the bank's names, the samples per run,
-    whether the two loops gave the same bits (None with one core)); ``SECONDS`` and ``REPEATS`` by default."""
+    whether the two loops gave the same bits (None with one core), the bytes of the C loop's arrays (None without
+    the C core)); ``SECONDS`` and ``REPEATS`` by default."""
     seconds = SECONDS if seconds is None else seconds
     repeats = REPEATS if repeats is None else repeats
     def say(text):
@@ -169,7 +170,8 @@ def measure(rate, cores, seconds=None, repeats=None, progress=True):
         (f1, e1), (f2, e2) = first.values()
         same = bool(np.array_equal(f1.view(np.uint64), f2.view(np.uint64))
                     and np.array_equal(e1.view(np.uint64), e2.view(np.uint64)))
-    return result, bank, n, same
+    arrays = _C(rate, bank, 1).c.nbytes if "c" in cores else None
+    return result, bank, n, same, arrays
 
 
 def run_cli(args):
@@ -177,13 +179,13 @@ def run_cli(args):
     rate = validate_rate(args.rate, "--rate")
     check_playable(rate, calibration.F0)
     try:
-        result, bank, n, same = measure(rate, cores)
+        result, bank, n, same, arrays = measure(rate, cores)
     except c_core.BuildError as exc:
         print(f"studyapp: error: {exc}", file=sys.stderr)
         return 1
     if getattr(args, "json", False):
         print(json.dumps({"rate": rate, "samples": n, "repeats": REPEATS, "bank": bank, "cores": result,
-                          "same_bits": same}))
+                          "same_bits": same, "c_arrays_bytes": arrays}))
         return 0
     print(f"loop cost at {rate:g} Hz: the controller and {len(bank)} estimators, the LVT sensor in the loop "
           f"(CPU ns per sample, median of {REPEATS} runs of {n} samples)")
@@ -192,5 +194,8 @@ def run_cli(args):
         print(f"{core:<8}" + "".join(f"{r[what + '_ns_per_sample']:>12.1f}" for what in FIGURES))
     if same is not None:
         print(f"the two loops' forces and estimates: {'the same bits' if same else 'DIFFERENT'}")
-    print("numba's loop also runs the stability monitor, which the C leaves to the host")
+    if "numba" in result:
+        print("numba's loop also runs the stability monitor, which the C leaves to the host")
+    if arrays is not None:
+        print(f"the C loop's arrays (parameters and state): {arrays:,} bytes")
     return 0
