@@ -102,7 +102,9 @@ void sl_run(sl_loop *L, uint32_t k0, uint32_t n, const double *x_m, const double
 /* 0 if L can run, else -1: ctl, state, lp, ls, sp, ss, bridge, nut and (with n_est > 0) kinds, est_s,
  * est_p given; line >= 3; both line delays from 1 to line - 2; the write index an integer from 0 to
  * line - 1; every kind known (se_known); est_s_width >= SE_GUARD. The kernels and the string index their
- * arrays from these, unchecked: a firmware calls sl_check whenever it takes new parameters, before it arms. */
+ * arrays from these, unchecked: a firmware calls sl_check whenever it takes new parameters, before it arms.
+ * Each estimator's own state and parameter sizes depend on its parameters (FOAW's window, LEASTSQ's taps)
+ * and are not checked here: the rows come whole from the host (Estimator.state_size, len(Estimator.p)). */
 int sl_check(const sl_loop *L);
 
 /* the string at rest (studyapp/model/loop.py ClosedLoop.reset_string's part of it) */
