@@ -152,6 +152,11 @@ class CLoop:
         self.est = np.zeros(self.n_est)
         self._est = _pointer(self.est, np.float64, "est")
 
+    @property
+    def nbytes(self):
+        """The bytes of the arrays the C loop reads and writes (a device's RAM for the loop's data)."""
+        return sum(a.nbytes for a in self.arrays[:11])
+
     def sample(self, k, x_m, a_m, v_m):
         """Sample k (the index a fault records): the force (N); ``out`` and ``est`` hold its outputs."""
         return self._lib.sl_sample(ctypes.byref(self._loop), int(k), float(x_m), float(a_m), float(v_m),

@@ -5,7 +5,7 @@ bowed on the strokes with the LVT at F_max 1 N, ``SECONDS`` at the rate but
 at least ``SAMPLES_MIN`` samples, accelerometer on), from identical arrays built once by the host
 (``ClosedLoop``: the bank of every position/acceleration estimator the rate
 allows, all but LVT: fourteen from 4.6 kHz up, COMP2's Table 1 high-pass
-needing that; the LVT sensor in the loop). Two figures per core, in ns per
+needing that; the LVT sensor in the loop). Three figures per core, in ns per
 sample:
 
 - loop: one sample of the controller (sensors, source, string, force, motor
@@ -14,6 +14,8 @@ sample:
   then observe_others, which also advances the stability monitor (the C
   leaves the monitor to the host) and writes the audio row (switched off
   here: no body filter, no contact microphone);
+- controller: the same with no estimator (the string, the force and the
+  limits: what a sample costs besides the bank);
 - bank: the estimators alone over the stream, each in turn: C se_run
   (device/c_estimators.py), numba dispatch.run_bank (what ``Bank.process``
   calls).
@@ -80,12 +82,17 @@ def stream(rate, n):
 class _Numba:
     def __init__(self, rate, bank, n):
         self.loop = _loop(rate, bank)
+        self.alone = _loop(rate, [])
         self.out = np.zeros((len(control.OUTPUTS), n))
         self.est = np.zeros((len(bank), n))
+        self.none = np.zeros((0, n))
 
     def run_loop(self, x, a, v):
         control.run_sensors(self.loop.control.arrays, x, a, v, self.out, self.est)
         return self.out[control.O_FORCE], self.est
+
+    def run_controller(self, x, a, v):
+        control.run_sensors(self.alone.control.arrays, x, a, v, self.out, self.none)
 
     def run_bank(self, bank, x, a, v):
         run_bank(bank.kinds, bank.states, bank.params, x, a, v, self.est)
@@ -97,8 +104,10 @@ class _C:
 
         self.loop = _loop(rate, bank)
         self.c = c_loop.CLoop(self.loop.control.arrays)
+        self.alone = c_loop.CLoop(_loop(rate, []).control.arrays)
         self.out = np.zeros((len(c_loop.OUT_ROWS), n))
         self.est = np.zeros((n, len(bank)))
+        self.none = np.zeros((n, 0))
         self.est_rows = np.zeros(n)
         self.se_run = c_estimators.library().se_run
 
@@ -106,9 +115,15 @@ class _C:
         out, est = self.c.run(x, a, v, out=self.out, est=self.est)
         return out[0], est
 
+    def run_controller(self, x, a, v):
+        self.alone.run(x, a, v, out=self.out, est=self.none)
+
     def run_bank(self, bank, x, a, v):
         for e, kind in enumerate(bank.kinds):
             self.se_run(int(kind), bank.states[e], bank.params[e], x, a, v, self.est_rows, x.shape[0])
+
+
+FIGURES = ("loop", "controller", "bank")
 
 
 def _cpu_ns(fn):
@@ -118,8 +133,9 @@ def _cpu_ns(fn):
 
 
 def measure(rate, cores, seconds=None, repeats=None, progress=True):
-    """({core: {"loop_ns_per_sample", "bank_ns_per_sample"}} (medians), the bank's names, the samples per run,
-    whether the two loops gave the same bits (None with one core)); ``SECONDS`` and ``REPEATS`` by default."""
+    """({core: {"loop_ns_per_sample", "controller_ns_per_sample", "bank_ns_per_sample"}} (medians), the bank's names, the samples per run,
+    whether the two loops gave the same bits (None with one core), the bytes of the C loop's arrays (None without
+    the C core)); ``SECONDS`` and ``REPEATS`` by default."""
     seconds = SECONDS if seconds is None else seconds
     repeats = REPEATS if repeats is None else repeats
     def say(text):
@@ -138,12 +154,14 @@ def measure(rate, cores, seconds=None, repeats=None, progress=True):
     for core, r in runners.items():  # warm: compile, caches; and the outputs compared below
         force, est = r.run_loop(x, a, v)
         first[core] = (force.copy(), np.ascontiguousarray(est).copy())
+        r.run_controller(x, a, v)
         r.run_bank(banks[core], x, a, v)
-    times = {core: {"loop": [], "bank": []} for core in cores}
+    times = {core: {what: [] for what in FIGURES} for core in cores}
     for repeat in range(repeats):
         say(f"repeat {repeat + 1} of {repeats} ...")
         for core, r in runners.items():
             times[core]["loop"].append(_cpu_ns(lambda: r.run_loop(x, a, v)))
+            times[core]["controller"].append(_cpu_ns(lambda: r.run_controller(x, a, v)))
             times[core]["bank"].append(_cpu_ns(lambda: r.run_bank(banks[core], x, a, v)))
     result = {core: {f"{what}_ns_per_sample": statistics.median(t) / n for what, t in times[core].items()}
               for core in cores}
@@ -152,7 +170,8 @@ def measure(rate, cores, seconds=None, repeats=None, progress=True):
         (f1, e1), (f2, e2) = first.values()
         same = bool(np.array_equal(f1.view(np.uint64), f2.view(np.uint64))
                     and np.array_equal(e1.view(np.uint64), e2.view(np.uint64)))
-    return result, bank, n, same
+    arrays = _C(rate, bank, 1).c.nbytes if "c" in cores else None
+    return result, bank, n, same, arrays
 
 
 def run_cli(args):
@@ -160,20 +179,23 @@ def run_cli(args):
     rate = validate_rate(args.rate, "--rate")
     check_playable(rate, calibration.F0)
     try:
-        result, bank, n, same = measure(rate, cores)
+        result, bank, n, same, arrays = measure(rate, cores)
     except c_core.BuildError as exc:
         print(f"studyapp: error: {exc}", file=sys.stderr)
         return 1
     if getattr(args, "json", False):
         print(json.dumps({"rate": rate, "samples": n, "repeats": REPEATS, "bank": bank, "cores": result,
-                          "same_bits": same}))
+                          "same_bits": same, "c_arrays_bytes": arrays}))
         return 0
     print(f"loop cost at {rate:g} Hz: the controller and {len(bank)} estimators, the LVT sensor in the loop "
           f"(CPU ns per sample, median of {REPEATS} runs of {n} samples)")
-    print(f"{'core':<8}{'loop':>10}{'bank':>10}")
+    print(f"{'core':<8}" + "".join(f"{what:>12}" for what in FIGURES))
     for core, r in result.items():
-        print(f"{core:<8}{r['loop_ns_per_sample']:>10.1f}{r['bank_ns_per_sample']:>10.1f}")
+        print(f"{core:<8}" + "".join(f"{r[what + '_ns_per_sample']:>12.1f}" for what in FIGURES))
     if same is not None:
         print(f"the two loops' forces and estimates: {'the same bits' if same else 'DIFFERENT'}")
-    print("numba's loop also runs the stability monitor, which the C leaves to the host")
+    if "numba" in result:
+        print("numba's loop also runs the stability monitor, which the C leaves to the host")
+    if arrays is not None:
+        print(f"the C loop's arrays (parameters and state): {arrays:,} bytes")
     return 0

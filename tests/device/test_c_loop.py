@@ -20,6 +20,9 @@ the audio switched on and the microphone's coefficients zeroed, so its audio row
 same value, compared as values (-0.0 + 0.0 is +0.0).
 """
 
+import tomllib
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -36,6 +39,8 @@ from studyapp.model.sources import LVT_SENSOR, TRUE
 c_loop = pytest.importorskip("studyapp.device.c_loop")
 
 NAMES = estimators.names()
+PROTOCOL = Path(__file__).resolve().parents[2] / "protocols" / "sinclair2014.toml"
+ADJUSTMENT = tomllib.loads(PROTOCOL.read_text())["adjustment"]["conditions"]  # the paper's nine
 # the C output rows and the numba rows they equal bit for bit
 SAME_BITS = {"force": "force", "source_velocity": "source_velocity", "string_velocity": "string_velocity",
              "v_delta": "v_delta", "stick": "stick", "friction": "friction"}
@@ -189,6 +194,21 @@ def test_the_comparison_sees_bowing():
     assert np.abs(force[:1200]).max() > 0.9 * fmax
     assert np.all(force[1200:] == 0.0)
     assert np.all(np.abs(c_est[:, 200:1200]).max(axis=1) > 0.0)
+
+
+@pytest.mark.parametrize("fmax", [0.5, 20.0])
+@pytest.mark.parametrize("source", ADJUSTMENT)
+def test_every_adjustment_condition_at_both_ends_of_f_max(source, fmax):
+    """Each of the paper's nine conditions in the loop, every estimator beside it, through a string reset and
+    bowing off and on, every run (the hypothesis test above draws its sources)."""
+    n = 1200
+    s = {"rate": 5000.0, "f0": 440.0, "bank": {name: {} for name in NAMES}, "n": n, "source": source,
+         "fmax": fmax, "seed": 2, "skip": 100, "bad": [],
+         "blocks": [(0, 400, None), (400, 700, ("reset_string", None)), (700, 900, ("bowing", False)),
+                    (900, n, ("bowing", True))]}
+    out, c_out, est, c_est = run_both(s)
+    assert_same(out, c_out, est, c_est)
+    assert np.any(c_out[c_loop.OUT_ROWS.index("force")] != 0.0)
 
 
 def test_one_sample_at_a_time_equals_the_block():

@@ -34,8 +34,9 @@ def test_both_cores_run_in_one_run_and_give_the_same_bits(monkeypatch, capsys):
     captured = capsys.readouterr()
     result = json.loads(captured.out)
     assert result["same_bits"] is True
+    assert 10_000 < result["c_arrays_bytes"] < 100_000
     assert result["samples"] == 5000 and len(result["bank"]) == 14
     for core in ("c", "numba"):
-        assert set(result["cores"][core]) == {"loop_ns_per_sample", "bank_ns_per_sample"}
+        assert set(result["cores"][core]) == {"loop_ns_per_sample", "controller_ns_per_sample", "bank_ns_per_sample"}
         assert all(value > 0.0 for value in result["cores"][core].values())
     assert "bench loop: repeat 1 of 1" in captured.err
