@@ -4,7 +4,7 @@
 
 #include <string.h>
 
-enum { HELLO = 0x81, FORCE, ARM, DISARM, START, STOP, PING, KEEPALIVE };
+enum { HELLO = 0x81, FORCE, ARM, DISARM, START, STOP, PING, KEEPALIVE, CONTROL, ALIVE };
 enum { INFO = 0x01, SENSORS, PONG, FAULT, STATE };
 
 static uint32_t rd32(const uint8_t *p) {
@@ -58,7 +58,7 @@ uint32_t sd_sizeof(void) { return (uint32_t)sizeof(sd_device); }
 
 /* ---- frames out ---- */
 
-static void send(sd_device *d, uint8_t *payload, uint32_t n) {
+void sd_send_payload(sd_device *d, uint8_t *payload, uint32_t n) {
     uint32_t need = n + 2u + (n + 2u) / 254u + 2u, i, o, code_at;
     uint16_t crc;
     uint8_t code, byte;
@@ -98,7 +98,7 @@ static void fault_frame(sd_device *d, uint8_t code, uint32_t sample, uint32_t de
     p[2] = code;
     wr32(p + 3, sample);
     wr32(p + 7, detail);
-    send(d, p, sizeof p);
+    sd_send_payload(d, p, sizeof p);
 }
 
 static void state_frame(sd_device *d) {
@@ -110,7 +110,7 @@ static void state_frame(sd_device *d) {
     wr32(p + 5, d->late);
     wr32(p + 9, d->lost);
     wr32(p + 13, d->corrupt);
-    send(d, p, sizeof p);
+    sd_send_payload(d, p, sizeof p);
 }
 
 /* a FAULT that is not latched, at most once per second per code */
@@ -158,7 +158,8 @@ static void arm(sd_device *d, uint32_t ramp_ms) {
     d->ramp = (uint32_t)((uint64_t)ms * d->rate_hz / 1000u);
     d->got = 0;
     d->hold = 0.0;
-    d->deadline = d->now + d->watchdog + (d->streaming ? d->latency : 0u);
+    /* a device loop's watchdog is the keep-alive's: START's latency is no lead there */
+    d->deadline = d->now + d->watchdog + (d->streaming && !d->loop_mode ? d->latency : 0u);
     d->last_feed = d->now;
 }
 
@@ -189,7 +190,7 @@ static void force(sd_device *d, uint32_t sample, uint32_t count, const uint8_t *
 
 int sd_needs_force(const sd_device *d) {
     uint32_t slot;
-    if (!d->streaming || ahead(d->now, d->start_sample + d->latency) < 0) return 0;
+    if (d->loop_mode || !d->streaming || ahead(d->now, d->start_sample + d->latency) < 0) return 0;
     slot = d->now % SD_RING;
     return !(d->valid[slot] && d->tags[slot] == d->now);
 }
@@ -227,6 +228,13 @@ double sd_actuate(sd_device *d) {
             d->armed = 0;
             fault_frame(d, SD_WATCHDOG, j, d->last_feed);
         }
+    } else if (d->armed && d->streaming && d->loop_mode) {
+        f = d->loop_force;
+        k = ahead(j, d->arm_sample);
+        if (k < (int64_t)d->ramp) {
+            f = f * ((double)k / (double)d->ramp);
+            d->ramping = 1;
+        }
     } else if (d->armed && d->streaming) {
         slot = j % SD_RING;
         if (d->valid[slot] && d->tags[slot] == j) {
@@ -246,6 +254,7 @@ double sd_actuate(sd_device *d) {
     }
     f = clamp(d, f);
     d->last_out = f;
+    if (d->streaming && d->hooks) d->hooks->actuated(d, f);
     d->now = j + 1u;
     return f;
 }
@@ -257,17 +266,19 @@ static int body_ok(sd_device *d, const uint8_t *b, uint32_t n, int type) {
     switch (type) {
     case HELLO: case ARM: return n == 2;
     case DISARM: return n == 1 && b[0] <= 2;
-    case START:
-        return n == 3 && b[0] >= 1 && (uint32_t)rd16(b + 1) + 1u >= b[0] && b[0] <= d->max_packet;
+    case START: /* a device loop's latency is the lock-step lead: at least one packet */
+        return n == 3 && b[0] >= 1 && (uint32_t)rd16(b + 1) + (d->loop_mode ? 0u : 1u) >= b[0] &&
+               b[0] <= d->max_packet;
     case STOP: case KEEPALIVE: return n == 0;
     case PING: return n == 4;
     case FORCE:
-        if (n < 5) return 0;
+        if (n < 5 || d->loop_mode) return 0;
         count = b[4];
         if (count < 1 || count > 64 || n != 5u + 8u * count) return 0;
         for (i = 0; i < count; i++)
             if (!finite64(b + 5u + 8u * i)) return 0;
         return 1;
+    case CONTROL: case ALIVE: return d->hooks && d->hooks->valid(d, type, b, n);
     default: return 0;
     }
 }
@@ -289,15 +300,19 @@ static void payload(sd_device *d, uint8_t *p, uint32_t n) {
     switch (type) {
     case FORCE: force(d, rd32(b), b[4], b + 5); return;
     case HELLO:
-        send(d, d->info, d->info_len);
+        sd_send_payload(d, d->info, d->info_len);
         return;
     case PING:
         out[0] = PONG;
         memcpy(out + 2, b, 4);
         wr32(out + 6, d->now);
-        send(d, out, 10);
+        sd_send_payload(d, out, 10);
         return;
     case KEEPALIVE: return;
+    case CONTROL: case ALIVE: /* only a device loop's hooks pass them as sound */
+        d->hooks->frame(d, type, b);
+        feed(d, d->now + d->watchdog);
+        return;
     case ARM: arm(d, rd16(b)); break;
     case DISARM: d->armed = 0; d->down_left = 0; break;
     case START:
@@ -309,7 +324,8 @@ static void payload(sd_device *d, uint8_t *p, uint32_t n) {
         d->got = 0;
         d->hold = 0.0;
         clear_tags(d);
-        feed(d, d->now + d->latency + d->watchdog);
+        feed(d, d->now + (d->loop_mode ? 0u : d->latency) + d->watchdog);
+        if (d->hooks) d->hooks->streaming(d, 1);
         break;
     case STOP:
         d->row_count = 0;
@@ -317,6 +333,7 @@ static void payload(sd_device *d, uint8_t *p, uint32_t n) {
         d->got = 0;
         d->hold = 0.0;
         clear_tags(d);
+        if (d->hooks) d->hooks->streaming(d, 0);
         break;
     }
     state_frame(d);
@@ -368,10 +385,10 @@ void sd_rx(sd_device *d, const uint8_t *data, uint32_t n) {
 }
 
 void sd_sample(sd_device *d, const double *raw) {
-    uint8_t *r;
+    uint8_t *r, *row;
     uint32_t c, flags;
     if (!d->streaming) return;
-    r = d->rows + 8u + d->row_count * d->row_size; /* after the SENSORS header: the frame is built in place */
+    r = row = d->rows + 8u + d->row_count * d->row_size; /* after the header: the frame is built in place */
     for (c = 0; c < d->channels; c++) {
         if (d->format[c] == 0) {
             wrf64(r, raw[c]);
@@ -386,6 +403,10 @@ void sd_sample(sd_device *d, const double *raw) {
             r += 2;
         }
     }
+    if (d->loop_mode) {
+        if (d->hooks) d->hooks->sample(d, row);
+        return;
+    }
     if (++d->row_count < d->packet) return;
     flags = (d->armed ? 1u : 0u) | (d->fault ? 2u : 0u) | (d->clamped ? 4u : 0u) | (d->ramping ? 8u : 0u);
     d->clamped = 0;
@@ -394,7 +415,7 @@ void sd_sample(sd_device *d, const double *raw) {
     wr32(d->rows + 2, d->now - d->packet + 1u);
     d->rows[6] = (uint8_t)d->packet;
     d->rows[7] = (uint8_t)flags;
-    send(d, d->rows, 8u + d->packet * d->row_size);
+    sd_send_payload(d, d->rows, 8u + d->packet * d->row_size);
     d->row_count = 0;
 }
 
@@ -404,6 +425,10 @@ uint32_t sd_tx(sd_device *d, uint8_t *out, uint32_t cap) {
     memmove(d->tx, d->tx + n, d->tx_len - n);
     d->tx_len -= n;
     return n;
+}
+
+int sd_needs_alive(const sd_device *d) {
+    return d->loop_mode && d->streaming && ahead(d->now, d->seen + d->latency) >= 0;
 }
 
 void sd_counters(const sd_device *d, uint32_t out[8]) {
@@ -419,11 +444,12 @@ void sd_counters(const sd_device *d, uint32_t out[8]) {
 
 int sd_init(sd_device *d, const uint8_t *info, uint32_t len, double rms_alpha) {
     const uint8_t *b = info + 2;
-    uint32_t at, c, wd, size;
+    uint32_t at, c, wd, size, version, end, keepalive = 0;
     memset(d, 0, sizeof *d);
     if (len < 2u + 10u || len > SD_MAX_PAYLOAD || info[0] != INFO) return -1;
     memcpy(d->info, info, len);
     d->info_len = len;
+    version = rd16(b);
     d->rate_hz = rd32(b + 4);
     d->max_packet = b[8];
     at = 9u;
@@ -437,12 +463,32 @@ int sd_init(sd_device *d, const uint8_t *info, uint32_t len, double rms_alpha) {
     d->ramp_ms_min = rd16(b + at + 34);
     d->channels = b[at + 36];
     at += 37u;
-    if (d->channels < 1u || d->channels > SD_MAX_CHANNELS || 2u + at + 18u * d->channels != len) return -1;
+    end = 2u + at + 18u * d->channels;
+    if (d->channels < 1u || d->channels > SD_MAX_CHANNELS || end > len || (version < 2u && end != len)) return -1;
     size = 0;
     for (c = 0; c < d->channels; c++) {
+        d->kind[c] = b[at + 18u * c];
         d->format[c] = b[at + 18u * c + 1u];
-        if (d->format[c] > 2u) return -1;
+        d->gain[c] = rdf64(b + at + 18u * c + 2u);
+        d->offset[c] = rdf64(b + at + 18u * c + 10u);
+        if (d->format[c] > 2u || d->kind[c] > 2u) return -1;
         size += d->format[c] == 0 ? 8u : (d->format[c] == 1 ? 4u : 2u);
+    }
+    if (version >= 2u) { /* the loop section: loop u8, keepalive_ms u16, image u32, n u8, kinds */
+        if (end + 8u > len || info[end] > 1u || info[end + 7u] > SD_MAX_ESTIMATORS ||
+            end + 8u + info[end + 7u] != len)
+            return -1;
+        d->loop_mode = info[end];
+        keepalive = rd16(info + end + 1u);
+        d->n_est = info[end + 7u];
+        memcpy(d->kinds, info + end + 8u, d->n_est);
+        if (d->loop_mode) {
+            if (keepalive < 1u) return -1;
+            wd = keepalive;
+            size += SD_TELEMETRY_TAIL;
+            for (c = 0; c < d->channels && d->kind[c] != 0u; c++) {}
+            if (c == d->channels) return -1; /* the loop's estimators need a position channel */
+        }
     }
     d->row_size = size;
     if (d->rate_hz == 0 || d->max_packet < 1u || d->max_packet * size + 8u > SD_MAX_PAYLOAD) return -1;

@@ -10,6 +10,12 @@
  *     n = sd_tx(d, out, cap)   the bytes to send to the host (frames, whole), oldest first
  * and, once, sd_init(d, info_payload, len, rms_alpha) with its INFO message (as messages.Info.pack makes
  * it; the sequence byte is replaced when sent) and alpha = 1 - exp(-1 / (rate * sustained_window)).
+ *
+ * Version 2 (docs/device-protocol.md, "Version 2"): a device whose INFO says loop = 1 runs the loop itself.
+ * It calls sd_attach_loop (studyapp_device_loop.h) once after sd_init; then sd_sample runs the loop on the
+ * sample (CONTROL settings applied at their tags) and sd_actuate applies this core's unchanged safety to the
+ * loop's force and streams TELEMETRY. This file reaches the loop only through the hooks below, so a
+ * version 1 firmware links neither the loop nor the C maths library.
  */
 #ifndef STUDYAPP_DEVICE_H
 #define STUDYAPP_DEVICE_H
@@ -23,10 +29,33 @@
 #define SD_MAX_CHANNELS 8u
 #define SD_MAX_ROWS 255u
 #define SD_TX_SIZE 8192u
+#define SD_QUEUE 16u           /* version 2: CONTROL settings held before they take effect */
+#define SD_MAX_ESTIMATORS 32u
+#define SD_TELEMETRY_TAIL 26u  /* a TELEMETRY row after its channels: loop_force, applied, bridge (f64), control (u16) */
 
 enum { SD_WATCHDOG = 1, SD_CLAMP = 2, SD_SUSTAINED = 3, SD_LINK_CORRUPT = 4, SD_INTERNAL = 5, SD_LATE = 6 };
 
+typedef struct sd_device sd_device;
+
+/* CONTROL's fields (version 2) */
 typedef struct {
+    uint16_t id;
+    uint32_t sample;
+    int8_t source;
+    uint8_t bowing, reset;
+    double gain, force_scale;
+} sd_control;
+
+/* What a loop on the device adds to this core (set by sd_attach_loop, studyapp_device_loop.c). */
+typedef struct {
+    int (*valid)(const sd_device *d, int type, const uint8_t *body, uint32_t n); /* CONTROL, ALIVE: 1 if sound */
+    void (*frame)(sd_device *d, int type, const uint8_t *body);                  /* a sound CONTROL or ALIVE */
+    void (*streaming)(sd_device *d, int on);                                     /* after START (1), STOP (0) */
+    void (*sample)(sd_device *d, uint8_t *row);      /* row: this sample's channels, written; runs the loop */
+    void (*actuated)(sd_device *d, double applied);  /* the force applied over [now, now + 1] */
+} sd_loop_hooks;
+
+struct sd_device {
     /* from INFO */
     uint8_t info[SD_MAX_PAYLOAD];
     uint32_t info_len;
@@ -35,8 +64,9 @@ typedef struct {
     double impulsive, sustained, rms_alpha;
     uint32_t watchdog, down, ramp_ms_min; /* watchdog and ramp-down in samples */
     uint32_t channels;
-    uint8_t format[SD_MAX_CHANNELS];
-    uint32_t row_size;
+    uint8_t format[SD_MAX_CHANNELS], kind[SD_MAX_CHANNELS];
+    double gain[SD_MAX_CHANNELS], offset[SD_MAX_CHANNELS];
+    uint32_t row_size; /* a SENSORS row, or in a device loop a TELEMETRY row */
     /* safety core */
     uint32_t now;
     int armed, streaming, fault;
@@ -62,7 +92,18 @@ typedef struct {
     uint32_t row_count;
     uint8_t tx[SD_TX_SIZE];
     uint32_t tx_len, tx_dropped;
-} sd_device;
+    /* version 2: INFO's loop section and the loop's state (studyapp_device_loop.c) */
+    int loop_mode;             /* INFO's loop = 1: the device runs the loop */
+    uint32_t n_est;
+    uint8_t kinds[SD_MAX_ESTIMATORS];
+    const sd_loop_hooks *hooks; /* NULL until sd_attach_loop */
+    void *loop;                 /* the sl_loop attached */
+    double loop_force;          /* the loop's force for the current sample */
+    uint32_t seen;              /* ALIVE's seen (START sets it to START's sample) */
+    sd_control queue[SD_QUEUE], setting;
+    uint32_t queued;
+    int row_open, loop_fault_sent;
+};
 
 /* 0 on success; -1 if the INFO payload is not one this core can run */
 int sd_init(sd_device *d, const uint8_t *info, uint32_t len, double rms_alpha);
@@ -75,5 +116,9 @@ uint16_t sd_crc16(const uint8_t *data, uint32_t n, uint16_t crc);
 uint32_t sd_sizeof(void);
 /* now, armed, streaming, fault, late, lost, corrupt, missing */
 void sd_counters(const sd_device *d, uint32_t out[8]);
+/* version 2, lock-step: 1 while a streaming device loop has run up to ALIVE's seen + START's latency */
+int sd_needs_alive(const sd_device *d);
+/* for studyapp_device_loop.c: frame and queue a payload (its seq byte is set here) */
+void sd_send_payload(sd_device *d, uint8_t *payload, uint32_t n);
 
 #endif

@@ -3,12 +3,16 @@
     studyapp device-emulator --link PATH [--rate HZ] [--seed N] [--gesture strokes|hold]
         [--latency S] [--jitter S] [--loss P] [--corrupt P] [--disconnect-after S] [--lockstep]
         [--format f64|counts] [--core auto|c|python] [--watchdog-ms MS]
+        [--loop host|device] [--keepalive-ms MS]
 
 Makes PATH a link to the device end of a new pty (as socat does) and prints
 ``ready: PATH`` once it exists; runs until SIGTERM / Ctrl-C (or
 ``--disconnect-after``), removes the link and prints ``stats: {json}``.
 studyapp/device/emulator.py says what it simulates; docs/device-protocol.md
-what it speaks. A bad option: one line, exit 2, no link made.
+what it speaks. ``--loop device`` runs the loop on the device (protocol version 2,
+in C: not with ``--core python``), its watchdog on the host's keep-alive
+(``--keepalive-ms``, default 200) instead of ``--watchdog-ms``. A bad option:
+one line, exit 2, no link made.
 """
 
 from studyapp.cli import number_options
@@ -38,13 +42,17 @@ def register(sub):
                    help="sensor channels: f64 in SI, or counts (i32 with a gain) (default f64)")
     p.add_argument("--core", metavar="auto|c|python", default="auto",
                    help="firmware core: auto is C if it builds (default auto)")
-    p.add_argument("--watchdog-ms", metavar="MS", type=int, default=1,
-                   help="the device's watchdog, 1..1000 ms (default 1)")
+    p.add_argument("--watchdog-ms", metavar="MS", type=int, default=None,
+                   help="the device's watchdog, 1..1000 ms (default 1; a host loop's)")
+    p.add_argument("--loop", metavar="host|device", default="host",
+                   help="who runs the loop: the host (protocol 1, default) or the device (protocol 2, the C loop)")
+    p.add_argument("--keepalive-ms", metavar="MS", type=int, default=None,
+                   help="a device loop's watchdog on the host's keep-alive, 1..65535 ms (default 200)")
     p.set_defaults(func=run)
 
 
 def config_from(args):
-    from studyapp.device.emulator import CORES, FORMATS, GESTURES, EmulatorConfig
+    from studyapp.device.emulator import CORES, FORMATS, GESTURES, KEEPALIVE_MS, LOOPS, EmulatorConfig
     from studyapp.device.pty_link import check_path
     from studyapp.errors import UserError
 
@@ -65,7 +73,19 @@ def config_from(args):
         need(0.0 <= value <= 1.0, f"--{name} {value:g}: allowed is a probability from 0 to 1")
     need(args.disconnect_after is None or args.disconnect_after > 0.0,
          f"--disconnect-after {args.disconnect_after}: allowed is a number of seconds above 0")
-    need(1 <= args.watchdog_ms <= 1000, f"--watchdog-ms {args.watchdog_ms}: allowed is 1 to 1000")
+    need(args.loop in LOOPS, f"--loop {args.loop!r}: allowed are {', '.join(LOOPS)}")
+    device_loop = args.loop == "device"
+    need(not (device_loop and args.core == "python"),
+         "--loop device with --core python: the device's loop is the C one (firmware/studyapp_loop.c); "
+         "allowed: --core auto or c")
+    need(not (device_loop and args.watchdog_ms is not None),
+         "--watchdog-ms with --loop device: a device loop's watchdog is the keep-alive's (--keepalive-ms)")
+    need(device_loop or args.keepalive_ms is None,
+         "--keepalive-ms with --loop host: the keep-alive watchdog is a device loop's (--loop device)")
+    watchdog_ms = 1 if args.watchdog_ms is None else args.watchdog_ms
+    keepalive_ms = KEEPALIVE_MS if args.keepalive_ms is None else args.keepalive_ms
+    need(1 <= watchdog_ms <= 1000, f"--watchdog-ms {watchdog_ms}: allowed is 1 to 1000")
+    need(1 <= keepalive_ms <= 65535, f"--keepalive-ms {keepalive_ms}: allowed is 1 to 65535")
     faults = [n for n in ("latency", "jitter", "loss", "corrupt") if getattr(args, n)]
     need(not (args.lockstep and faults),
          f"--lockstep with --{faults[0] if faults else ''}: lock-step waits for every force, so it takes no "
@@ -74,7 +94,7 @@ def config_from(args):
     return EmulatorConfig(link=args.link, rate=int(args.rate), seed=args.seed, gesture=args.gesture,
                           latency=args.latency, jitter=args.jitter, loss=args.loss, corrupt=args.corrupt,
                           disconnect_after=args.disconnect_after, lockstep=args.lockstep, format=args.format,
-                          core=args.core, watchdog_ms=args.watchdog_ms)
+                          core=args.core, watchdog_ms=watchdog_ms, loop=args.loop, keepalive_ms=keepalive_ms)
 
 
 def run(args):

@@ -6,9 +6,11 @@ tests hold the two equal byte for byte. ``build()`` compiles the C file
 once into the user's cache (``$XDG_CACHE_HOME/studyapp/device/<hash of the
 sources and flags>/``, the compiler from ``$CC`` or ``cc``; the Debian
 packages gcc and libc6-dev, scripts/system-deps.txt) and returns the shared
-library's path; a second process finds it there. C99, -O2, no contraction
-of a * b + c into a fused multiply-add (``-ffp-contract=off``), so the
-floating point is the same as Python's, operation for operation.
+library's path; a second process finds it there. ``build_library`` does the
+same for any set of firmware/ sources (the estimators: c_estimators.py).
+C99, -O2, no contraction of a * b + c into a fused multiply-add
+(``-ffp-contract=off``), so the floating point is the same as Python's and
+numba's, operation for operation.
 """
 
 import ctypes
@@ -24,6 +26,7 @@ from studyapp.device.device_side import SafetyConfig
 SOURCE_DIR = Path(__file__).resolve().parents[2] / "firmware"
 SOURCES = ("studyapp_device.c", "studyapp_device.h")
 FLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fPIC", "-shared")
+LIBS = ("-lm",)  # after the sources: the C maths library (sqrt, fabs, copysign, isfinite's kin)
 COUNTERS = ("now", "armed", "streaming", "fault", "late", "lost", "corrupt", "missing")
 TX_CHUNK = 1 << 14
 
@@ -39,27 +42,38 @@ def cache_dir():
 
 def build():
     """The path of the compiled core, compiling it first if this version of the sources has none."""
-    missing = [s for s in SOURCES if not (SOURCE_DIR / s).is_file()]
+    return build_library("studyapp_device", SOURCES)
+
+
+def build_library(name, sources):
+    """The path of the shared library ``name``.so built from ``sources`` (file names in firmware/), compiling it
+    first if this version of the sources has none.
+
+    Every ``.c`` of ``sources`` is compiled into the one library; every file of ``sources`` (headers too)
+    goes into the hash that names its folder in the cache, with the compiler and ``FLAGS``.
+    """
+    missing = [s for s in sources if not (SOURCE_DIR / s).is_file()]
     if missing:
         raise BuildError(f"{SOURCE_DIR / missing[0]} not found (a source checkout of studyapp has it)")
     compiler = os.environ.get("CC") or "cc"
     if shutil.which(compiler) is None:
         raise BuildError(f"no C compiler {compiler!r} (install the Debian packages gcc and libc6-dev)")
-    digest = hashlib.sha1(" ".join((compiler,) + FLAGS).encode())
-    for s in SOURCES:
+    digest = hashlib.sha1(" ".join((compiler,) + FLAGS + LIBS).encode())
+    for s in sources:
         digest.update((SOURCE_DIR / s).read_bytes())
-    target = cache_dir() / digest.hexdigest()[:16] / "studyapp_device.so"
+    target = cache_dir() / digest.hexdigest()[:16] / f"{name}.so"
     if target.is_file():
         return target
+    units = [s for s in sources if s.endswith(".c")]
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
     os.close(fd)
     try:
-        r = subprocess.run([compiler, *FLAGS, "-o", tmp, str(SOURCE_DIR / SOURCES[0])], capture_output=True,
-                           text=True, timeout=120)
+        r = subprocess.run([compiler, *FLAGS, "-o", tmp, *(str(SOURCE_DIR / s) for s in units), *LIBS],
+                           capture_output=True, text=True, timeout=120)
         if r.returncode != 0:
             first = (r.stderr.strip().splitlines() or ["no message"])[0]
-            raise BuildError(f"{compiler} failed on {SOURCES[0]}: {first}")
+            raise BuildError(f"{compiler} failed on {', '.join(units)}: {first}")
         os.replace(tmp, target)  # atomic: a process running at once loads a whole library or builds its own
     finally:
         if os.path.exists(tmp):
@@ -101,11 +115,11 @@ def library():
 
 
 class CCore:
-    """The C firmware core for the device described by ``info`` (messages.Info)."""
+    """The C firmware core for the device described by ``info`` (messages.Info); ``lib``: a library built with it."""
 
-    def __init__(self, info):
+    def __init__(self, info, lib=None):
         self.info = info
-        self._lib = library()
+        self._lib = lib or library()
         self._state = ctypes.create_string_buffer(self._lib.sd_sizeof())
         payload = info.pack(0)
         alpha = SafetyConfig.from_info(info).rms_alpha

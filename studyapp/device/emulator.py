@@ -21,6 +21,18 @@ the force tagged j (from START's sample + latency on; the samples before get
 0 N), so a host's loop over the pty equals the simulated loop with that fixed
 latency sample for sample.
 
+The loop (``loop``): ``host`` (the default) is protocol version 1's, the
+host's FORCE frames applied at their tags. ``device`` is version 2's loop on
+the device (docs/device-protocol.md, "Version 2"): INFO says loop = 1 with
+the keep-alive watchdog (``keepalive_ms``), the parameter image's CRC
+(loop_image.py) and the estimators of loop_bank.py (the study's
+position-only ones, and the accelerometer's), and per sample the C core runs
+the C loop on the simulated sensors (c_loop_core.py: CONTROL settings at
+their tags, the loop, the unchanged safety core on its force, TELEMETRY).
+Its lock-step has the device run sample j only once j < ALIVE's seen +
+START's latency, so a host that tags its CONTROL at seen + latency is never
+late and the loop equals the model's at no latency, sample for sample.
+
 The link's faults (link_faults.py, seeded): ``latency`` and ``jitter`` delay
 what the device receives; ``loss`` and ``corrupt`` drop frames or flip a bit
 of them, both ways; ``disconnect_after`` closes the link after that many
@@ -38,7 +50,7 @@ import sys
 import time
 from dataclasses import dataclass
 
-from studyapp.device import messages
+from studyapp.device import loop_messages, messages
 from studyapp.device.firmware import Firmware
 from studyapp.device.link_faults import LinkFaults
 from studyapp.device.pty_link import PtyLink
@@ -49,6 +61,8 @@ IDLE_TICK = 0.001  # s: the longest sleep while idle (a host's frame wakes it so
 GESTURES = ("strokes", "hold")
 FORMATS = ("f64", "counts")
 CORES = ("auto", "c", "python")
+LOOPS = ("host", "device")
+KEEPALIVE_MS = 200
 MAX_PACKET = 32
 FIRMWARE_VERSION = (1, 0)
 # --format counts: what a firmware with ADCs would send; SI = gain * raw
@@ -73,16 +87,26 @@ class EmulatorConfig:
     format: str = "f64"
     core: str = "auto"
     watchdog_ms: int = 1
+    loop: str = "host"
+    keepalive_ms: int = KEEPALIVE_MS
 
 
-def device_info(config):
-    """The emulator's INFO: the simulated device's limits (model/limits.py), its rate, watchdog and channels."""
+def device_info(config, loop=None):
+    """The emulator's INFO: the simulated device's limits (model/limits.py), its rate, watchdog and channels;
+    with ``loop`` (loop_bank.device_loop's) version 2's loop section for a device loop."""
     from studyapp.model.device import DeviceLimits
     limits = DeviceLimits()
     channels = COUNT_CHANNELS if config.format == "counts" else messages.SI_CHANNELS
-    return messages.Info(messages.PROTOCOL_VERSION, *FIRMWARE_VERSION, int(config.rate), MAX_PACKET,
+    version, largest, tail = messages.PROTOCOL_VERSION, MAX_PACKET, b""
+    if loop is not None:
+        from studyapp.device.loop_image import image_crc
+        version, largest = loop_messages.LOOP_VERSION, min(MAX_PACKET, loop_messages.max_telemetry_packet(channels))
+        tail = loop_messages.LoopInfo(loop_messages.DEVICE_LOOP, int(config.keepalive_ms),
+                                      image_crc(int(config.rate), loop.control.arrays),
+                                      tuple(int(k) for k in loop.bank.kinds)).pack()
+    return messages.Info(version, *FIRMWARE_VERSION, int(config.rate), largest,
                          "studyapp emulator", f"EMU-{config.seed:04d}", limits.travel, limits.impulsive,
-                         limits.sustained, limits.sustained_window, int(config.watchdog_ms), 0, channels)
+                         limits.sustained, limits.sustained_window, int(config.watchdog_ms), 0, channels, tail)
 
 
 def make_core(kind, info):
@@ -98,6 +122,15 @@ def make_core(kind, info):
     return Firmware(info), "python"
 
 
+def make_loop_core(info, loop):
+    """The C core with the C loop on ``loop``'s arrays attached: a device loop has no Python core."""
+    from studyapp.device import c_core, c_loop, c_loop_core
+    try:
+        return c_loop_core.CLoopCore(info, c_loop.CLoop(loop.control.arrays)), "c"
+    except c_core.BuildError as exc:
+        raise UserError(f"--loop device: {exc}") from None
+
+
 def raw_row(channels, x, a, v):
     values = (x, a, v)
     if channels[0].format == messages.F64:
@@ -110,8 +143,15 @@ class Emulator:
         from studyapp.model.loop import make_gesture
         from studyapp.model.simulated_device import SimulatedDevice
         self.config = config
-        self.info = device_info(config)
-        self.core, self.core_name = make_core(config.core, self.info)
+        self.device_loop = config.loop == "device"
+        if self.device_loop:
+            from studyapp.device.loop_bank import device_loop
+            self.loop = device_loop(config.rate, accelerometer=True)  # the emulator has an accelerometer channel
+            self.info = device_info(config, self.loop)
+            self.core, self.core_name = make_loop_core(self.info, self.loop)
+        else:
+            self.info = device_info(config)
+            self.core, self.core_name = make_core(config.core, self.info)
         warm = SimulatedDevice(config.rate)  # loads the compiled per-sample path before the link is ready
         warm.read_sensors()
         warm.write_force(0.0)
@@ -133,7 +173,8 @@ class Emulator:
             self.link.open()
             print(f"ready: {self.link.path}", file=out, flush=True)
             print(f"studyapp device-emulator: {self.link.path} -> {self.link.name}, {self.config.rate} Hz, "
-                  f"{self.core_name} core{', lock-step' if self.config.lockstep else ''}", file=sys.stderr)
+                  f"{self.core_name} core, loop on the {self.config.loop}"
+                  f"{', lock-step' if self.config.lockstep else ''}", file=sys.stderr)
             if self.config.lockstep:
                 self._lockstep()
             else:
@@ -146,7 +187,7 @@ class Emulator:
         return 0
 
     def stats(self):
-        return {"samples": self.samples, "core": self.core_name, **self.core.counters(),
+        return {"samples": self.samples, "core": self.core_name, "loop": self.config.loop, **self.core.counters(),
                 "link_lost_in": self.faults.lost["in"], "link_lost_out": self.faults.lost["out"],
                 "link_flipped_in": self.faults.flipped["in"], "link_flipped_out": self.faults.flipped["out"],
                 "tx_dropped": self.link.dropped}
@@ -220,9 +261,19 @@ class Emulator:
             if not self.core.streaming():
                 self._block()
                 continue
+            if self.device_loop:
+                self._lockstep_device_loop()
+                continue
             x, a, v = self.device.read_sensors()
             self.core.sample(raw_row(self.info.channels, x, a, v))
             self.link.write(self.core.tx())
             while self.core.needs_force() and not self._stop:
                 self._block()
             self._actuate()
+
+    def _lockstep_device_loop(self):
+        """One sample of a device loop once the host's ALIVE lets it run (sample j < seen + latency)."""
+        while self.core.needs_alive() and not self._stop:
+            self._block()
+        if self.core.streaming() and not self._stop:
+            self._sense_and_actuate()
