@@ -8,7 +8,8 @@ device streams TELEMETRY rows (its sensors, the loop's force, the force it
 applied, the bridge velocity, the id of the CONTROL in effect); the host:
 
 - checks at the first block that INFO's parameter image CRC is its own
-  loop's (loop_image.py); a device whose loop computes with other numbers is
+  loop's (loop_image.py: its estimators, Table 1's numbers at the rate,
+  the string, the motor limits); a device whose loop computes with other numbers is
   refused with one line (a device fault before any force);
 - sends CONTROL (the loop's settings: source, bowing, gain = F_max / peak,
   force scale, a string reset) whenever the loop's settings changed since the
@@ -43,7 +44,6 @@ that first named it, host seconds from sending to reading that row).
 """
 
 import time
-import zlib
 from collections import deque
 
 import numpy as np
@@ -51,10 +51,11 @@ import numpy as np
 from studyapp.device import handshake
 from studyapp.device import loop_messages as lm
 from studyapp.device.link_device import LinkDevice
+from studyapp.device.loop_image import image_crc
 from studyapp.errors import ParameterError
 from studyapp.model import bowed_string
 from studyapp.model.control import (
-    C_BOWING, C_BREAKAWAY, C_FORCE_SCALE, C_GAIN, C_PEAK, C_SCALE, C_SOURCE, O_FORCE, observe_others,
+    C_BOWING, C_FORCE_SCALE, C_GAIN, C_SOURCE, O_FORCE, observe_others,
 )
 
 DEFAULT_PACKET = 10  # rows per TELEMETRY frame (2 ms at 5 kHz)
@@ -63,27 +64,14 @@ ALIVE_EVERY = 0.001  # s: ALIVE after a read at most this often (it is also sent
 DELAYS_KEPT = 100_000
 EXTRA_HEALTH = ("gaps", "force_gaps", "unchecked", "controls")
 # the loop's arrays (control.Control.arrays): settings, clamp state, estimators, string, body, microphone
-A_CTL, A_LIMIT_P, A_LIMIT_S, A_KINDS, A_EST_S, A_EST_P, A_SP, A_SS, A_BRIDGE, A_NUT, A_BODY_S, A_MIC_S = (
-    0, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 16)
+A_CTL, A_LIMIT_S, A_KINDS, A_EST_S, A_EST_P, A_SP, A_SS, A_BRIDGE, A_NUT, A_BODY_S, A_MIC_S = (
+    0, 3, 4, 5, 6, 7, 8, 9, 10, 12, 16)
 AT_REST = (A_LIMIT_S, A_EST_S, A_SS, A_BRIDGE, A_NUT, A_BODY_S, A_MIC_S)
 IDLE = (lm.SOURCE_VELOCITY_SENSOR, 0, 0, 0.0, 1.0)  # before the first CONTROL: the bow lifted, gain 0
 
 
 def default_lead(rate, packet):
     return max(int(packet), round(LEAD_MS * rate / 1000.0))
-
-
-def host_image(arrays, rate):
-    """The parameter image of the host's loop (docs/device-protocol.md, INFO's loop section), as bytes."""
-    ctl, kinds, est_p = arrays[A_CTL], arrays[A_KINDS], arrays[A_EST_P]
-    out = bytearray(int(rate).to_bytes(4, "little"))
-    out += bytes(int(k) for k in kinds)
-    for row in est_p:
-        out += np.ascontiguousarray(row, dtype="<f8").tobytes()
-    out += np.ascontiguousarray(arrays[A_SP], dtype="<f8").tobytes()
-    out += np.ascontiguousarray(arrays[A_LIMIT_P], dtype="<f8").tobytes()
-    out += np.array([ctl[C_SCALE], ctl[C_PEAK], ctl[C_BREAKAWAY]], dtype="<f8").tobytes()
-    return bytes(out)
 
 
 def settings_of(ctl):
@@ -263,7 +251,7 @@ class LoopLink(LinkDevice):
 
     def _check_image(self, arrays):
         self._image_checked = True
-        crc = zlib.crc32(host_image(arrays, self.rate))
+        crc = image_crc(int(self.rate), arrays)
         if crc != self.loop_info.image:
             self._device_fault(f"its loop's parameters are not the host's (image CRC {self.loop_info.image:08x}, "
                                f"the host's {crc:08x}); refused")

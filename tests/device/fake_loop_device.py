@@ -16,13 +16,13 @@ import select
 import threading
 import time
 import tty
-import zlib
 
 import numpy as np
 
 from studyapp.device import frames, messages
 from studyapp.device import loop_messages as lm
-from studyapp.device.loop_link import A_BRIDGE, A_SP, A_SS, IDLE, host_image
+from studyapp.device.loop_image import image_crc
+from studyapp.device.loop_link import A_BRIDGE, A_SP, A_SS, IDLE
 from studyapp.model import bowed_string
 from studyapp.model.control import C_BOWING, C_FORCE_SCALE, C_GAIN, C_SOURCE, OUTPUTS, observe_others
 from studyapp.model.device import DeviceLimits, HapticDevice
@@ -43,7 +43,7 @@ class Handle(HapticDevice):
 def info_for(config, base, image=None):
     """INFO v2 for a device loop of ``config`` (estimators in the config's order; image: the host's unless given)."""
     reference = ClosedLoop(config, device=Handle(config.rate, base), judge=False)
-    crc = zlib.crc32(host_image(reference.control.arrays, config.rate)) if image is None else image
+    crc = image_crc(int(config.rate), reference.control.arrays) if image is None else image
     tail = lm.LoopInfo(lm.DEVICE_LOOP, KEEPALIVE_MS, crc, tuple(int(k) for k in reference.bank.kinds)).pack()
     return messages.Info(**{**base.__dict__, "protocol_version": 2, "loop_tail": tail})
 
