@@ -50,6 +50,7 @@ import numpy as np
 
 from studyapp.device import handshake
 from studyapp.device import loop_messages as lm
+from studyapp.device import messages as msg
 from studyapp.device.link_device import LinkDevice
 from studyapp.device.loop_image import image_crc
 from studyapp.errors import ParameterError
@@ -120,6 +121,20 @@ class LoopLink(LinkDevice):
         super()._open()
         self.health.update({key: self.health.get(key, 0) for key in EXTRA_HEALTH})
         self.silence = max(self.silence, self.loop_info.keepalive_ms / 1000.0)
+
+    def _start(self):
+        """START waits for the host's first use (``_begin``): the device streams from the moment the host reads,
+        so nothing piles up while the loop is still being built (a pty that fills drops telemetry: a gap)."""
+        self._start_pending = True
+
+    def _begin(self):
+        if self._start_pending and self.link is not None:
+            self._start_pending = False
+            self._guarded(msg.Start(packet=self.packet, latency=self.lead))
+
+    def arm(self, ramp_ms=None):
+        self._begin()
+        super().arm(ramp_ms)
 
     def _check_loop(self, loop):
         if loop.loop != lm.DEVICE_LOOP:
@@ -259,6 +274,7 @@ class LoopLink(LinkDevice):
     # the loop's block ---------------------------------------------------------
     def exchange(self, control, n, out, est_out):
         """The next ``n`` telemetry rows through the shadow; the rest of the block zero once faulted."""
+        self._begin()
         arrays = control.arrays
         self._arrays = arrays
         ctl = arrays[A_CTL]
@@ -329,6 +345,7 @@ class LoopLink(LinkDevice):
 
     def resync(self):
         """Rows waiting are kept (the shadow must run every row the device ran); only the link's bytes are read."""
+        self._begin()
         while self.fault is None and self.link.wait(0.0):
             try:
                 data = self.link.read()
