@@ -67,4 +67,5 @@ def probe(spec, rate, packet=1, calibration=None, latency=1, ramp_ms=0):
         link.close()
     loop = handshake.loop_of(info, spec)
     return {"name": info.name, "serial": info.serial, "calibration": scales.source, "round_trip_ms": round_trip,
-            "protocol": info.protocol_version, "loop": "device" if loop.loop == lm.DEVICE_LOOP else "host"}
+            "protocol": info.protocol_version, "loop": "device" if loop.loop == lm.DEVICE_LOOP else "host",
+            "estimator_kinds": list(loop.kinds)}

@@ -64,10 +64,8 @@ LEAD_MS = 4.0  # a CONTROL acts this far past the newest sample seen (the knob r
 ALIVE_EVERY = 0.001  # s: ALIVE after a read at most this often (it is also sent whenever the host waits)
 DELAYS_KEPT = 100_000
 EXTRA_HEALTH = ("gaps", "force_gaps", "unchecked", "controls")
-# the loop's arrays (control.Control.arrays): settings, clamp state, estimators, string, body, microphone
-A_CTL, A_LIMIT_S, A_KINDS, A_EST_S, A_EST_P, A_SP, A_SS, A_BRIDGE, A_NUT, A_BODY_S, A_MIC_S = (
-    0, 3, 4, 5, 6, 7, 8, 9, 10, 12, 16)
-AT_REST = (A_LIMIT_S, A_EST_S, A_SS, A_BRIDGE, A_NUT, A_BODY_S, A_MIC_S)
+# the loop's arrays (control.Control.arrays) the driver reads: settings, estimators, string
+A_CTL, A_KINDS, A_EST_S, A_EST_P, A_SP, A_SS, A_BRIDGE = 0, 4, 5, 6, 7, 8, 9
 IDLE = (lm.SOURCE_VELOCITY_SENSOR, 0, 0, 0.0, 1.0)  # before the first CONTROL: the bow lifted, gain 0
 
 
@@ -115,8 +113,9 @@ class LoopLink(LinkDevice):
         self._effect_id = 0
         self._alive_seen = 0
         self._alive_at = 0.0
-        self._synced = True
-        self._restart = self._arrays is not None  # a reopen: the device's loop starts from rest, the shadow too
+        # a reopen (a re-arm after the link failed): the device's loop ran on through rows the host never read,
+        # so the shadow can no longer follow it
+        self._synced = self._arrays is None
         self._image_checked = False
         super()._open()
         self.health.update({key: self.health.get(key, 0) for key in EXTRA_HEALTH})
@@ -222,6 +221,7 @@ class LoopLink(LinkDevice):
         self._reset_pending = rest
 
     def _send_control(self, setting):
+        self._read_waiting()  # tag from the newest sample there is, not from where the host last stopped reading
         rest, self._reset_pending = self._reset_pending, None
         self._last_id = self._last_id % 0xFFFF + 1
         seen = self._newest + 1
@@ -278,10 +278,6 @@ class LoopLink(LinkDevice):
         arrays = control.arrays
         self._arrays = arrays
         ctl = arrays[A_CTL]
-        if self._restart:
-            for i in AT_REST:
-                arrays[i][:] = 0.0
-            self._restart = False
         if not self._image_checked and self.fault is None:
             self._check_image(arrays)
         wanted = ctl.copy()
@@ -346,6 +342,10 @@ class LoopLink(LinkDevice):
     def resync(self):
         """Rows waiting are kept (the shadow must run every row the device ran); only the link's bytes are read."""
         self._begin()
+        self._read_waiting()
+
+    def _read_waiting(self):
+        """Take every byte already waiting on the link, without waiting."""
         while self.fault is None and self.link.wait(0.0):
             try:
                 data = self.link.read()
