@@ -112,6 +112,8 @@ class LoopLink(LinkDevice):
         self._effect = IDLE
         self._effect_id = 0
         self._alive_seen = 0
+        self._steady = False
+        self._serviced = 0.0
         self._alive_at = 0.0
         # a reopen (a re-arm after the link failed): the device's loop ran on through rows the host never read,
         # so the shadow can no longer follow it
@@ -169,12 +171,24 @@ class LoopLink(LinkDevice):
         self._newest = frame.sample + count - 1
         width = len(self._channels)
         x, a, v = self.scales.convert([r[:width] for r in frame.rows])
-        steady = flags & lm.FLAG_ARMED and not flags & (lm.FLAG_RAMPING | lm.FLAG_FAULT)
+        # a packet's flags are the device's state at its end: a force gap is counted only inside a run of
+        # steady packets (an ARM or a DISARM within a packet is no gap)
+        now_steady = bool(flags & lm.FLAG_ARMED) and not flags & (lm.FLAG_RAMPING | lm.FLAG_FAULT)
+        steady, self._steady = now_steady and self._steady, now_steady
         for i, r in enumerate(frame.rows):
             loop_force, applied, bridge, cid = r[width:]
             if steady and applied == 0.0 and loop_force != 0.0:
                 h["force_gaps"] += 1
             self._rows.append((frame.sample + i, x[i], a[i], v[i], loop_force, applied, bridge, cid))
+
+    def _service(self):
+        """While catching up on waiting rows (after a stall), still read the link and send ALIVE every ms: the
+        device's keep-alive is fed and its telemetry does not pile up in the link until it drops some."""
+        now = time.perf_counter()
+        if now - self._serviced >= ALIVE_EVERY:
+            self._serviced = now
+            self._read_waiting()
+            self._alive()
 
     def _alive(self, force=False):
         """ALIVE(seen) when the host has read further since the last one (at most every ms unless ``force``)."""
@@ -300,6 +314,8 @@ class LoopLink(LinkDevice):
             row = self._next_row() if self.fault is None else None
             if row is None:
                 break
+            if k % self.packet == 0:
+                self._service()
             sample, x, a, v, loop_force, applied, v_bridge, cid = row
             if cid != self._effect_id:
                 self._others(start, k, out, est_out, arrays)

@@ -169,3 +169,20 @@ def test_protocol_3_is_refused(device_loop):
     fake.info = dataclasses.replace(fake.info, protocol_version=3)
     with pytest.raises(ParameterError, match="protocol version 3, this host speaks 1 and 2"):
         LoopLink(fake.path, RATE, pings=2)
+
+
+def test_the_driver_is_picked_from_info(device_loop):
+    from studyapp.device.device_open import open_link_device
+    from tests.device.fake_device import FakeDevice
+
+    fake = device_loop()
+    device = open_link_device(fake.path, RATE, {"latency": 5, "packet": 1, "silence": 2.0})
+    assert isinstance(device, LoopLink) and device.packet == 10
+    device.close()
+    v1 = FakeDevice()
+    try:
+        device = open_link_device(v1.path, RATE, {"latency": 5, "packet": 1})
+        assert type(device) is LinkDevice and device.latency == 5
+        device.close()
+    finally:
+        v1.close()
