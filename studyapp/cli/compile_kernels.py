@@ -38,8 +38,9 @@ def register(sub):
 
 def closed_loop():
     """The loop the engine and ``simulate`` run, with the paper's sensor and with an estimator in it, and the
-    same loop on a real device's per-sample interface (model/device.py ``exchange``). One part: the two
-    share most of their compiled callees, which two processes would each compile."""
+    same loop on a real device's per-sample interface (model/device.py ``exchange``), and the shadow of a device
+    that runs the loop. One part: they share most of their compiled callees, which two processes would each
+    compile."""
     from studyapp.model.device import DeviceLimits, HapticDevice
     from studyapp.model.loop import ClosedLoop, LoopConfig
     from studyapp.model.simulate import simulate
@@ -57,7 +58,21 @@ def closed_loop():
 
     simulate(1.0, duration=0.05)
     simulate(1.0, duration=0.05, source="KALMAN")
-    ClosedLoop(LoopConfig(rate=StillHandle.rate, fmax=1.0, source="LVT"), device=StillHandle()).run(100)
+    loop = ClosedLoop(LoopConfig(rate=StillHandle.rate, fmax=1.0, source="LVT"), device=StillHandle())
+    loop.run(100)
+    shadow_of_a_device_loop(loop)
+
+
+def shadow_of_a_device_loop(loop):
+    """The host's shadow of a device that runs the loop (device/shadow.py), on a few rows at rest."""
+    import numpy as np
+
+    from studyapp.device import shadow
+    from studyapp.model.control import OUTPUTS
+
+    rows = np.zeros((4, shadow.ROW_WIDTH))
+    shadow.run_rows(loop.control.arrays, 0, rows, 0.0, True, np.zeros((len(OUTPUTS), 4)),
+                    np.zeros((len(loop.names), 4)), np.zeros(2))
 
 
 def estimator_bank():

@@ -51,21 +51,18 @@ import numpy as np
 from studyapp.device import handshake
 from studyapp.device import loop_messages as lm
 from studyapp.device import messages as msg
+from studyapp.device import shadow
 from studyapp.device.link_device import LinkDevice
 from studyapp.device.loop_image import image_crc
 from studyapp.errors import ParameterError
-from studyapp.model import bowed_string
-from studyapp.model.control import (
-    C_BOWING, C_FORCE_SCALE, C_GAIN, C_SOURCE, O_FORCE, observe_others,
-)
+from studyapp.model.control import C_BOWING, C_FORCE_SCALE, C_GAIN, C_SOURCE
 
 DEFAULT_PACKET = 10  # rows per TELEMETRY frame (2 ms at 5 kHz)
 LEAD_MS = 4.0  # a CONTROL acts this far past the newest sample seen (the knob reaches the device within 10 ms)
 ALIVE_EVERY = 0.001  # s: ALIVE after a read at most this often (it is also sent whenever the host waits)
 DELAYS_KEPT = 100_000
 EXTRA_HEALTH = ("gaps", "force_gaps", "unchecked", "controls")
-# the loop's arrays (control.Control.arrays) the driver reads: settings, estimators, string
-A_CTL, A_KINDS, A_EST_S, A_EST_P, A_SP, A_SS, A_BRIDGE = 0, 4, 5, 6, 7, 8, 9
+A_CTL = 0  # the control vector's place in the loop's arrays (control.Control.arrays)
 IDLE = (lm.SOURCE_VELOCITY_SENSOR, 0, 0, 0.0, 1.0)  # before the first CONTROL: the bow lifted, gain 0
 
 
@@ -114,6 +111,7 @@ class LoopLink(LinkDevice):
         self._alive_seen = 0
         self._steady = False
         self._serviced = 0.0
+        self._shadow_values = np.zeros(2)  # the shadow's force and bridge velocity at a row that differed
         self._alive_at = 0.0
         # a reopen (a re-arm after the link failed): the device's loop ran on through rows the host never read,
         # so the shadow can no longer follow it
@@ -306,54 +304,41 @@ class LoopLink(LinkDevice):
             ctl[:] = wanted
 
     def _run(self, control, n, out, est_out, ctl):
-        arrays = control.arrays
-        sp, ss, bridge = arrays[A_SP], arrays[A_SS], arrays[A_BRIDGE]
-        h = self.health
-        start = 0  # the first row of the current setting's segment in this block
-        for k in range(n):
-            row = self._next_row() if self.fault is None else None
+        rows = []
+        while len(rows) < n and self.fault is None:
+            row = self._next_row()
             if row is None:
                 break
-            if k % self.packet == 0:
+            rows.append(row)
+            if len(rows) % self.packet == 0:
                 self._service()
-            sample, x, a, v, loop_force, applied, v_bridge, cid = row
-            if cid != self._effect_id:
-                self._others(start, k, out, est_out, arrays)
-                start = k
-                if not self._apply(cid, sample, ctl):
-                    break
-            shadow_bridge = bowed_string.read_line(bridge, int(ss[bowed_string.S_WRITE]), sp[bowed_string.P_DB])
-            force = control.sample(k, (x, a, v), None, out, est_out)
-            h["samples"] += 1
-            if self._synced:
-                if abs(force - loop_force) > self.tolerance or abs(shadow_bridge - v_bridge) > self.tolerance \
-                        or not (np.isfinite(loop_force) and np.isfinite(v_bridge)):
-                    self._device_fault(
-                        f"the device's loop differs from the host's shadow at its sample {sample}: force "
-                        f"{loop_force!r} N (shadow {force!r}), bridge {v_bridge!r} (shadow {shadow_bridge!r})")
-                    out[O_FORCE, k] = 0.0
-                    self._others(start, k + 1, out, est_out, arrays)
-                    return
-            else:
-                h["unchecked"] += 1
-            out[O_FORCE, k] = applied
-        else:
-            k = n
-        self._others(start, k, out, est_out, arrays)
-
-    def _others(self, k0, k1, out, est_out, arrays):
-        """The estimators other than the source, stepped over rows [k0, k1) (one setting: one source)."""
-        if k1 <= k0:
+        if not rows:
             return
-        src = int(self._effect[0])
-        kinds, est_s, est_p = arrays[A_KINDS], arrays[A_EST_S], arrays[A_EST_P]
-        if k0 == 0 and k1 == out.shape[1]:
-            observe_others(src, kinds, est_s, est_p, out, est_out)
-            return
-        part_out = np.ascontiguousarray(out[:, k0:k1])
-        part_est = np.ascontiguousarray(est_out[:, k0:k1])
-        observe_others(src, kinds, est_s, est_p, part_out, part_est)
-        est_out[:, k0:k1] = part_est
+        table = np.array(rows, dtype=np.float64)
+        controls = table[:, shadow.R_CONTROL]
+        h = self.health
+        start = 0
+        while start < len(rows):
+            cid = int(controls[start])
+            if cid != self._effect_id and not self._apply(cid, int(table[start, shadow.R_SAMPLE]), ctl):
+                return
+            changes = np.flatnonzero(controls[start:] != cid)
+            end = start + int(changes[0]) if changes.size else len(rows)
+            bad = shadow.run_rows(control.arrays, start, table[start:end], self.tolerance, self._synced, out,
+                                  est_out, self._shadow_values)
+            done = end - start if bad < 0 else bad + 1
+            h["samples"] += done
+            if not self._synced:
+                h["unchecked"] += done
+            if bad >= 0:
+                row = table[start + bad]
+                force, bridge = self._shadow_values
+                self._device_fault(
+                    f"the device's loop differs from the host's shadow at its sample {int(row[shadow.R_SAMPLE])}: "
+                    f"force {row[shadow.R_LOOP_FORCE]!r} N (shadow {force!r}), bridge {row[shadow.R_BRIDGE]!r} "
+                    f"(shadow {bridge!r})")
+                return
+            start = end
 
     def resync(self):
         """Rows waiting are kept (the shadow must run every row the device ran); only the link's bytes are read."""

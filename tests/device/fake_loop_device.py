@@ -22,13 +22,14 @@ import numpy as np
 from studyapp.device import frames, messages
 from studyapp.device import loop_messages as lm
 from studyapp.device.loop_image import image_crc
-from studyapp.device.loop_link import A_BRIDGE, A_SP, A_SS, IDLE
+from studyapp.device.loop_link import IDLE
 from studyapp.model import bowed_string
 from studyapp.model.control import C_BOWING, C_FORCE_SCALE, C_GAIN, C_SOURCE, OUTPUTS, observe_others
 from studyapp.model.device import DeviceLimits, HapticDevice
 from studyapp.model.loop import ClosedLoop
 
 KEEPALIVE_MS = 150
+A_SP, A_SS, A_BRIDGE = 7, 8, 9  # the string's parameters, state and bridge-side line in the loop's arrays
 
 
 class Handle(HapticDevice):

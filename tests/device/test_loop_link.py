@@ -50,7 +50,7 @@ def device_loop(request):
 
 
 def _open(fake, config=None, **options):
-    link = LoopLink(fake.path, RATE, pings=2, silence=2.0, **options)
+    link = LoopLink(fake.path, RATE, pings=2, silence=10.0, **options)  # the first call compiles (GIL held)
     return link, ClosedLoop(config or _config(), device=link, judge=False)
 
 
