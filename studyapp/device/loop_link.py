@@ -331,8 +331,8 @@ class LoopLink(LinkDevice):
             if not self._synced:
                 h["unchecked"] += done
             if bad >= 0:
-                row = table[start + bad]
-                force, bridge = self._shadow_values
+                row = [float(v) for v in table[start + bad]]
+                force, bridge = (float(v) for v in self._shadow_values)
                 self._device_fault(
                     f"the device's loop differs from the host's shadow at its sample {int(row[shadow.R_SAMPLE])}: "
                     f"force {row[shadow.R_LOOP_FORCE]!r} N (shadow {force!r}), bridge {row[shadow.R_BRIDGE]!r} "

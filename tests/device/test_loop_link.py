@@ -119,6 +119,7 @@ def test_a_last_bit_difference_is_a_device_fault_naming_the_sample(device_loop):
     forces, _, _ = _run(loop, 8)
     assert link.fault is not None and "sample 437" in link.fault, link.fault
     assert "differs from the host's shadow" in link.fault and "\n" not in link.fault
+    assert "(shadow " in link.fault and "np." not in link.fault
     assert loop.fault is not None and "sample 437" in loop.fault
     assert np.all(forces[437:] == 0.0) and np.count_nonzero(forces[:437]) > 0
 
