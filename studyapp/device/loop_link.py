@@ -15,9 +15,11 @@ applied, the bridge velocity, the id of the CONTROL in effect); the host:
   force scale, a string reset) whenever the loop's settings changed since the
   last block, tagged ``lead`` samples past the newest sample seen (the knob
   reaches the device within lead / rate plus one block), and ALIVE (the
-  keep-alive, with the samples read) whenever it waits for telemetry;
-- runs the **shadow**: the loop's own compiled controller (model/control.py
-  ``sample``, with the loop's arrays) on each streamed sensor row, each
+  keep-alive, with the samples read) whenever it waits for telemetry, and
+  every ms while it catches up on rows that waited (after a stall);
+- runs the **shadow** (shadow.py, one compiled call per setting): the loop's
+  own controller (model/control.py ``sample``, with the loop's arrays) on
+  each streamed sensor row, every estimator stepped on it, each
   CONTROL applied at the row whose control id first names it, exactly as the
   device did. The shadow's force must equal the row's loop_force, and the
   bridge velocity the shadow's string reads the row's bridge (``tolerance``,
@@ -33,8 +35,10 @@ keep-alive disarms it if the host stays away); the host finds the rows
 waiting and runs them late (a gap in the scope, never a stale force: it sends
 none). Device samples that never arrive are counted (``missing``, ``gaps``):
 the shadow cannot follow the device across them, so from then on it is no
-longer compared (``unchecked`` counts the rows) until a reopen restarts both
-loops from rest.
+longer compared (``unchecked`` counts the rows); nor after a reopen of a
+failed link. The shadow starts at rest: it follows a device loop that starts
+at rest with this host's START (a device that kept its loop's state from an
+earlier host's stream differs at once: a device fault).
 
 ``health`` (cumulative): version 1's counts, plus ``gaps`` (telemetry gaps),
 ``force_gaps`` (rows armed, past the ramp, with a loop force but none applied),
