@@ -159,7 +159,7 @@ def scales(info, serial, calibration_path):
 def greet(send, receive, link, rate, motor_limits, packet, calibration_path):
     """HELLO until INFO comes (bounded); the checked INFO and its ``Scales``."""
     for _ in range(HELLO_TRIES):
-        send(msg.Hello(protocol_version=VERSIONS[-1]))
+        send(msg.Hello(protocol_version=msg.PROTOCOL_VERSION))  # HELLO(1), as the protocol has it for both
         end = time.monotonic() + HELLO_TIMEOUT
         while (left := end - time.monotonic()) > 0:
             reply = receive(left)

@@ -124,6 +124,7 @@ class LoopLink(LinkDevice):
         super()._open()
         self.health.update({key: self.health.get(key, 0) for key in EXTRA_HEALTH})
         self.silence = max(self.silence, self.loop_info.keepalive_ms / 1000.0)
+        self._alive_period = self.loop_info.keepalive_ms / 4000.0  # s: the protocol's longest gap between ALIVEs
 
     def _start(self):
         """START waits for the host's first use (``_begin``): the device streams from the moment the host reads,
@@ -193,10 +194,13 @@ class LoopLink(LinkDevice):
             self._alive()
 
     def _alive(self, force=False):
-        """ALIVE(seen) when the host has read further since the last one (at most every ms unless ``force``)."""
+        """ALIVE(seen) when the host has read further since the last one (at most every ms unless ``force``),
+        and at least every keepalive_ms / 4 even when it has not (a device that paused and then runs its
+        samples fast, as an emulator catching up, must still hear from the host within its watchdog)."""
         seen = self._newest + 1
         now = time.perf_counter()
-        if seen > self._alive_seen and (force or now - self._alive_at >= ALIVE_EVERY):
+        due = now - self._alive_at >= self._alive_period
+        if due or (seen > self._alive_seen and (force or now - self._alive_at >= ALIVE_EVERY)):
             self._guarded(lm.Alive(seen=seen & 0xFFFFFFFF))
             self._alive_seen, self._alive_at = seen, now
 
@@ -228,7 +232,7 @@ class LoopLink(LinkDevice):
             if left <= 0:
                 self._device_fault(f"the link was silent for more than {1e3 * self.silence:g} ms")
                 return False
-            self.link.wait(left)
+            self.link.wait(min(left, self._alive_period))
         return False
 
     # settings -----------------------------------------------------------------
