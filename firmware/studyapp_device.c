@@ -1,33 +1,13 @@
 /* studyapp device protocol v1, the device side: see studyapp_device.h and docs/device-protocol.md.
- * Each function mirrors its namesake in studyapp/device/device_side.py or firmware.py. */
+ * Each function mirrors its namesake in studyapp/device/device_side.py or firmware.py; the framing (CRC,
+ * COBS, the receiver) is studyapp_device_link.c. */
 #include "studyapp_device.h"
+#include "studyapp_bytes.h"
 
 #include <string.h>
 
 enum { HELLO = 0x81, FORCE, ARM, DISARM, START, STOP, PING, KEEPALIVE, CONTROL, ALIVE };
 enum { INFO = 0x01, SENSORS, PONG, FAULT, STATE };
-
-static uint32_t rd32(const uint8_t *p) {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
-static uint64_t rd64(const uint8_t *p) { return (uint64_t)rd32(p) | ((uint64_t)rd32(p + 4) << 32); }
-static double rdf64(const uint8_t *p) {
-    uint64_t u = rd64(p);
-    double f;
-    memcpy(&f, &u, 8);
-    return f;
-}
-static void wr32(uint8_t *p, uint32_t v) {
-    p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
-}
-static void wrf64(uint8_t *p, double f) {
-    uint64_t u;
-    memcpy(&u, &f, 8);
-    wr32(p, (uint32_t)u);
-    wr32(p + 4, (uint32_t)(u >> 32));
-}
-static int finite64(const uint8_t *p) { return ((rd64(p) >> 52) & 0x7FFu) != 0x7FFu; }
 
 /* a count from a double, saturating (a cast of an out-of-range double is undefined in C); NaN gives 0 */
 static int32_t count_of(double v, double lo, double hi) {
@@ -37,60 +17,7 @@ static int32_t count_of(double v, double lo, double hi) {
     return (int32_t)v;
 }
 
-/* a - b as a signed difference of wrapping 32-bit counters */
-static int64_t ahead(uint32_t a, uint32_t b) {
-    uint32_t d = a - b;
-    return d < 0x80000000u ? (int64_t)d : (int64_t)d - (int64_t)0x100000000LL;
-}
-
-uint16_t sd_crc16(const uint8_t *data, uint32_t n, uint16_t crc) {
-    uint32_t i;
-    int b;
-    for (i = 0; i < n; i++) {
-        crc ^= (uint16_t)(data[i] << 8);
-        for (b = 0; b < 8; b++)
-            crc = (crc & 0x8000u) ? (uint16_t)((crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
-    }
-    return crc;
-}
-
 uint32_t sd_sizeof(void) { return (uint32_t)sizeof(sd_device); }
-
-/* ---- frames out ---- */
-
-void sd_send_payload(sd_device *d, uint8_t *payload, uint32_t n) {
-    uint32_t need = n + 2u + (n + 2u) / 254u + 2u, i, o, code_at;
-    uint16_t crc;
-    uint8_t code, byte;
-    payload[1] = d->tx_seq++;
-    if (d->tx_len + need > SD_TX_SIZE) {
-        d->tx_dropped++;
-        return;
-    }
-    crc = sd_crc16(payload, n, 0xFFFFu);
-    o = d->tx_len;
-    code_at = o++;
-    code = 1;
-    for (i = 0; i < n + 2u; i++) {
-        byte = i < n ? payload[i] : (i == n ? (uint8_t)(crc & 0xFFu) : (uint8_t)(crc >> 8));
-        if (code == 255) {
-            d->tx[code_at] = 255;
-            code_at = o++;
-            code = 1;
-        }
-        if (byte == 0) {
-            d->tx[code_at] = code;
-            code_at = o++;
-            code = 1;
-        } else {
-            d->tx[o++] = byte;
-            code++;
-        }
-    }
-    d->tx[code_at] = code;
-    d->tx[o++] = 0;
-    d->tx_len = o;
-}
 
 static void fault_frame(sd_device *d, uint8_t code, uint32_t sample, uint32_t detail) {
     uint8_t p[11];
@@ -115,7 +42,7 @@ static void state_frame(sd_device *d) {
 
 /* a FAULT that is not latched, at most once per second per code */
 static void report(sd_device *d, int code, uint32_t detail) {
-    if (!d->reported[code] || ahead(d->now, d->report_at[code]) >= (int64_t)d->rate_hz) {
+    if (!d->reported[code] || sd_ahead(d->now, d->report_at[code]) >= (int64_t)d->rate_hz) {
         d->reported[code] = 1;
         d->report_at[code] = d->now;
         fault_frame(d, (uint8_t)code, d->now, detail);
@@ -132,11 +59,11 @@ static uint32_t milli(double f) {
 
 static void feed(sd_device *d, uint32_t until) {
     if (d->down_left) return;
-    if (ahead(until, d->deadline) > 0 || !d->armed) d->deadline = until;
+    if (sd_ahead(until, d->deadline) > 0 || !d->armed) d->deadline = until;
     d->last_feed = d->now;
 }
 
-static void corrupt_frame(sd_device *d) {
+void sd_corrupt_frame(sd_device *d) {
     d->corrupt++;
     d->corrupt_run++;
     if (d->corrupt_run >= SD_LINK_RUN && d->armed) {
@@ -170,7 +97,7 @@ static void force(sd_device *d, uint32_t sample, uint32_t count, const uint8_t *
     if (!d->streaming) return;
     for (i = 0; i < count; i++) {
         t = sample + i;
-        dt = ahead(t, d->now);
+        dt = sd_ahead(t, d->now);
         if (dt < 0) {
             d->late++;
             report(d, SD_LATE, d->late);
@@ -190,7 +117,7 @@ static void force(sd_device *d, uint32_t sample, uint32_t count, const uint8_t *
 
 int sd_needs_force(const sd_device *d) {
     uint32_t slot;
-    if (d->loop_mode || !d->streaming || ahead(d->now, d->start_sample + d->latency) < 0) return 0;
+    if (d->loop_mode || !d->streaming || sd_ahead(d->now, d->start_sample + d->latency) < 0) return 0;
     slot = d->now % SD_RING;
     return !(d->valid[slot] && d->tags[slot] == d->now);
 }
@@ -216,7 +143,7 @@ double sd_actuate(sd_device *d) {
     uint32_t j = d->now, slot;
     double f = 0.0;
     int64_t k;
-    if (d->armed && d->down_left == 0 && ahead(j, d->deadline) >= 0) {
+    if (d->armed && d->down_left == 0 && sd_ahead(j, d->deadline) >= 0) {
         d->fault = SD_WATCHDOG;
         d->down_left = d->down;
         d->down_from = d->last_out;
@@ -230,7 +157,7 @@ double sd_actuate(sd_device *d) {
         }
     } else if (d->armed && d->streaming && d->loop_mode) {
         f = d->loop_force;
-        k = ahead(j, d->arm_sample);
+        k = sd_ahead(j, d->arm_sample);
         if (k < (int64_t)d->ramp) {
             f = f * ((double)k / (double)d->ramp);
             d->ramping = 1;
@@ -246,7 +173,7 @@ double sd_actuate(sd_device *d) {
             f = d->hold;
             d->missing++;
         }
-        k = ahead(j, d->arm_sample);
+        k = sd_ahead(j, d->arm_sample);
         if (k < (int64_t)d->ramp) {
             f = f * ((double)k / (double)d->ramp);
             d->ramping = 1;
@@ -283,13 +210,13 @@ static int body_ok(sd_device *d, const uint8_t *b, uint32_t n, int type) {
     }
 }
 
-static void payload(sd_device *d, uint8_t *p, uint32_t n) {
+void sd_payload(sd_device *d, uint8_t *p, uint32_t n) {
     const uint8_t *b = p + 2;
     uint32_t bn = n - 2u;
     int type = p[0];
     uint8_t out[10];
     if (!body_ok(d, b, bn, type)) {
-        corrupt_frame(d);
+        sd_corrupt_frame(d);
         return;
     }
     if (d->have_seq) d->lost += (uint8_t)(p[1] - d->last_seq - 1u);
@@ -339,51 +266,6 @@ static void payload(sd_device *d, uint8_t *p, uint32_t n) {
     state_frame(d);
 }
 
-static void finish_run(sd_device *d) {
-    uint8_t p[SD_MAX_ENCODED];
-    uint32_t i = 0, n = d->rx_len, o = 0, end, code, k;
-    int overlong = d->rx_overlong;
-    d->rx_len = 0;
-    d->rx_overlong = 0;
-    if (overlong) {
-        corrupt_frame(d);
-        return;
-    }
-    if (n == 0) return;
-    while (i < n) { /* COBS: the run holds no 0x00 */
-        code = d->rx[i];
-        end = i + code;
-        if (end > n) {
-            corrupt_frame(d);
-            return;
-        }
-        for (k = i + 1u; k < end; k++) p[o++] = d->rx[k];
-        i = end;
-        if (code < 255u && i < n) p[o++] = 0;
-    }
-    if (o < 4u || sd_crc16(p, o - 2u, 0xFFFFu) != (uint16_t)(p[o - 2u] | (p[o - 1u] << 8))) {
-        corrupt_frame(d);
-        return;
-    }
-    payload(d, p, o - 2u);
-}
-
-void sd_rx(sd_device *d, const uint8_t *data, uint32_t n) {
-    uint32_t i;
-    for (i = 0; i < n; i++) {
-        if (data[i] == 0) {
-            finish_run(d);
-        } else if (!d->rx_overlong) {
-            if (d->rx_len == SD_MAX_ENCODED) {
-                d->rx_overlong = 1;
-                d->rx_len = 0;
-            } else {
-                d->rx[d->rx_len++] = data[i];
-            }
-        }
-    }
-}
-
 void sd_sample(sd_device *d, const double *raw) {
     uint8_t *r, *row;
     uint32_t c, flags;
@@ -419,16 +301,8 @@ void sd_sample(sd_device *d, const double *raw) {
     d->row_count = 0;
 }
 
-uint32_t sd_tx(sd_device *d, uint8_t *out, uint32_t cap) {
-    uint32_t n = d->tx_len < cap ? d->tx_len : cap;
-    memcpy(out, d->tx, n);
-    memmove(d->tx, d->tx + n, d->tx_len - n);
-    d->tx_len -= n;
-    return n;
-}
-
 int sd_needs_alive(const sd_device *d) {
-    return d->loop_mode && d->streaming && ahead(d->now, d->seen + d->latency) >= 0;
+    return d->loop_mode && d->streaming && sd_ahead(d->now, d->seen + d->latency) >= 0;
 }
 
 void sd_counters(const sd_device *d, uint32_t out[8]) {

@@ -118,7 +118,9 @@ uint32_t sd_sizeof(void);
 void sd_counters(const sd_device *d, uint32_t out[8]);
 /* version 2, lock-step: 1 while a streaming device loop has run up to ALIVE's seen + START's latency */
 int sd_needs_alive(const sd_device *d);
-/* for studyapp_device_loop.c: frame and queue a payload (its seq byte is set here) */
-void sd_send_payload(sd_device *d, uint8_t *payload, uint32_t n);
+/* between the core's files (studyapp_device.c, _link.c, _loop.c), not for a firmware: */
+void sd_send_payload(sd_device *d, uint8_t *payload, uint32_t n); /* frame and queue (sets the seq byte) */
+void sd_payload(sd_device *d, uint8_t *p, uint32_t n);            /* a sound frame's payload: apply it */
+void sd_corrupt_frame(sd_device *d);                               /* count a corrupt frame */
 
 #endif

@@ -4,36 +4,13 @@
 
 #include <string.h>
 
+#include "studyapp_bytes.h"
+
 enum { CONTROL = 0x89, ALIVE = 0x8A, TELEMETRY = 0x06, FAULT = 0x04 };
 enum { SOURCE_SENSOR = -2, CONTROL_BODY = 25, ALIVE_BODY = 4 };
 
-static uint32_t rd32(const uint8_t *p) {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
-static double rdf64(const uint8_t *p) {
-    uint64_t u = (uint64_t)rd32(p) | ((uint64_t)rd32(p + 4) << 32);
-    double f;
-    memcpy(&f, &u, 8);
-    return f;
-}
-static void wr32(uint8_t *p, uint32_t v) {
-    p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
-}
-static void wrf64(uint8_t *p, double f) {
-    uint64_t u;
-    memcpy(&u, &f, 8);
-    wr32(p, (uint32_t)u);
-    wr32(p + 4, (uint32_t)(u >> 32));
-}
 /* finite, without <math.h>: NaN fails every comparison, and an infinity minus itself is NaN */
 static int finite(double f) { return f - f == 0.0; }
-
-/* a - b as a signed difference of wrapping 32-bit counters */
-static int64_t ahead(uint32_t a, uint32_t b) {
-    uint32_t d = a - b;
-    return d < 0x80000000u ? (int64_t)d : (int64_t)d - (int64_t)0x100000000LL;
-}
 
 static sd_control parse_control(const uint8_t *b) {
     sd_control c;
@@ -88,7 +65,7 @@ static void frame(sd_device *d, int type, const uint8_t *b) {
         d->corrupt++;
         return;
     }
-    if (ahead(c.sample, d->now) < 0) d->late++; /* it takes effect at the next sample */
+    if (sd_ahead(c.sample, d->now) < 0) d->late++; /* it takes effect at the next sample */
     d->queue[d->queued++] = c;
 }
 
@@ -106,7 +83,7 @@ static void streaming(sd_device *d, int on) {
 static void apply_due(sd_device *d, uint32_t j) {
     uint32_t i, kept = 0;
     for (i = 0; i < d->queued; i++) {
-        if (ahead(j, d->queue[i].sample) >= 0)
+        if (sd_ahead(j, d->queue[i].sample) >= 0)
             apply(d, &d->queue[i]);
         else
             d->queue[kept++] = d->queue[i];

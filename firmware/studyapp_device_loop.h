@@ -25,7 +25,8 @@
 #include "studyapp_device.h"
 #include "studyapp_loop.h"
 
-/* 0 on success; -1 if the INFO has no device loop, L's estimators are not INFO's, or sl_check(L) fails */
+/* 0 on success; -1 if the INFO has no device loop, L's estimators are not INFO's, or sl_check(L) fails.
+ * Until a loop is attached, a device loop counts CONTROL and ALIVE as corrupt and applies 0 N. */
 int sd_attach_loop(sd_device *d, sl_loop *L);
 
 /* control id in effect, CONTROLs queued, ALIVE's seen, the loop's fault code */

@@ -12,10 +12,14 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.estimators.benchmark"))
 
-    p = kinds.add_parser("loop", help="closed-loop throughput with all fourteen estimators")
+    p = kinds.add_parser("loop", help="closed-loop throughput with all fourteen estimators; with --core, the "
+                                      "loop's cost in C and in numba")
     p.add_argument("--rate", type=float, default=48_000.0, help="sample rate in Hz (default 48000)")
+    p.add_argument("--core", action="append", metavar="CORE",
+                   help="c, numba or c,numba (repeatable): ns per sample of the loop and of its estimator bank "
+                        "on each core, on a recorded sensor stream, instead of the simulated loop's throughput")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(func=_run("studyapp.model.benchmark"))
+    p.set_defaults(func=_loop)
 
     p = kinds.add_parser("live", help="highest rate the live engine holds in real time")
     p.add_argument("--seconds", type=float, default=30.0, help="confirmation run length (default 30)")
@@ -77,6 +81,10 @@ def register(sub):
                         "the device (protocol 2: telemetry, the host's shadow, CONTROL on a knob turn)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.device.benchmark"))
+
+
+def _loop(args):
+    return _run("studyapp.device.loop_benchmark" if args.core else "studyapp.model.benchmark")(args)
 
 
 def _run(module):

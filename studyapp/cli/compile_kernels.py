@@ -11,8 +11,9 @@ on a real device's per-sample interface, the optimiser's side-by-side
 kernels, the estimator bank and benchmark, the metric (one-off and the
 optimiser's memorised reference), the stability monitor on a recording,
 FOAW's window sizes, the audio resampler and the scope's envelope; and it
-builds the device emulator's C core (studyapp/device/c_core.py). Every
-later process loads the compiled code from the cache; a warm cache makes
+builds the device emulator's C core (studyapp/device/c_core.py) and the
+estimators and the loop in C (studyapp/device/c_estimators.py, c_loop.py).
+Every later process loads the compiled code from the cache; a warm cache makes
 this take a few seconds. ``make run`` and ``make test`` call it.
 
 The parts run in two processes at once (``--jobs``), one per core of a
@@ -37,10 +38,13 @@ def register(sub):
 
 
 def closed_loop():
-    """The loop the engine and ``simulate`` run, with the paper's sensor and with an estimator in it, and the
-    same loop on a real device's per-sample interface (model/device.py ``exchange``), and the shadow of a device
-    that runs the loop. One part: they share most of their compiled callees, which two processes would each
-    compile."""
+    """The loop the engine and ``simulate`` run, with the paper's sensor and with an estimator in it, the
+    same loop on a real device's per-sample interface (model/device.py ``exchange``) and on recorded sensor
+    samples (control.run_sensors, the C loop's reference), and the shadow of a device that runs the loop.
+    One part: they share most of their compiled callees, which two processes would each compile."""
+    import numpy as np
+
+    from studyapp.model import control
     from studyapp.model.device import DeviceLimits, HapticDevice
     from studyapp.model.loop import ClosedLoop, LoopConfig
     from studyapp.model.simulate import simulate
@@ -60,6 +64,8 @@ def closed_loop():
     simulate(1.0, duration=0.05, source="KALMAN")
     loop = ClosedLoop(LoopConfig(rate=StillHandle.rate, fmax=1.0, source="LVT"), device=StillHandle())
     loop.run(100)
+    x = np.zeros(16)
+    control.run_sensors(loop.control.arrays, x, x, x, np.zeros((len(control.OUTPUTS), 16)), np.zeros((0, 16)))
     shadow_of_a_device_loop(loop)
 
 
@@ -124,13 +130,17 @@ def signal_paths():
 
 
 def device_core():
-    """The device protocol's C core (firmware/studyapp_device.c), which the device emulator runs when it builds;
-    without a C compiler the emulator runs the Python core and says so."""
-    from studyapp.device import c_core
-    try:
-        c_core.build()
-    except c_core.BuildError:
-        pass
+    """The device protocol's C core (firmware/studyapp_device.c), which the device emulator runs when it builds
+    (without a C compiler the emulator runs the Python core and says so), the estimators in C
+    (firmware/studyapp_estimators.h, studyapp/device/c_estimators.py) and the loop in C with them
+    (firmware/studyapp_loop.h, studyapp/device/c_loop.py), and the device core with that loop, which
+    ``device-emulator --loop device`` runs (firmware/studyapp_device_loop.h, studyapp/device/c_loop_core.py)."""
+    from studyapp.device import c_core, c_estimators, c_loop, c_loop_core
+    for build in (c_core.build, c_estimators.build, c_loop.build, c_loop_core.build):
+        try:
+            build()
+        except c_core.BuildError:
+            pass
 
 
 # the longest first: a pool of two then ends about together

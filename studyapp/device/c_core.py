@@ -2,8 +2,8 @@
 
 The same interface as firmware.py's ``Firmware`` (rx, sample, needs_force,
 actuate, tx, streaming, busy, counters), so the emulator runs either and the
-tests hold the two equal byte for byte. ``build()`` compiles the C file
-once into the user's cache (``$XDG_CACHE_HOME/studyapp/device/<hash of the
+tests hold the two equal byte for byte. ``build()`` compiles the C files
+(``SOURCES``) once into the user's cache (``$XDG_CACHE_HOME/studyapp/device/<hash of the
 sources and flags>/``, the compiler from ``$CC`` or ``cc``; the Debian
 packages gcc and libc6-dev, scripts/system-deps.txt) and returns the shared
 library's path; a second process finds it there. ``build_library`` does the
@@ -24,7 +24,7 @@ from pathlib import Path
 from studyapp.device.device_side import SafetyConfig
 
 SOURCE_DIR = Path(__file__).resolve().parents[2] / "firmware"
-SOURCES = ("studyapp_device.c", "studyapp_device.h")
+SOURCES = ("studyapp_device.c", "studyapp_device_link.c", "studyapp_device.h", "studyapp_bytes.h")
 FLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fPIC", "-shared")
 LIBS = ("-lm",)  # after the sources: the C maths library (sqrt, fabs, copysign, isfinite's kin)
 COUNTERS = ("now", "armed", "streaming", "fault", "late", "lost", "corrupt", "missing")

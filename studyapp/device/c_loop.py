@@ -157,19 +157,23 @@ class CLoop:
         return self._lib.sl_sample(ctypes.byref(self._loop), int(k), float(x_m), float(a_m), float(v_m),
                                    ctypes.byref(self.out), self._est)
 
-    def run(self, x_m, a_m, v_m, k0=0):
+    def run(self, x_m, a_m, v_m, k0=0, out=None, est=None):
         """A block of ``len(x_m)`` samples from sample index ``k0``: (out, est).
 
-        ``out`` has a row per ``OUT_ROWS`` name and ``est`` a row per estimator of the bank (a view of the
-        samples-by-estimators array the C writes), each with a column per sample.
+        ``out`` has a row per ``OUT_ROWS`` name and ``est`` a row per estimator of the bank, each with a
+        column per sample; ``est`` is the transpose of the samples-by-estimators array the C writes. Pass
+        ``out`` (rows by samples) and ``est`` (samples by estimators), C-contiguous float64, to fill them.
         """
         n = int(np.shape(x_m)[0])
         x_m, a_m, v_m = (_rows(n, s, w) for s, w in ((x_m, "x_m"), (a_m, "a_m"), (v_m, "v_m")))
-        out = np.empty((len(OUT_ROWS), n))
-        est = np.empty((n, self.n_est))
-        f = _f64
-        self._lib.sl_run(ctypes.byref(self._loop), int(k0), n, x_m.ctypes.data_as(f), a_m.ctypes.data_as(f),
-                         v_m.ctypes.data_as(f), out.ctypes.data_as(f), est.ctypes.data_as(f))
+        out = np.empty((len(OUT_ROWS), n)) if out is None else out
+        est = np.empty((n, self.n_est)) if est is None else est
+        if out.shape != (len(OUT_ROWS), n) or est.shape != (n, self.n_est):
+            raise ParameterError(f"C loop: out must be {(len(OUT_ROWS), n)} and est {(n, self.n_est)}, "
+                                 f"got {out.shape} and {est.shape}")
+        self._lib.sl_run(ctypes.byref(self._loop), int(k0), n, _pointer(x_m, np.float64, "x_m"),
+                         _pointer(a_m, np.float64, "a_m"), _pointer(v_m, np.float64, "v_m"),
+                         _pointer(out, np.float64, "out"), _pointer(est, np.float64, "est"))
         return out, est.T
 
     def reset_string(self):

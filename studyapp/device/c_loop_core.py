@@ -16,19 +16,22 @@ from studyapp.device import c_core, c_loop
 from studyapp.device.c_core import BuildError, CCore
 
 NAME = "studyapp_device_loop"
-SOURCES = ("studyapp_device.c", "studyapp_device.h", "studyapp_device_loop.c", "studyapp_device_loop.h")
+SOURCES = c_core.SOURCES + ("studyapp_device_loop.c", "studyapp_device_loop.h")
 LOOP_COUNTERS = ("control", "queued", "seen", "loop_fault")
 
 _LIB = None
 
 
+def build():
+    """The path of the device core and the loop in one library (built on first use, then cached)."""
+    return c_core.build_library(NAME, SOURCES + tuple(s for s in c_loop.sources() if s not in SOURCES))
+
+
 def library():
-    """The device core and the loop in one library (built on first use, then cached)."""
     global _LIB
     if _LIB is None:
-        sources = SOURCES + tuple(s for s in c_loop.sources() if s not in SOURCES)
         try:
-            lib = c_core._load(c_core.build_library(NAME, sources))
+            lib = c_core._load(build())
         except OSError as exc:
             raise BuildError(f"cannot load the C device loop: {exc}") from None
         ptr = ctypes.c_void_p

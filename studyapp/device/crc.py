@@ -4,7 +4,7 @@ Polynomial x^16 + x^12 + x^5 + 1 (0x1021), initial value 0xFFFF, input and
 output not reflected, no final xor; the catalogue's check value of
 b"123456789" is 0x29B1. Every single-bit error and every burst of up to 16
 bits is detected. Table-driven, one byte at a time, as a firmware does it
-(firmware/studyapp_device.c computes the same CRC bit by bit).
+(firmware/studyapp_device_link.c computes the same CRC bit by bit).
 """
 
 POLY = 0x1021

@@ -41,7 +41,13 @@ def params(rate, gain=GAIN):
 
 @njit(cache=True, inline="always")
 def step(p, s, a):
-    """One sample of the contact microphone for the handle acceleration ``a`` (m/s^2)."""
+    """One sample of the contact microphone for the handle acceleration ``a`` (m/s^2; non-finite counts as 0).
+
+    A real device's accelerometer feeds it: a NaN sample faults the loop (control.py), and must not stay
+    in the filter's state, where it would silence the audio for the rest of the run.
+    """
+    if not np.isfinite(a):
+        a = 0.0
     return section_at(p, 0, s, 0, a)
 
 

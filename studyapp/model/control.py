@@ -190,6 +190,20 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
                                 out[O_VELOCITY_LVT], est_out[e])
 
 
+@njit(cache=True, error_model="numpy")
+def run_sensors(c, x_m, a_m, v_m, out, est_out):
+    """The controller over a block of recorded sensor samples, as for a device without truth, then the others.
+
+    Sample k is ``Control.sample`` with no truth (the monitor and the microphone observe the sensors),
+    and the estimators but the source follow the block (``observe_others``): what a device that runs the
+    loop itself computes (firmware/studyapp_loop.c), and what the host's shadow of it computes.
+    """
+    nan = math.nan
+    for k in range(x_m.shape[0]):
+        sample(c, k, x_m[k], a_m[k], v_m[k], nan, nan, nan, nan, v_m[k], a_m[k], out, est_out)
+    observe_others(int(c[0][C_SOURCE]), c[4], c[5], c[6], out, est_out)
+
+
 class Control:
     """The loop's side of ``HapticDevice.exchange``: the compiled controller's arrays, and one sample from Python."""
 

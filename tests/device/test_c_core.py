@@ -106,3 +106,39 @@ def test_long_streaming_run_with_clamps_and_watchdog():
 def test_crc_matches():
     lib = c_core.library()
     assert lib.sd_crc16(b"123456789", 9, 0xFFFF) == 0x29B1
+
+
+def test_build_library_compiles_every_c_file_once_into_a_cache_keyed_by_the_sources(tmp_path, monkeypatch):
+    import ctypes
+
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "two.h").write_text("int two(void);\n")
+    (src / "one.c").write_text('#include "two.h"\nint one(void) { return two() - 1; }\n')
+    (src / "two.c").write_text('#include "two.h"\nint two(void) { return 2; }\n')
+    monkeypatch.setattr(c_core, "SOURCE_DIR", src)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    sources = ("one.c", "two.c", "two.h")
+    path = c_core.build_library("pair", sources)
+    assert path.name == "pair.so" and path.parent.parent == tmp_path / "cache" / "studyapp" / "device"
+    assert ctypes.CDLL(str(path)).one() == 1  # both units linked into the one library
+    built = path.stat().st_mtime_ns
+    assert c_core.build_library("pair", sources) == path and path.stat().st_mtime_ns == built  # found, not rebuilt
+    (src / "two.h").write_text("int two(void); /* a header's change is a new version */\n")
+    assert c_core.build_library("pair", sources).parent != path.parent
+
+
+def test_build_library_refuses_a_missing_source_and_a_compile_error_in_one_line(tmp_path, monkeypatch):
+    monkeypatch.setattr(c_core, "SOURCE_DIR", tmp_path)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    with pytest.raises(c_core.BuildError, match=r"absent\.c not found"):
+        c_core.build_library("x", ("absent.c",))
+    (tmp_path / "bad.c").write_text("int f(void) { return }\n")
+    with pytest.raises(c_core.BuildError, match=r"failed on bad\.c: ") as error:
+        c_core.build_library("x", ("bad.c",))
+    assert "\n" not in str(error.value)
+    assert not list((tmp_path / "cache").rglob("*.so"))  # no half-built library left in the cache
+
+
+def test_the_device_core_is_the_library_of_its_sources():
+    assert c_core.build() == c_core.build_library("studyapp_device", c_core.SOURCES)

@@ -225,6 +225,10 @@ def run_cli(*args):
     (["--latency", "-1"], "--latency"), (["--lockstep", "--loss", "0.1"], "--lockstep"),
     (["--disconnect-after", "0"], "--disconnect-after"), (["--core", "fpga"], "--core"),
     (["--watchdog-ms", "0"], "--watchdog-ms"),
+    (["--loop", "fpga"], "--loop"), (["--loop", "device", "--core", "python"], "--core python"),
+    (["--loop", "device", "--keepalive-ms", "0"], "--keepalive-ms"),
+    (["--loop", "device", "--keepalive-ms", "65536"], "--keepalive-ms"),
+    (["--keepalive-ms", "200"], "--keepalive-ms"), (["--loop", "device", "--watchdog-ms", "5"], "--watchdog-ms"),
 ])
 def test_bad_options_one_line_exit_2(tmp_path, args, word):
     link = tmp_path / "dev"

@@ -114,3 +114,24 @@ def test_a_fault_the_device_reports_is_latched_and_the_force_held_at_0():
     assert np.any(first["force"] != 0.0)
     assert loop.fault is not None and "amplifier over temperature" in loop.fault
     assert np.all(loop.run(500)["force"] == 0.0)
+
+
+def test_a_non_finite_accelerometer_sample_latches_the_fault_and_leaves_the_sound_finite():
+    """A real device's bad accelerometer sample faults the loop; the contact microphone (which hears the
+    accelerometer on a real device) must not keep that NaN in its state and silence the audio for good."""
+    class Glitch(PureMass):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            self.reads = 0
+
+        def read_sensors(self):
+            self.reads += 1
+            x, a, v = super().read_sensors()
+            return x, (float("nan") if self.reads == 200 else a), v
+
+    loop = ClosedLoop(LoopConfig(rate=RATE, fmax=2.0, source=LVT_SENSOR), device=Glitch(RATE, mass=1.0, v0=0.02))
+    out = loop.run(1000)
+    assert loop.fault is not None and "a sensor sample" in loop.fault
+    assert np.all(out["force"][199:] == 0.0)
+    assert np.all(np.isfinite(out["audio"]))
+    assert np.any(out["audio"][199:] != 0.0)  # the string rings on after the bow is lifted
