@@ -47,6 +47,7 @@ per CONTROL, (device samples from the newest seen when it was sent to the row
 that first named it, host seconds from sending to reading that row).
 """
 
+import math
 import time
 from collections import deque
 
@@ -119,7 +120,9 @@ class LoopLink(LinkDevice):
         self._alive_at = 0.0
         # a reopen (a re-arm after the link failed): the device's loop ran on through rows the host never read,
         # so the shadow can no longer follow it
-        self._synced = self._arrays is None
+        # the first device sample the shadow can no longer follow: none yet (inf) on a first open; on a reopen
+        # (a re-arm after the link failed) every one, the device's loop having run on through rows never read
+        self._unsynced_from = math.inf if self._arrays is None else -1
         self._image_checked = False
         super()._open()
         self.health.update({key: self.health.get(key, 0) for key in EXTRA_HEALTH})
@@ -167,7 +170,7 @@ class LoopLink(LinkDevice):
         if self._newest >= 0 and frame.sample > expected:
             h["missing"] += frame.sample - expected
             h["gaps"] += 1
-            self._synced = False
+            self._unsynced_from = min(self._unsynced_from, expected)  # rows before the gap still compare
         if frame.sample < expected:
             return
         count = len(frame.rows)
@@ -332,11 +335,15 @@ class LoopLink(LinkDevice):
                 return
             changes = np.flatnonzero(controls[start:] != cid)
             end = start + int(changes[0]) if changes.size else len(rows)
-            bad = shadow.run_rows(control.arrays, start, table[start:end], self.tolerance, self._synced, out,
+            first = table[start, shadow.R_SAMPLE]
+            synced = bool(first < self._unsynced_from)
+            if synced and table[end - 1, shadow.R_SAMPLE] >= self._unsynced_from:
+                end = start + int(self._unsynced_from - first)  # a segment never straddles a gap
+            bad = shadow.run_rows(control.arrays, start, table[start:end], self.tolerance, synced, out,
                                   est_out, self._shadow_values)
             done = end - start if bad < 0 else bad + 1
             h["samples"] += done
-            if not self._synced:
+            if not synced:
                 h["unchecked"] += done
             if bad >= 0:
                 row = [float(v) for v in table[start + bad]]
