@@ -16,6 +16,18 @@ link (studyapp.model.link), over seeds 0..N-1, median, min and max:
   force per sample applied a packet later, which is a pure latency of P - 1
   = 4 samples (0.8 ms).
 
+The device-loop rows (``--device emulator --loop device``): the same
+searches with each trial on a device that runs the loop itself
+(studyapp/device/emulated_loop.py: ``studyapp device-emulator --loop device
+--lockstep`` in its own process over a pty, 5 kHz, telemetry packets of 10
+samples; the host's shadow of the loop, its settings and keep-alive
+``--late`` samples after each full packet: 1, 5 and 20 by default), for the
+conditions but TRUE (a device has no true velocity; the reference stays the
+model's TRUE, the handle's velocity judged is the device's LVT). Each trial
+starts its own emulator, so a search costs about a minute of two cores:
+``--sources`` runs a subset (LVT must be in it). Writes
+``OUT/device_loop_table.csv`` and prints its table.
+
 Writes ``OUT/link_delay_table.csv`` (one row per link and source, each seed's
 value) and ``OUT/link_delay.png`` (breakdown F_max against latency), prints
 the Markdown tables of docs/devices.md, and shows each search's progress with
@@ -69,6 +81,64 @@ def search(seed, link, source, params):
     value = breakdown_fmax(source, rate=RATE, seed=seed, estimators=own,
                            link=LinkSpec(latency=link[0], packet=link[1], jitter=link[2]))
     return seed, link, source, value, time.process_time() - start
+
+
+def device_search(seed, late, source):
+    """One breakdown search on the emulator's device loop: (seed, late, source, F_max, host CPU seconds)."""
+    from studyapp.device.emulated_loop import factory
+    from studyapp.model.breakdown import breakdown_fmax
+
+    start = time.process_time()
+    value = breakdown_fmax(source, rate=RATE, seed=seed, make_loop=factory(late))
+    return seed, late, source, value, time.process_time() - start
+
+
+def measure_device_loop(seeds, lates, sources, jobs):
+    """{(late, source): [F_max per seed]} on the emulator's device loop (the searches in ``jobs`` processes)."""
+    results = {}
+    tasks = [(seed, late, source) for late in lates for source in sources for seed in range(seeds)]
+    t0 = time.monotonic()
+    with ProcessPoolExecutor(jobs) as pool:
+        futures = [pool.submit(device_search, *task) for task in tasks]
+        for done, future in enumerate(as_completed(futures), 1):
+            seed, late, source, value, _ = future.result()
+            results.setdefault((late, source), {})[seed] = value
+            wall = time.monotonic() - t0
+            print(f"link_delay_table: device loop {done}/{len(tasks)} searches, {wall / 60:.1f} min so far, about "
+                  f"{wall / done * (len(tasks) - done) / 60:.1f} min left", file=sys.stderr, flush=True)
+    return [{"late": late, **row((0.0, 0.0, 0.0), source, [results[(late, source)][s] for s in range(seeds)])}
+            for late in lates for source in sources]
+
+
+DEVICE_FIELDS = ("late", "source", "fmax_median", "fmax_min", "fmax_max", "fmax_per_seed")
+
+
+def write_device_csv(path, rows):
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(DEVICE_FIELDS)
+        for r in rows:
+            writer.writerow([r["late"], r["source"]] + [repr(r[k]) for k in DEVICE_FIELDS[2:5]]
+                            + [";".join(repr(v) for v in r["fmax_per_seed"])])
+
+
+def device_table(rows):
+    """The device-loop table: per lateness, every source's median (min-max), LVT over the best estimator."""
+    lates = list(dict.fromkeys(r["late"] for r in rows))
+    sources = list(dict.fromkeys(r["source"] for r in rows))
+    order = ["LVT"] + [s for s in sources if s != "LVT"]
+    lines = ["| the host's answers | " + " | ".join(order) + " | LVT / best (best) | seeds: LVT / best |",
+             "|" + " --- |" * (len(order) + 3)]
+    for late in lates:
+        by = {r["source"]: r for r in rows if r["late"] == late}
+        ratio, best = margin({s: by[s]["fmax_median"] for s in by})
+        per_seed = [lvt / max(by[s]["fmax_per_seed"][i] for s in by if s != "LVT")
+                    for i, lvt in enumerate(by["LVT"]["fmax_per_seed"])]
+        cells = [f"{number(by[s]['fmax_median'])} ({number(by[s]['fmax_min'])}-{number(by[s]['fmax_max'])})"
+                 for s in order]
+        lines.append(f"| {late} sample{'s' * (late > 1)} late | " + " | ".join(cells) + f" | {ratio:.2f} ({best}) | "
+                     + ", ".join(f"{v:.2f}" for v in per_seed) + " |")
+    return "\n".join(lines) + "\n"
 
 
 def seed_batch(seed, link_list, sources, params):
@@ -213,8 +283,19 @@ def main(argv=None):
     parser.add_argument("--rows", default="latency,packet", help="latency, packet or both (default both)")
     parser.add_argument("--out", default=str(ROOT / "docs"), help="folder for the CSV and the PNG (default docs)")
     parser.add_argument("--plot-only", action="store_true", help="redraw the plot and tables from the CSV")
+    parser.add_argument("--device", default="model", metavar="model|emulator",
+                        help="model: the simulated device behind the model's link (default); emulator: the device "
+                             "emulator in its own process (with --loop device)")
+    parser.add_argument("--loop", default="host", metavar="host|device",
+                        help="with --device emulator: device, the loop on the device (protocol 2)")
+    parser.add_argument("--late", default="1,5,20", metavar="SAMPLES,...",
+                        help="with --loop device: how late the host's answers are, in samples (default 1,5,20)")
+    parser.add_argument("--sources", default=None, metavar="NAME,...",
+                        help="with --loop device: the sources to search (default the adjustment conditions)")
     args = parser.parse_args(argv)
     out = Path(args.out)
+    if args.device != "model":
+        return device_main(args, out)
     csv_path, png_path = out / "link_delay_table.csv", out / "link_delay.png"
     if args.plot_only:
         rows = read_csv(csv_path)
@@ -227,6 +308,28 @@ def main(argv=None):
           f"--seeds {args.seeds} --rows {args.rows}`.\n")
     sys.stdout.write(tables(rows))
     print(f"wrote {csv_path} and {png_path}", file=sys.stderr)
+    return 0
+
+
+def device_main(args, out):
+    if (args.device, args.loop) != ("emulator", "device"):
+        print(f"link_delay_table: --device {args.device} --loop {args.loop}: allowed is --device emulator --loop "
+              "device (the host loop's figures are the model's rows)", file=sys.stderr)
+        return 2
+    sources = args.sources.split(",") if args.sources else [s for s in conditions()[0] if s != "TRUE"]
+    if "LVT" not in sources or len(sources) < 2:
+        print(f"link_delay_table: --sources {args.sources}: allowed is LVT and at least one estimator",
+              file=sys.stderr)
+        return 2
+    lates = [int(v) for v in args.late.split(",")]
+    rows = measure_device_loop(args.seeds, lates, sources, args.jobs)
+    path = out / "device_loop_table.csv"
+    write_device_csv(path, rows)
+    words = f" --sources {args.sources}" if args.sources else ""
+    print(f"Generated on {datetime.date.today().isoformat()} by `PYTHONPATH=. python scripts/link_delay_table.py "
+          f"--device emulator --loop device --seeds {args.seeds} --late {args.late}{words} --jobs {args.jobs}`.\n")
+    sys.stdout.write(device_table(rows))
+    print(f"wrote {path}", file=sys.stderr)
     return 0
 
 

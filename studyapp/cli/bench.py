@@ -65,14 +65,20 @@ def register(sub):
     p.add_argument("--seconds", type=float, default=60.0, help="run length (default 60)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.engine.heartbeat_benchmark"))
-    p = kinds.add_parser("device", help="the loop over a pty to the device emulator: frames on time, host turnaround")
+    p = kinds.add_parser("device", help="the loop over a pty to the device emulator: frames on time, host turnaround; "
+                                                 "--loop device: watchdog trips, force gaps, telemetry, CONTROL delivery")
     p.add_argument("--seconds", type=float, default=60.0, help="timed run length (default 60)")
     p.add_argument("--runs", type=int, default=1, help="runs; the figures are their medians (default 1)")
     p.add_argument("--rate", type=float, default=5000.0, help="the device's rate in Hz (default 5000)")
     p.add_argument("--latency", type=int, default=5, metavar="SAMPLES",
                    help="samples the host answers ahead (default 5: 1 ms at 5 kHz)")
-    p.add_argument("--packet", type=int, default=1, metavar="SAMPLES", help="samples per sensor frame (default 1)")
+    p.add_argument("--packet", type=int, default=None, metavar="SAMPLES",
+                   help="samples per sensor (host loop) or telemetry (device loop) frame (default 1; 10 for a "
+                        "device loop)")
     p.add_argument("--watchdog-ms", type=int, default=1, help="the emulator's watchdog in ms (default 1)")
+    p.add_argument("--loop", default="host", metavar="host|device",
+                   help="who runs the loop: the host, answering each sensor frame (protocol 1, the default), or "
+                        "the device (protocol 2: telemetry, the host's shadow, CONTROL on a knob turn)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run("studyapp.device.benchmark"))
 

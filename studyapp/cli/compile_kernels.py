@@ -40,8 +40,8 @@ def register(sub):
 def closed_loop():
     """The loop the engine and ``simulate`` run, with the paper's sensor and with an estimator in it, the
     same loop on a real device's per-sample interface (model/device.py ``exchange``) and on recorded sensor
-    samples (control.run_sensors, the C loop's reference). One part: they share most of their compiled
-    callees, which two processes would each compile."""
+    samples (control.run_sensors, the C loop's reference), and the shadow of a device that runs the loop.
+    One part: they share most of their compiled callees, which two processes would each compile."""
     import numpy as np
 
     from studyapp.model import control
@@ -66,6 +66,19 @@ def closed_loop():
     loop.run(100)
     x = np.zeros(16)
     control.run_sensors(loop.control.arrays, x, x, x, np.zeros((len(control.OUTPUTS), 16)), np.zeros((0, 16)))
+    shadow_of_a_device_loop(loop)
+
+
+def shadow_of_a_device_loop(loop):
+    """The host's shadow of a device that runs the loop (device/shadow.py), on a few rows at rest."""
+    import numpy as np
+
+    from studyapp.device import shadow
+    from studyapp.model.control import OUTPUTS
+
+    rows = np.zeros((4, shadow.ROW_WIDTH))
+    shadow.run_rows(loop.control.arrays, 0, rows, 0.0, True, np.zeros((len(OUTPUTS), 4)),
+                    np.zeros((len(loop.names), 4)), np.zeros(2))
 
 
 def estimator_bank():

@@ -11,7 +11,8 @@ panel's choice).
 adjustment task on a device on a link, the model's prediction at the link's
 latency (live/rig_check.py, seconds of CPU per condition) and, when LVT falls
 below 1.5x the best estimator, the warning line (the console asks the same at
-Start). The simulated device is the paper's own loop: nothing to check.
+Start). The simulated device is the paper's own loop: nothing to check; so
+is a device that runs the loop itself (its INFO says so: the line says that).
 """
 
 from studyapp.errors import ParameterError
@@ -27,26 +28,35 @@ def add_device_option(parser):
 
 def check_device(device, rate):
     """None for the simulated device, else the link (probed: ``ParameterError``, one line, if it is no device)."""
+    return probe_device(device, rate)[0]
+
+
+def probe_device(device, rate):
+    """(link, who runs the loop: "host" or "device") of ``--device``; (None, None) for the simulated device."""
     if device is None or device == SIMULATED:
-        return None
+        return None, None
     from studyapp.device.link_open import is_link
     from studyapp.device.link_probe import probe
 
     if not is_link(device):
         raise ParameterError(f"--device {device}: allowed is simulated, a serial port, a pty or a pyserial URL")
-    probe(device, rate)
-    return device
+    return device, probe(device, rate)["loop"]
 
 
-def rig_check_line(protocol, device, say):
+def rig_check_line(protocol, device, say, loop=None):
     """Predict the protocol's adjustment conditions on the rig (``say`` the progress); returns (request, prediction,
-    warning line or None), or None when there is nothing to check."""
+    warning line or None), or None when there is nothing to check. ``loop``: "device" for a device that runs the
+    loop itself (``probe_device``)."""
     from studyapp.engine.config import EngineConfig
     from studyapp.live import rig_check
 
-    rig = rig_check.rig_of(EngineConfig(rate=protocol.rate, device=device))
+    rig = rig_check.rig_of(EngineConfig(rate=protocol.rate, device=device), loop)
     req = rig_check.request(protocol, rig)
-    if req is None or not rig_check.needs_check(rig):
+    if req is None:
+        return None
+    if not rig_check.needs_check(rig):
+        if rig.kind == rig_check.DEVICE_LOOP:
+            say(f"rig check: {rig.words}; LVT's margin is the model's own, nothing to predict")
         return None
     say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_ms:.2f} ms "
         "link latency (the model, 5 seeds)…")

@@ -15,6 +15,21 @@ ahead. Reported per run, and as the median over ``--runs`` runs:
     watchdog       device faults (the emulator's watchdog firing because the host fell
                    behind by more than the latency + watchdog); the run re-arms and goes on
 
+With ``--loop device`` the emulator runs the loop itself (protocol version 2,
+its C loop on its own clock) and this process is the host of a device loop
+(loop_link.py: telemetry in packets of ``--packet`` samples, 10 by default,
+the shadow compared row by row, ALIVE, and a knob turn every ``KNOB_EVERY``
+s: F_max between two values, as CONTROL). Reported (device_loop.py):
+
+    watchdog       the device's keep-alive watchdog firing (the host away longer than keepalive_ms)
+    force_gaps     samples the device was armed, past its ramp, with a loop force, and applied none
+    telemetry      device samples the host never received (missing) and in how many gaps, and the
+                   longest the host went between two blocks (ms)
+    control        CONTROL delivery: device samples from the newest sample the host had seen when it
+                   sent the CONTROL to the sample it took effect at (ms), and the host's time from
+                   sending it to reading the row that names it (ms); p50 / p99 / max
+    shadow_faults  rows where the device's force differed from the host's shadow (0 on one machine)
+
 Speed is measured here, never asserted in tests (the machine is shared).
 """
 
@@ -32,6 +47,7 @@ from studyapp.errors import ParameterError
 
 WARMUP = 0.5  # s of loop before the timed run (compiled code loads, the pty settles)
 BLOCK = 10  # samples per loop.run, the engine's 2 ms at 5 kHz
+LOOPS = ("host", "device")
 
 
 def one_run(rate, seconds, latency, packet, watchdog_ms, seed):
@@ -101,14 +117,20 @@ def run_cli(args):
         raise ParameterError(f"--seconds {args.seconds}: allowed is a positive number")
     if not args.runs >= 1:
         raise ParameterError(f"--runs {args.runs}: allowed is 1 or more")
-    result = measure(args.rate, args.seconds, args.runs, args.latency, args.packet, args.watchdog_ms)
+    if args.loop not in LOOPS:
+        raise ParameterError(f"--loop {args.loop}: allowed is {' or '.join(LOOPS)}")
+    if args.loop == "device":
+        from studyapp.device import device_loop_benchmark
+
+        return device_loop_benchmark.run_cli(args)
+    result = measure(args.rate, args.seconds, args.runs, args.latency, args.packet or 1, args.watchdog_ms)
     if args.json:
         print(json.dumps(result))
     else:
         m = result["median"]
         t = m["turnaround_us"]
         print(f"device over a pty at {args.rate:g} Hz, 14 estimators, latency {args.latency} samples, "
-              f"packet {args.packet}, watchdog {args.watchdog_ms} ms, {args.seconds:g} s x {args.runs}: "
+              f"packet {args.packet or 1}, watchdog {args.watchdog_ms} ms, {args.seconds:g} s x {args.runs}: "
               f"on time {100 * m['on_time']:.2f} %, host turnaround p50 {t['p50']:.0f} us, p99 {t['p99']:.0f} us, "
               f"p99.9 {t['p99.9']:.0f} us, watchdog trips {m['watchdog']:g} (medians over runs)")
     sys.stdout.flush()

@@ -1,7 +1,9 @@
 """Opening a conversation with a device: HELLO -> INFO checked, the calibration, the round-trip probe.
 
-The host refuses (``ParameterError``, one line naming what differs) a device
-that speaks another protocol version, runs at a rate other than the loop's,
+The host speaks versions 1 and 2 (docs/device-protocol.md): it refuses
+(``ParameterError``, one line naming what differs) a device that speaks
+another protocol version, a version 2 device whose loop section does not
+parse or whose loop this host cannot run beside it (``check_loop``), runs at a rate other than the loop's,
 declares force limits above the motor's (model/limits.py: 200 N impulsive,
 60 N sustained), has no position channel, or sends fewer samples per frame
 than asked. A device that does not answer HELLO within ``HELLO_TIMEOUT`` in
@@ -24,7 +26,9 @@ import statistics
 import time
 
 from studyapp.device import calibration_file
+from studyapp.device import loop_messages as lm
 from studyapp.device import messages as msg
+from studyapp.device.errors import ProtocolError
 from studyapp.errors import ParameterError
 
 HELLO_TIMEOUT = 0.4  # s per HELLO
@@ -33,6 +37,7 @@ PINGS = 20
 PING_TIMEOUT = 0.2  # s
 CHANNEL_NAMES = calibration_file.CHANNELS  # INFO's channel kinds 0, 1, 2
 MAX_LATENCY = 0xFFFF
+VERSIONS = (msg.PROTOCOL_VERSION, lm.LOOP_VERSION)  # 1: the loop on the host; 2: either side runs it
 
 
 def check_latency(latency):
@@ -107,8 +112,9 @@ def _refuse(link, what):
 
 def check_info(info, link, rate, motor_limits, packet):
     """Refuse a device that does not fit this host and loop (one line naming what differs)."""
-    if info.protocol_version != msg.PROTOCOL_VERSION:
-        _refuse(link, f"protocol version {info.protocol_version}, this host speaks {msg.PROTOCOL_VERSION}")
+    if info.protocol_version not in VERSIONS:
+        _refuse(link, f"protocol version {info.protocol_version}, this host speaks "
+                      f"{' and '.join(str(v) for v in VERSIONS)}")
     if float(info.rate_hz) != float(rate):
         _refuse(link, f"rate {info.rate_hz:g} Hz, the loop runs at {rate:g} Hz")
     if not info.impulsive_n <= motor_limits.impulsive:
@@ -122,6 +128,25 @@ def check_info(info, link, rate, motor_limits, packet):
         _refuse(link, f"channel kinds {kinds}; allowed is each of 0 (position), 1, 2 at most once")
     if packet > info.max_packet:
         _refuse(link, f"at most {info.max_packet} samples per frame, {packet} asked")
+    check_loop(info, link, packet)
+
+
+def loop_of(info, link):
+    """INFO's loop section (``loop_messages.LoopInfo``; a version 1 INFO: the host runs the loop), or a refusal."""
+    try:
+        return lm.loop_info(info)
+    except ProtocolError as exc:
+        _refuse(link, f"its INFO's loop section does not parse ({exc})")
+
+
+def check_loop(info, link, packet):
+    """Refuse a device loop this host cannot run beside: TELEMETRY frames of ``packet`` rows must fit a frame."""
+    loop = loop_of(info, link)
+    if loop.loop == lm.DEVICE_LOOP:
+        largest = lm.max_telemetry_packet(info.channels)
+        if packet > largest:
+            _refuse(link, f"runs the loop itself, and a TELEMETRY frame of its channels holds at most {largest} "
+                          f"samples, {packet} asked")
 
 
 def scales(info, serial, calibration_path):
@@ -134,7 +159,7 @@ def scales(info, serial, calibration_path):
 def greet(send, receive, link, rate, motor_limits, packet, calibration_path):
     """HELLO until INFO comes (bounded); the checked INFO and its ``Scales``."""
     for _ in range(HELLO_TRIES):
-        send(msg.Hello(protocol_version=msg.PROTOCOL_VERSION))
+        send(msg.Hello(protocol_version=msg.PROTOCOL_VERSION))  # HELLO(1), as the protocol has it for both
         end = time.monotonic() + HELLO_TIMEOUT
         while (left := end - time.monotonic()) > 0:
             reply = receive(left)

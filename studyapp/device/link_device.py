@@ -41,6 +41,7 @@ import time
 import numpy as np
 
 from studyapp.device import handshake
+from studyapp.device import loop_messages as lm
 from studyapp.device import messages as msg
 from studyapp.device.errors import ProtocolError
 from studyapp.device.frames import FrameReader, encode
@@ -69,6 +70,7 @@ class LinkDevice(HapticDevice):
     """
 
     clock = True  # the device's frames pace the worker (engine/pacing.py)
+    STREAM = msg.Sensors  # the streamed frame ``_sensors`` takes
 
     def __init__(self, spec, rate, *, latency=DEFAULT_LATENCY, packet=DEFAULT_PACKET, calibration=None,
                  ramp_ms=DEFAULT_RAMP_MS, limits=DeviceLimits(), pings=handshake.PINGS, timing=False,
@@ -115,11 +117,12 @@ class LinkDevice(HapticDevice):
             self.device_info, self.scales = handshake.greet(self._send, self._receive_one, self.spec, self.rate,
                                                             self.motor_limits, self.packet, self.calibration_path)
             self._channels = self.device_info.channels
+            self._check_loop(handshake.loop_of(self.device_info, self.spec))
             self.round_trip = handshake.probe(self._send, self._receive_one, self.spec, self.pings)
             self._pending.clear()
             self._newest = -1
             self.health = health
-            self._send(msg.Start(packet=self.packet, latency=self.latency))
+            self._start()
             self._streaming = True
         except (OSError, EOFError) as exc:
             self.link.close()
@@ -133,6 +136,18 @@ class LinkDevice(HapticDevice):
                                    impulsive=min(self.device_info.impulsive_n, self.motor_limits.impulsive),
                                    sustained=min(self.device_info.sustained_n, self.motor_limits.sustained),
                                    sustained_window=self.motor_limits.sustained_window)
+
+    def _check_loop(self, loop):
+        """Refuse a version 2 device that runs the loop itself: FORCE frames would be corrupt to it."""
+        if loop.loop == lm.DEVICE_LOOP:
+            raise ParameterError(f"device at {self.spec}: it runs the loop itself (protocol 2), so the host's loop "
+                                 "cannot drive it (studyapp/device/loop_link.py does); refused")
+
+    def _start(self):
+        self._send(msg.Start(packet=self.packet, latency=self.latency))
+
+    def _parse(self, payload):
+        return msg.parse(payload, self._channels)
 
     @property
     def info(self):
@@ -175,7 +190,7 @@ class LinkDevice(HapticDevice):
         corrupt = self._reader.corrupt
         for payload in self._reader.feed(data):
             try:
-                seq, message = msg.parse(payload, self._channels)
+                seq, message = self._parse(payload)
             except ProtocolError:
                 self._reader.corrupt += 1
                 continue
@@ -183,7 +198,7 @@ class LinkDevice(HapticDevice):
                 gap = (seq - self._seq_in - 1) & 0xFF
                 self.health["lost"] += gap
             self._seq_in = seq
-            if isinstance(message, msg.Sensors):
+            if isinstance(message, self.STREAM):
                 self._sensors(message)
             elif isinstance(message, msg.Fault):
                 self.health["faults"] += 1

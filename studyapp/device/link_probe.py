@@ -5,14 +5,17 @@ character device or a URL that answers), shakes hands (handshake.py: HELLO ->
 INFO checked, bounded timeouts, two PINGs) and closes it again, importing
 neither numba nor the loop, so that ``studyapp live --device`` refuses a bad
 link with one line and exit code 2 well within 5 s even on a loaded machine.
-Returns the INFO's summary (name, serial, round trip); the worker opens the
-link again for the run (a device answers every HELLO with INFO).
+Returns the INFO's summary (name, serial, round trip, protocol, and who runs
+the loop: "host" or "device", protocol 2); the worker opens the link again
+for the run (a device answers every HELLO with INFO), with the driver that
+fits it (device_open.py).
 """
 
 import time
 from collections import namedtuple
 
 from studyapp.device import handshake
+from studyapp.device import loop_messages as lm
 from studyapp.device import messages as msg
 from studyapp.device.errors import ProtocolError
 from studyapp.device.frames import FrameReader, encode
@@ -42,10 +45,10 @@ def probe(spec, rate, packet=1, calibration=None, latency=1, ramp_ms=0):
         while True:
             for payload in reader.feed(link.read()):
                 try:
-                    _, message = msg.parse(payload, channels[0])
+                    _, message = lm.parse(payload, channels[0])
                 except ProtocolError:
                     continue
-                if not isinstance(message, msg.Sensors):
+                if not isinstance(message, (msg.Sensors, lm.Telemetry)):
                     return message
             left = end - time.monotonic()
             if left <= 0 or not link.wait(left):
@@ -62,4 +65,7 @@ def probe(spec, rate, packet=1, calibration=None, latency=1, ramp_ms=0):
         raise ParameterError(f"device at {spec}: the link failed during the handshake ({exc})") from None
     finally:
         link.close()
-    return {"name": info.name, "serial": info.serial, "calibration": scales.source, "round_trip_ms": round_trip}
+    loop = handshake.loop_of(info, spec)
+    return {"name": info.name, "serial": info.serial, "calibration": scales.source, "round_trip_ms": round_trip,
+            "protocol": info.protocol_version, "loop": "device" if loop.loop == lm.DEVICE_LOOP else "host",
+            "estimator_kinds": list(loop.kinds)}

@@ -90,6 +90,16 @@ class Engine(Watchdog):
         c.rate = validate_rate(c.rate)
         check_playable(c.rate, calibration.F0 if c.f0 is None else c.f0)
         estimators = c.estimators if isinstance(c.estimators, dict) else {n: {} for n in c.estimators}
+        if is_link(c.device):
+            found = probe_link(c.device, c.rate, c.device_packet, c.device_calibration, c.device_latency,
+                               c.device_ramp_ms)
+            if found["loop"] == "device":
+                # the device's loop runs its own estimators: the engine's loop (its shadow) runs the same, in
+                # INFO's order, with the protocol's parameters where it names them (a difference is refused
+                # at the first block: loop_link.py checks the parameter image)
+                from studyapp.device.loop_bank import names_of
+
+                estimators = {n: estimators.get(n, {}) for n in names_of(found["estimator_kinds"])}
         names = Bank(c.rate, estimators).names
         c.estimators = dict(zip(names, estimators.values()))
         allowed = with_pseudo_sources(names)
@@ -103,8 +113,6 @@ class Engine(Watchdog):
             raise ParameterError(f"gesture {c.gesture!r}: allowed are {', '.join(live)}")
         parse_audio(c.audio)
         c.check_sizes()
-        if is_link(c.device):
-            probe_link(c.device, c.rate, c.device_packet, c.device_calibration, c.device_latency, c.device_ramp_ms)
         return names
 
     def start(self, timeout=START_TIMEOUT):

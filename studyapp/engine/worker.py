@@ -71,15 +71,16 @@ REALTIME_PRIORITY = 5  # below JACK's own threads (10 and 9 by default)
 
 
 def make_device(config):
-    """The configured device: a link (path or URL, studyapp/device/link_device.py), a driver from
+    """The configured device: a link (path or URL: studyapp/device/link_device.py, or loop_link.py for a device
+    that runs the loop, as its INFO says: device_open.py), a driver from
     ``"module:factory"`` (called with the rate), or ``None`` (the simulated device)."""
     spec = config.device
     if not spec:
         return None
     if is_link(spec):
-        from studyapp.device.link_device import LinkDevice
+        from studyapp.device.device_open import open_link_device
 
-        return LinkDevice(spec, config.rate, **config.link_options())
+        return open_link_device(spec, config.rate, config.link_options())
     module, _, factory = spec.partition(":")
     return getattr(importlib.import_module(module), factory)(config.rate)
 

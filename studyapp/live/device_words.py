@@ -5,7 +5,8 @@ engine as ``DeviceInfo``): the handshake (name, serial number, protocol and
 firmware versions, rate, channels with their SI units), the calibration's
 source (the handshake's own gains, or a TOML file), the round trip measured
 at open (PING probe: median and 99th percentile) and the link's latency (the
-samples the host answers ahead, and the same in ms). From a ``DeviceHealth``:
+samples the host answers ahead, and the same in ms), or "loop on the device" for a
+device that runs the loop itself (protocol 2: latency 0, the paper's loop). From a ``DeviceHealth``:
 a trial's frame counts, the problems first.
 """
 
@@ -25,18 +26,28 @@ def calibration(info):
     return "handshake (the device's own gains)" if source == "device" else f"TOML file {source}"
 
 
+def runs_loop(info):
+    """True for a device that runs the loop itself (protocol 2, loop_link.LoopLink.info)."""
+    return info.get("loop") == "device"
+
+
 def latency(info):
     trip = info.get("round_trip_ms") or {}
     measured = (f"round trip {trip['median']:.2f} ms median, {trip['p99']:.2f} ms p99"
                 if "median" in trip and "p99" in trip else "round trip not measured")
-    return (f"link latency {info['latency_samples']} samples = {info['latency_ms']:.2f} ms "
+    if runs_loop(info):
+        return (f"loop on the device: force from the same sample's sensors (latency 0, the paper's loop); "
+                f"telemetry in packets of {info.get('packet', 1)}, settings {1e3 * info['lead_samples'] / info['rate']:.1f}"
+                f" ms ahead, keep-alive {info['keepalive_ms']} ms; {measured}")
+    return (f"loop on the host: link latency {info['latency_samples']} samples = {info['latency_ms']:.2f} ms "
             f"(packets of {info.get('packet', 1)}); {measured}")
 
 
 def late_risk(info):
-    """A warning when the measured round trip's p99 exceeds the link latency (forces would come too late)."""
+    """A warning when the measured round trip's p99 exceeds the link latency (forces would come too late);
+    never for a device loop, whose forces do not cross the link."""
     trip = info.get("round_trip_ms") or {}
-    if "p99" in trip and trip["p99"] > info["latency_ms"]:
+    if not runs_loop(info) and "p99" in trip and trip["p99"] > info["latency_ms"]:
         return (f"the measured round trip (p99 {trip['p99']:.2f} ms) exceeds the link latency "
                 f"({info['latency_ms']:.2f} ms): some forces will arrive late (counted, never applied)")
     return None

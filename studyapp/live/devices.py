@@ -51,4 +51,5 @@ class Devices:
 
     def rig(self):
         live = self.live
-        return None if live.protocol is None else rig_of(live.apparatus.config(live.protocol, 0, {}))
+        loop = (self.info or {}).get("loop")  # the handshake says whether the device runs the loop itself
+        return None if live.protocol is None else rig_of(live.apparatus.config(live.protocol, 0, {}), loop)

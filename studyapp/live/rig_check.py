@@ -1,8 +1,11 @@
 """Can this rig show the paper's effect? The predicted bowing breakdown of a protocol's adjustment conditions
 at the rig's link latency, and the verdict the console and ``studyapp run`` give before a session. No Qt.
 
-The rig (``Rig``): the simulated device is the paper's loop (latency 0); a
-device on a link answers each sensor sample k with a force tagged k + L
+The rig (``Rig``): the simulated device is the paper's loop (latency 0), and
+so is a device that runs the loop itself (protocol 2, device/loop_link.py: the
+force for sample k from the sensors of sample k, on the device; the link
+carries only its settings and telemetry); a device whose loop runs on the host
+answers each sensor sample k with a force tagged k + L
 (L = ``EngineConfig.device_latency`` samples, link_device.py), which the device
 applies at its sample k + L: a pure delay of L samples, the model's link with
 ``latency = L / rate`` and no packets (model/link.py's special case P = 1,
@@ -33,6 +36,7 @@ from studyapp.model.link_prediction import MARGIN
 from studyapp.model.sources import LVT_SENSOR, TRUE
 
 ADJUSTMENT = "adjustment"
+SIMULATED, DEVICE_LOOP = "simulated", "device-loop"
 
 
 @dataclass(frozen=True)
@@ -49,14 +53,26 @@ class Rig:
         return self.latency_samples / self.rate
 
     @property
+    def words(self):
+        """Where the loop runs, for the console and ``studyapp run``."""
+        if self.kind == DEVICE_LOOP:
+            return "the loop runs on the device: the paper's own loop (latency 0)"
+        if self.kind == SIMULATED:
+            return "the simulated device: the paper's own loop (latency 0)"
+        return f"the loop runs on the host, {self.latency_ms:.2f} ms across the link"
+
+    @property
     def latency_ms(self):
         return 1e3 * self.latency
 
 
-def rig_of(config):
-    """The ``Rig`` of an ``EngineConfig``: simulated (latency 0) or a device on a link (its answer-ahead latency)."""
+def rig_of(config, loop=None):
+    """The ``Rig`` of an ``EngineConfig``: simulated (latency 0), a device on a link that runs the loop itself
+    (``loop`` "device", from its INFO: latency 0) or one the host's loop drives (its answer-ahead latency)."""
     if not config.device:
-        return Rig("simulated", float(config.rate))
+        return Rig(SIMULATED, float(config.rate))
+    if loop == "device":
+        return Rig(DEVICE_LOOP, float(config.rate))
     return Rig("link", float(config.rate), int(config.device_latency))
 
 

@@ -121,15 +121,24 @@ def check_duration(seconds, label="duration"):
 
 
 def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, seed=0, estimators=None, f0=None,
-              link=None, windows="seconds"):
+              link=None, windows="seconds", make_loop=None):
     """Whether ``source`` at ``fmax`` N breaks down within ``duration`` s of ``gesture`` (the module's criteria),
-    the device behind ``link`` (a link.LinkSpec; None: ideal)."""
+    the device behind ``link`` (a link.LinkSpec; None: ideal); or, with ``make_loop(source, fmax, rate, gesture,
+    seed)`` (a context manager giving a ``ClosedLoop``), on that loop's device (device/emulated_loop.py: a device
+    that runs the loop itself, its own estimators with Table 1's parameters, at F0)."""
+    if make_loop is not None:
+        with make_loop(source, fmax, rate, gesture, seed) as loop:
+            return _broken(loop, gesture, duration, fmax, seed)
     estimators = dict(estimators or {})
     if not is_pseudo(source) and source not in estimators:
         estimators[source] = table1(source, rate, windows)
     f0 = F0 if f0 is None else f0
     loop = ClosedLoop(LoopConfig(rate=rate, estimators=estimators, source=source, fmax=fmax, gesture=gesture,
                                  f0=f0, seed=seed, audio=False, link=link), judge=False)
+    return _broken(loop, gesture, duration, fmax, seed)
+
+
+def _broken(loop, gesture, duration, fmax, seed):
     if gesture == "hold":
         return _broken_holding(loop, duration)
     total = int(round(duration * loop.rate))
@@ -137,7 +146,8 @@ def is_broken(source, fmax, rate=5000.0, gesture="strokes", duration=DURATION, s
     if loop.fault is not None:
         return True
     level, hiss, pitch = _bowing_measures(block, loop.rate)
-    ref_level, ref_hiss, _ = _true_bowing(float(loop.rate), float(f0), gesture, float(fmax), total, int(seed))
+    ref_level, ref_hiss, _ = _true_bowing(float(loop.rate), float(loop.string.f0), gesture, float(fmax), total,
+                                          int(seed))
     return (level > stability.RISE * ref_level or stability.over(hiss, ref_hiss, stability.RISE)
             or not abs(pitch / loop.string.f0 - 1.0) <= stability.PITCH_TOLERANCE)
 
@@ -156,8 +166,13 @@ def _broken_holding(loop, duration):
 
 
 def _bowing_measures(block, rate):
-    """(band level m/s, upper band level m/s or None, pitch Hz) of a bowing trial over [SETTLE, end]."""
-    return bowing_reference.measures(block["velocity_true"], block["string_velocity"], rate, int(round(SETTLE * rate)))
+    """(band level m/s, upper band level m/s or None, pitch Hz) of a bowing trial over [SETTLE, end].
+
+    The handle's velocity is the true one; on a device, whose true motion the host cannot know, its LVT's."""
+    velocity = block["velocity_true"]
+    if not np.isfinite(velocity).any():
+        velocity = block["velocity_lvt"]
+    return bowing_reference.measures(velocity, block["string_velocity"], rate, int(round(SETTLE * rate)))
 
 
 @functools.lru_cache(maxsize=4096)
@@ -168,18 +183,18 @@ def _true_bowing(rate, f0, gesture, fmax, total, seed):
 
 
 def breakdown_fmax(source, rate=5000.0, gesture="strokes", duration=DURATION, low=LOW, high=HIGH, tolerance=0.02,
-                   seed=0, estimators=None, f0=None, progress=None, link=None, windows="seconds"):
+                   seed=0, estimators=None, f0=None, progress=None, link=None, windows="seconds", make_loop=None):
     """The largest F_max (N) at which ``source`` stays stable, by bisection on a log scale.
 
     Stable means: ``is_broken`` is False (bowing ``strokes`` by default;
     ``gesture="hold"``: the hand holding the handle, with tremor). Returns ``low`` if even ``low`` breaks down and ``inf`` if
     ``high`` does not; otherwise the geometric midpoint of the final bracket,
     whose width is at most ``tolerance`` (relative). ``progress(fmax, broken)``
-    is called after each trial. ``link``: the device's link (None: ideal).
-    ``windows``: how Table 1 is made for the rate when ``estimators`` does not give the source (module doc).
+    is called after each trial. ``link``: the device's link (None: ideal); ``make_loop``: each trial's loop
+    on a device of its own (``is_broken``). ``windows``: how Table 1 is made for the rate when ``estimators`` does not give the source (module doc).
     """
     kwargs = dict(rate=rate, gesture=gesture, duration=duration, seed=seed, estimators=estimators, f0=f0, link=link,
-                  windows=windows)
+                  windows=windows, make_loop=make_loop)
 
     def trial(fmax):
         broken = is_broken(source, fmax, **kwargs)

@@ -257,7 +257,18 @@ class ClosedLoop:
         self._gesture.set(x_m)
 
     def reset_string(self):
-        """Put the string (and the body filter) at rest; the stability monitor starts afresh with it."""
+        """Put the string (and the body filter) at rest; the stability monitor starts afresh with it.
+
+        A device that runs the loop itself (device/loop_link.py) resets its string at a sample of its own:
+        the host's shadow of the loop is put at rest at that same sample, so the reset is handed to it.
+        """
+        defer = getattr(self.device, "defer_reset", None)
+        if defer is not None:
+            defer(self._rest)
+        else:
+            self._rest()
+
+    def _rest(self):
         self._ss[:] = 0.0
         self._bridge[:] = 0.0
         self._nut[:] = 0.0
@@ -285,8 +296,9 @@ class ClosedLoop:
         out = np.zeros((len(OUTPUTS), n))
         est = np.zeros((len(self.names), n))
         self.device.exchange(self.control, n, out, est)
-        src = int(self._ctl[C_SOURCE])
-        control.observe_others(src, self.bank.kinds, self.bank.states, self.bank.params, out, est)
+        if not getattr(self.device, "steps_every_estimator", False):  # a device loop's shadow steps them per row
+            src = int(self._ctl[C_SOURCE])
+            control.observe_others(src, self.bank.kinds, self.bank.states, self.bank.params, out, est)
         if self._state[L_FAULT] == 0.0 and self.device.fault:
             self._state[L_FAULT] = FAULT_DEVICE
             self._state[L_FAULT_SAMPLE] = max(n - 1, 0)

@@ -56,7 +56,7 @@ def test_handshake_info_and_start(fake):
 
 
 @pytest.mark.parametrize("change, words", [
-    ({"protocol_version": 2}, "protocol version 2, this host speaks 1"),
+    ({"protocol_version": 3}, "protocol version 3, this host speaks 1 and 2"),
     ({"rate_hz": 1000}, "rate 1000 Hz, the loop runs at 5000 Hz"),
     ({"impulsive_n": 250.0}, "impulsive limit 250 N, above the motor's 200 N"),
     ({"sustained_n": 61.0}, "sustained limit 61 N, above the motor's 60 N"),

@@ -9,7 +9,7 @@ def test_the_handshake_calibration_and_latency_in_words():
                                             "channels position (m), acceleration (m/s²), velocity (m/s)")
     assert device_words.calibration(INFO) == "handshake (the device's own gains)"
     assert device_words.calibration({**INFO, "calibration": "lab.toml [EMU-0042]"}) == "TOML file lab.toml [EMU-0042]"
-    assert device_words.latency(INFO) == ("link latency 5 samples = 1.00 ms (packets of 1); "
+    assert device_words.latency(INFO) == ("loop on the host: link latency 5 samples = 1.00 ms (packets of 1); "
                                           "round trip 0.05 ms median, 0.40 ms p99")
     assert device_words.late_risk(INFO) is None
     assert "exceeds the link latency" in device_words.late_risk({**INFO, "round_trip_ms": {"median": 1, "p99": 4.0}})
@@ -21,3 +21,12 @@ def test_a_trials_health():
               "clamped": 0}
     assert device_words.health(4, counts) == ("trial 4: 5000 frames, 5000 samples; 1 corrupt, 0 lost, 2 missing, "
                                               "3 late, 0 faults, 0 clamped")
+
+
+def test_a_device_loop_says_loop_on_the_device_and_never_warns_of_late_forces():
+    info = {**INFO, "protocol": 2, "loop": "device", "latency_samples": 0, "latency_ms": 0.0, "packet": 10,
+            "lead_samples": 20, "keepalive_ms": 150, "round_trip_ms": {"median": 1.0, "p99": 9.0}}
+    assert device_words.latency(info) == ("loop on the device: force from the same sample's sensors (latency 0, "
+                                          "the paper's loop); telemetry in packets of 10, settings 4.0 ms ahead, "
+                                          "keep-alive 150 ms; round trip 1.00 ms median, 9.00 ms p99")
+    assert device_words.late_risk(info) is None

@@ -37,6 +37,16 @@ def test_the_rig_of_an_engine_config():
     link = rig_check.rig_of(EngineConfig(rate=5000.0, device="/tmp/dev", device_latency=5))
     assert link.kind == "link" and link.latency == pytest.approx(1e-3) and link.latency_ms == pytest.approx(1.0)
     assert rig_check.needs_check(link)
+    assert "on the host, 1.00 ms across the link" in link.words
+
+
+def test_a_device_that_runs_the_loop_is_the_papers_own_loop():
+    rig = rig_check.rig_of(EngineConfig(rate=5000.0, device="/tmp/dev", device_latency=5), loop="device")
+    assert (rig.kind, rig.latency, rig.latency_samples) == ("device-loop", 0.0, 0)
+    assert not rig_check.needs_check(rig)
+    assert rig.words == "the loop runs on the device: the paper's own loop (latency 0)"
+    host = rig_check.rig_of(EngineConfig(rate=5000.0, device="/tmp/dev", device_latency=5), loop="host")
+    assert host.kind == "link" and host.latency_samples == 5
 
 
 def test_the_request_is_the_adjustment_tasks_conditions_with_the_protocols_parameters(tmp_path):

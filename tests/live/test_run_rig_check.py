@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from studyapp.cli.device_choice import rig_check_line
 from studyapp.experiment.protocol import load_protocol
 from studyapp.live import rig_check
@@ -23,6 +25,14 @@ def test_run_prints_the_warning_line_on_a_link_and_nothing_on_the_simulated_devi
     assert "below 1.5x" in said[-2]
     said.clear()
     assert rig_check_line(protocol, None, said.append) is None and said == []
+
+
+def test_run_says_a_device_loop_is_the_papers_own_loop_and_predicts_nothing(monkeypatch):
+    monkeypatch.setattr(rig_check, "predict", lambda req: pytest.fail("a device loop needs no prediction"))
+    said = []
+    assert rig_check_line(load_protocol(DEMO), "/tmp/studyapp-device", said.append, loop="device") is None
+    assert said == ["rig check: the loop runs on the device: the paper's own loop (latency 0); LVT's margin is the "
+                    "model's own, nothing to predict"]
 
 
 def test_device_is_refused_headless(tmp_path):
