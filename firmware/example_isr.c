@@ -73,6 +73,7 @@ int studyapp_init(void)
     loop.bridge = bridge;
     loop.nut = nut;
     loop.line = SP_LINE;
+    loop.est_s0 = sp_est_s; /* START puts the estimators back here (sl_reset) */
     if (sl_check(&loop) != 0)
         return -1;
     if (sd_init(&dev, sp_info, (uint32_t)sizeof sp_info, sp_rms_alpha) != 0)

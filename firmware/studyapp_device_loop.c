@@ -73,6 +73,8 @@ static void streaming(sd_device *d, int on) {
     d->row_open = 0;
     if (on) {
         d->seen = d->now;
+        sl_reset((sl_loop *)d->loop); /* a new run: the loop as built, as a host's fresh shadow is */
+        d->loop_fault_sent = 0;
         rest_setting(d);
     } else {
         d->queued = 0;

@@ -111,6 +111,14 @@ void sl_reset_string(sl_loop *L) {
     memset(L->nut, 0, L->line * sizeof(double));
 }
 
+void sl_reset(sl_loop *L) {
+    sl_reset_string(L);
+    if (L->est_s0 != NULL && L->n_est > 0u)
+        memcpy(L->est_s, L->est_s0, (size_t)L->n_est * L->est_s_width * sizeof(double));
+    memset(L->ls, 0, SL_N_LIMIT_STATE * sizeof(double));
+    memset(L->state, 0, SL_N_LOOP_STATE * sizeof(double));
+}
+
 double sl_sample(sl_loop *L, uint32_t k, double x_m, double a_m, double v_m, sl_out *o, double *est) {
     double *ctl = L->ctl, *state = L->state;
     double source = ctl[SL_C_SOURCE];

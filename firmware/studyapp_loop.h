@@ -77,6 +77,7 @@ typedef struct {
     double *bridge;
     double *nut;
     uint32_t line;
+    const double *est_s0; /* the estimators' starting states (n_est x est_s_width), or NULL: sl_reset keeps est_s */
 } sl_loop;
 
 /* one sample's outputs (the order of sl_run's rows) */
@@ -109,6 +110,10 @@ int sl_check(const sl_loop *L);
 
 /* the string at rest (studyapp/model/loop.py ClosedLoop.reset_string's part of it) */
 void sl_reset_string(sl_loop *L);
+
+/* the loop as built: the string at rest, the estimators at est_s0 (when given), the mean square force 0, no
+ * fault. A device loop runs it at START, so that a host's shadow, built afresh, starts from the same state. */
+void sl_reset(sl_loop *L);
 
 /* the layout constants above (in the order of studyapp_loop.c's table), for a binding to check against
  * its own: writes SL_N_LAYOUT int32s */

@@ -142,6 +142,7 @@ int main(void)
     L.est_s_width = head[2];
     L.est_p_width = head[3];
     L.line = head[4];
+    L.est_s0 = 0; /* no START here: sl_reset is not used */
     n = head[5];
     n_events = head[6];
     if (n_events > MAX_EVENTS) return fail("arm_in.bin: more control events than MAX_EVENTS");

@@ -60,7 +60,8 @@ class SlLoop(ctypes.Structure):
     _fields_ = [("ctl", _f64), ("state", _f64), ("lp", _f64), ("ls", _f64),
                 ("kinds", ctypes.POINTER(ctypes.c_int64)), ("n_est", _u32),
                 ("est_s", _f64), ("est_s_width", _u32), ("est_p", _f64), ("est_p_width", _u32),
-                ("sp", _f64), ("ss", _f64), ("bridge", _f64), ("nut", _f64), ("line", _u32)]
+                ("sp", _f64), ("ss", _f64), ("bridge", _f64), ("nut", _f64), ("line", _u32),
+                ("est_s0", _f64)]
 
 
 class SlOut(ctypes.Structure):
@@ -88,6 +89,7 @@ def _load(path):
     lib.sl_run.argtypes = [ptr, _u32, _u32, _f64, _f64, _f64, _f64, _f64]
     lib.sl_run.restype = None
     lib.sl_reset_string.argtypes = [ptr]
+    lib.sl_reset.argtypes = [ptr]
     lib.sl_reset_string.restype = None
     lib.sl_check.argtypes = [ptr]
     lib.sl_check.restype = ctypes.c_int
@@ -138,6 +140,7 @@ class CLoop:
         if bridge.shape != nut.shape:
             raise ParameterError("C loop: the string's two delay lines must have one length")
         self.n_est = int(kinds.shape[0])
+        self.est_s0 = np.array(est_s, dtype=np.float64, order="C")  # the starting states: sl_reset's
         self._loop = SlLoop(
             _pointer(ctl, np.float64, "ctl"), _pointer(state, np.float64, "state"),
             _pointer(lp, np.float64, "lp"), _pointer(ls, np.float64, "ls"),
@@ -145,7 +148,8 @@ class CLoop:
             _pointer(est_s, np.float64, "est_s"), est_s.shape[1],
             _pointer(est_p, np.float64, "est_p"), est_p.shape[1],
             _pointer(sp, np.float64, "sp"), _pointer(ss, np.float64, "ss"),
-            _pointer(bridge, np.float64, "bridge"), _pointer(nut, np.float64, "nut"), bridge.shape[0])
+            _pointer(bridge, np.float64, "bridge"), _pointer(nut, np.float64, "nut"), bridge.shape[0],
+            _pointer(self.est_s0, np.float64, "est_s0"))
         if self._lib.sl_check(ctypes.byref(self._loop)) != 0:
             raise ParameterError("C loop: the arrays fail sl_check (firmware/studyapp_loop.h says what it needs)")
         self.out = SlOut()
@@ -184,3 +188,8 @@ class CLoop:
     def reset_string(self):
         """The string at rest (ClosedLoop.reset_string's part that the C loop holds)."""
         self._lib.sl_reset_string(ctypes.byref(self._loop))
+
+    def reset(self):
+        """The loop as built: the string at rest, the estimators at their states when this CLoop was made,
+        the mean square force 0, no fault (sl_reset; a device loop runs it at START)."""
+        self._lib.sl_reset(ctypes.byref(self._loop))

@@ -36,9 +36,9 @@ waiting and runs them late (a gap in the scope, never a stale force: it sends
 none). Device samples that never arrive are counted (``missing``, ``gaps``):
 the shadow cannot follow the device across them, so from then on it is no
 longer compared (``unchecked`` counts the rows); nor after a reopen of a
-failed link. The shadow starts at rest: it follows a device loop that starts
-at rest with this host's START (a device that kept its loop's state from an
-earlier host's stream differs at once: a device fault).
+failed link. The shadow starts as built, as the device's loop does at this
+host's START (the protocol's sl_reset); a device that kept its loop's state
+from an earlier host's stream would differ at once: a device fault.
 
 ``health`` (cumulative): version 1's counts, plus ``gaps`` (telemetry gaps),
 ``force_gaps`` (rows armed, past the ramp, with a loop force but none applied),

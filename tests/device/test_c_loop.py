@@ -252,3 +252,22 @@ def test_a_c_layout_out_of_step_with_the_python_one_is_refused(monkeypatch):
     monkeypatch.setattr(c_loop, "LAYOUT", c_loop.LAYOUT[:-1] + (c_loop.LAYOUT[-1] + 1,))
     with pytest.raises(c_loop.BuildError, match="layout"):
         c_loop._load(c_loop.build())
+
+
+def test_reset_puts_the_loop_as_built_so_a_fresh_loop_runs_on_with_the_same_bits():
+    """sl_reset (a device loop's START): string, estimators, mean square force and fault as a new loop's."""
+    rate, f0, fmax = 5000.0, 220.0, 4.0
+    bank = {name: {} for name in NAMES}
+    x, a, v = record(rate, f0, fmax, 1, 200, 300)
+    used = make_loop(rate, f0, bank, "KALLEV", fmax)
+    fresh = make_loop(rate, f0, bank, "KALLEV", fmax)
+    c_used, c_fresh = c_loop.CLoop(used.control.arrays), c_loop.CLoop(fresh.control.arrays)
+    c_used.run(x, a, v)
+    c_used.sample(x.size, np.nan, 0.0, 0.0)  # a fault latched too
+    assert used.control.arrays[1][control.L_FAULT] != 0.0
+    c_used.reset()
+    for i in STATE:
+        assert np.array_equal(bits(used.control.arrays[i]), bits(fresh.control.arrays[i])), i
+    out_used, est_used = c_used.run(x, a, v)
+    out_fresh, est_fresh = c_fresh.run(x, a, v)
+    assert np.array_equal(bits(out_used), bits(out_fresh)) and np.array_equal(bits(est_used), bits(est_fresh))

@@ -71,10 +71,8 @@ def test_a_device_loop_of_other_estimator_parameters_is_refused(emulator):
     device.close()
 
 
-@pytest.mark.xfail(strict=True, reason="the device loop keeps its estimators and string over STOP and START "
-                   "(docs/device-protocol.md, version 2), so a second host (the console's session engine after its "
-                   "preview engine) starts its shadow at rest beside a loop that is not: START must put the loop at "
-                   "rest for a new host to follow it")
+# START puts the device's loop as built (sl_reset), so a second host (the console's session engine after its
+# preview engine) follows it from its own fresh shadow
 def test_a_second_host_on_the_same_device_follows_its_loop(emulator):
     link = emulator("--seed", "1")
     for _ in range(2):
