@@ -38,13 +38,9 @@ def register(sub):
 
 
 def closed_loop():
-    """The loop the engine and ``simulate`` run, with the paper's sensor and with an estimator in it, the
-    same loop on a real device's per-sample interface (model/device.py ``exchange``) and on recorded sensor
-    samples (control.run_sensors, the C loop's reference), and the shadow of a device that runs the loop.
-    One part: they share most of their compiled callees, which two processes would each compile."""
-    import numpy as np
-
-    from studyapp.model import control
+    """The loop the engine and ``simulate`` run, with the paper's sensor and with an estimator in it, and the
+    same loop on a real device's per-sample interface (model/device.py ``exchange``). One part: they share
+    most of their compiled callees, which two processes would each compile."""
     from studyapp.model.device import DeviceLimits, HapticDevice
     from studyapp.model.loop import ClosedLoop, LoopConfig
     from studyapp.model.simulate import simulate
@@ -62,22 +58,22 @@ def closed_loop():
 
     simulate(1.0, duration=0.05)
     simulate(1.0, duration=0.05, source="KALMAN")
-    loop = ClosedLoop(LoopConfig(rate=StillHandle.rate, fmax=1.0, source="LVT"), device=StillHandle())
-    loop.run(100)
-    x = np.zeros(16)
-    control.run_sensors(loop.control.arrays, x, x, x, np.zeros((len(control.OUTPUTS), 16)), np.zeros((0, 16)))
-    shadow_of_a_device_loop(loop)
+    ClosedLoop(LoopConfig(rate=StillHandle.rate, fmax=1.0, source="LVT"), device=StillHandle()).run(100)
 
 
-def shadow_of_a_device_loop(loop):
-    """The host's shadow of a device that runs the loop (device/shadow.py), on a few rows at rest."""
+def shadow_of_a_device_loop():
+    """The host's shadow of a device that runs the loop (device/shadow.py; also ``bench loop``'s numba loop), on
+    a few rows at rest. A part of its own: its estimator dispatch is as long to compile as the closed loop."""
     import numpy as np
 
     from studyapp.device import shadow
     from studyapp.model.control import OUTPUTS
+    from studyapp.model.loop import ClosedLoop, LoopConfig
+
+    loop = ClosedLoop(LoopConfig(rate=5000.0, fmax=1.0, source="LVT", audio=False), judge=False)
 
     rows = np.zeros((4, shadow.ROW_WIDTH))
-    shadow.run_rows(loop.control.arrays, 0, rows, 0.0, True, np.zeros((len(OUTPUTS), 4)),
+    shadow.run_rows(loop.control.arrays, 0, rows, 0.0, shadow.CHECK, np.zeros((len(OUTPUTS), 4)),
                     np.zeros((len(loop.names), 4)), np.zeros(2))
 
 
@@ -144,8 +140,9 @@ def device_core():
 
 
 # the longest first: a pool of two then ends about together
-PARTS = {"closed loop": closed_loop, "optimiser kernels": optimiser_kernels, "estimator bank": estimator_bank,
-         "signal paths": signal_paths, "device C core": device_core}
+PARTS = {"closed loop": closed_loop, "device loop's shadow": shadow_of_a_device_loop,
+         "optimiser kernels": optimiser_kernels, "estimator bank": estimator_bank, "signal paths": signal_paths,
+         "device C core": device_core}
 
 
 def _timed(name):

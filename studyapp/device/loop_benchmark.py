@@ -10,10 +10,11 @@ sample:
 
 - loop: one sample of the controller (sensors, source, string, force, motor
   limits, fault latch) and every estimator of the bank on it. C: sl_run
-  (device/c_loop.py); numba: control.run_sensors, control.sample per sample
-  then observe_others, which also advances the stability monitor (the C
-  leaves the monitor to the host) and writes the audio row (switched off
-  here: no body filter, no contact microphone);
+  (device/c_loop.py); numba: the host's shadow of a device loop
+  (device/shadow.py run_rows: control.sample and every other estimator per
+  row), which also advances the stability monitor (the C leaves the monitor
+  to the host) and writes the audio row (switched off here: no body filter,
+  no contact microphone);
 - controller: the same with no estimator (the string, the force and the
   limits: what a sample costs besides the bank);
 - bank: the estimators alone over the stream, each in turn: C se_run
@@ -23,8 +24,10 @@ sample:
 Each figure is the median over ``REPEATS`` runs of the whole stream in one
 call (so no per-call overhead is counted: a firmware's per-sample cost), in
 the process's CPU time (on a shared machine wall time would count other
-processes too), the cores taking turns within each repeat. The first repeat's
-outputs of the two loops are compared bit for bit and the answer printed.
+processes too), the cores taking turns within each repeat. The numba loop's
+first run checks every row's force and bridge velocity against the C loop's
+(the shadow's own comparison, tolerance 0), the estimates are compared bit
+for bit, and the answer printed.
 ``bench estimators``'s bank figure (Python calls on blocks of 256) includes
 its calls' overhead; this one does not.
 """
@@ -36,7 +39,7 @@ import time
 
 import numpy as np
 
-from studyapp.device import c_core
+from studyapp.device import c_core, shadow
 from studyapp.errors import ParameterError
 from studyapp.estimators import lvt, names
 from studyapp.estimators.dispatch import run_bank
@@ -79,20 +82,32 @@ def stream(rate, n):
     return tuple(np.ascontiguousarray(out[k]) for k in ("position", "acceleration", "velocity_lvt"))
 
 
+def sensor_rows(x, a, v, force=None, bridge=None):
+    """The sensors as the shadow's rows (device/shadow.py); with the C loop's force and bridge velocity to check."""
+    rows = np.zeros((x.shape[0], shadow.ROW_WIDTH))
+    rows[:, shadow.R_X], rows[:, shadow.R_A], rows[:, shadow.R_V] = x, a, v
+    if force is not None:
+        rows[:, shadow.R_LOOP_FORCE], rows[:, shadow.R_BRIDGE] = force, bridge
+    return rows
+
+
 class _Numba:
+    """The numba loop on recorded sensors: the host's compiled shadow of a device loop (device/shadow.py), every
+    estimator stepped per row as the device does."""
+
     def __init__(self, rate, bank, n):
         self.loop = _loop(rate, bank)
         self.alone = _loop(rate, [])
         self.out = np.zeros((len(control.OUTPUTS), n))
         self.est = np.zeros((len(bank), n))
         self.none = np.zeros((0, n))
+        self.differs = np.zeros(2)
 
-    def run_loop(self, x, a, v):
-        control.run_sensors(self.loop.control.arrays, x, a, v, self.out, self.est)
-        return self.out[control.O_FORCE], self.est
+    def run_loop(self, rows):
+        return shadow.run_rows(self.loop.control.arrays, 0, rows, 0.0, shadow.CHECK, self.out, self.est, self.differs)
 
-    def run_controller(self, x, a, v):
-        control.run_sensors(self.alone.control.arrays, x, a, v, self.out, self.none)
+    def run_controller(self, rows):
+        shadow.run_rows(self.alone.control.arrays, 0, rows, 0.0, shadow.MODEL, self.out, self.none, self.differs)
 
     def run_bank(self, bank, x, a, v):
         run_bank(bank.kinds, bank.states, bank.params, x, a, v, self.est)
@@ -106,6 +121,7 @@ class _C:
         self.c = c_loop.CLoop(self.loop.control.arrays)
         self.alone = c_loop.CLoop(_loop(rate, []).control.arrays)
         self.out = np.zeros((len(c_loop.OUT_ROWS), n))
+        self.bridge_row = c_loop.OUT_ROWS.index("bridge_velocity")
         self.est = np.zeros((n, len(bank)))
         self.none = np.zeros((n, 0))
         self.est_rows = np.zeros(n)
@@ -113,7 +129,7 @@ class _C:
 
     def run_loop(self, x, a, v):
         out, est = self.c.run(x, a, v, out=self.out, est=self.est)
-        return out[0], est
+        return out[0], out[self.bridge_row], est
 
     def run_controller(self, x, a, v):
         self.alone.run(x, a, v, out=self.out, est=self.none)
@@ -150,26 +166,29 @@ def measure(rate, cores, seconds=None, repeats=None, progress=True):
     x, a, v = stream(rate, n)
     runners = {core: (_C if core == "c" else _Numba)(rate, bank, n) for core in cores}
     banks = {core: Bank(rate, bank) for core in cores}
-    first = {}
-    for core, r in runners.items():  # warm: compile, caches; and the outputs compared below
-        force, est = r.run_loop(x, a, v)
-        first[core] = (force.copy(), np.ascontiguousarray(est).copy())
-        r.run_controller(x, a, v)
+    same, c_est, rows = None, None, sensor_rows(x, a, v)
+    if "c" in runners:  # warm: the library, caches; and the C loop's outputs, which the numba loop checks
+        force, bridge, est = runners["c"].run_loop(x, a, v)
+        c_est = np.ascontiguousarray(est).copy()
+        checked = sensor_rows(x, a, v, force, bridge)
+    if "numba" in runners:  # warm: compile; with the C core, every row's force and bridge velocity compared
+        r = runners["numba"]
+        differs = r.run_loop(checked if c_est is not None else rows)
+        if c_est is not None:
+            same = bool(differs == -1 and np.array_equal(r.est.view(np.uint64), c_est.view(np.uint64)))
+    for core, r in runners.items():
+        r.run_controller(*((x, a, v) if core == "c" else (rows,)))
         r.run_bank(banks[core], x, a, v)
     times = {core: {what: [] for what in FIGURES} for core in cores}
     for repeat in range(repeats):
         say(f"repeat {repeat + 1} of {repeats} ...")
         for core, r in runners.items():
-            times[core]["loop"].append(_cpu_ns(lambda: r.run_loop(x, a, v)))
-            times[core]["controller"].append(_cpu_ns(lambda: r.run_controller(x, a, v)))
+            sensors = (x, a, v) if core == "c" else (rows,)
+            times[core]["loop"].append(_cpu_ns(lambda: r.run_loop(*sensors)))
+            times[core]["controller"].append(_cpu_ns(lambda: r.run_controller(*sensors)))
             times[core]["bank"].append(_cpu_ns(lambda: r.run_bank(banks[core], x, a, v)))
     result = {core: {f"{what}_ns_per_sample": statistics.median(t) / n for what, t in times[core].items()}
               for core in cores}
-    same = None
-    if len(first) == 2:
-        (f1, e1), (f2, e2) = first.values()
-        same = bool(np.array_equal(f1.view(np.uint64), f2.view(np.uint64))
-                    and np.array_equal(e1.view(np.uint64), e2.view(np.uint64)))
     arrays = _C(rate, bank, 1).c.nbytes if "c" in cores else None
     return result, bank, n, same, arrays
 

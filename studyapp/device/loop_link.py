@@ -339,7 +339,8 @@ class LoopLink(LinkDevice):
             synced = bool(first < self._unsynced_from)
             if synced and table[end - 1, shadow.R_SAMPLE] >= self._unsynced_from:
                 end = start + int(self._unsynced_from - first)  # a segment never straddles a gap
-            bad = shadow.run_rows(control.arrays, start, table[start:end], self.tolerance, synced, out,
+            bad = shadow.run_rows(control.arrays, start, table[start:end], self.tolerance,
+                                  shadow.CHECK if synced else shadow.TRUST, out,
                                   est_out, self._shadow_values)
             done = end - start if bad < 0 else bad + 1
             h["samples"] += done

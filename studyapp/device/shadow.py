@@ -15,7 +15,11 @@ the applied force (what acted on the handle is what the session logs).
 ``run_rows`` runs one setting's rows (one CONTROL in effect: the caller
 writes it into the control vector first) and returns the index of the first
 row that differs, or -1; that row's force is 0 and the rows after it are not
-run. ``check`` False (after a telemetry gap) runs them without comparing.
+run. ``mode``: ``CHECK`` compares every row and logs the applied force;
+``TRUST`` (after a telemetry gap) runs them without comparing and logs the
+applied force; ``MODEL`` runs them as the model's loop on recorded sensors
+and keeps its own force (the C loop's reference in the tests, and ``bench
+loop``'s numba loop).
 """
 
 import math
@@ -30,10 +34,12 @@ from studyapp.model.control import C_SOURCE, O_FORCE, sample
 # the columns of a row as loop_link.py packs them
 R_SAMPLE, R_X, R_A, R_V, R_LOOP_FORCE, R_APPLIED, R_BRIDGE, R_CONTROL = range(8)
 ROW_WIDTH = 8
+# run_rows' modes
+TRUST, CHECK, MODEL = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
-def run_rows(c, k0, rows, tol, check, out, est_out, shadow):
+def run_rows(c, k0, rows, tol, mode, out, est_out, shadow):
     """Rows ``rows`` (m, ROW_WIDTH) at the loop's samples k0.. of ``out``; the first differing row's index or -1
     (``shadow`` then holds the shadow's force and bridge velocity there)."""
     ctl, kinds, est_s, est_p, sp, ss, bridge = c[0], c[4], c[5], c[6], c[7], c[8], c[9]
@@ -47,7 +53,9 @@ def run_rows(c, k0, rows, tol, check, out, est_out, shadow):
         for e in range(kinds.shape[0]):
             if e != src:
                 est_out[e, k] = step_guarded(kinds[e], est_s[e], est_p[e], x, a, v)
-        if check:
+        if mode == MODEL:
+            continue
+        if mode == CHECK:
             device_f, device_b = rows[i, R_LOOP_FORCE], rows[i, R_BRIDGE]
             if not (np.isfinite(device_f) and np.isfinite(device_b)) or abs(f - device_f) > tol \
                     or abs(b - device_b) > tol:

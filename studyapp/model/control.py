@@ -190,31 +190,6 @@ def observe_others(src, kinds, est_s, est_p, out, est_out):
                                 out[O_VELOCITY_LVT], est_out[e])
 
 
-@njit(cache=True, error_model="numpy")
-def run_sensors(c, x_m, a_m, v_m, out, est_out):
-    """The controller over a block of recorded sensor samples, as for a device without truth, then the others.
-
-    Sample k is ``sample`` with no truth (x, v, a and the hand's force NaN; the monitor and the microphone
-    observe the sensors), then the estimators but the source follow the block (``observe_others``): what a
-    device that runs the loop itself computes (firmware/studyapp_loop.c), and what the host's shadow of it
-    computes. ``sample``'s sequence is written out here, the arrays unpacked once: calling ``sample`` per
-    sample cost 75 ns more (214 against 140 ns a sample with no estimator at 48 kHz, measured 2026-11-28);
-    tests/model/test_model_run_sensors.py holds the two equal.
-    """
-    ctl, state, lp, ls, kinds, est_s, est_p, sp, ss, bridge, nut, body_p, body_s, mon_p, mon_s, mic_p, mic_s = c
-    src = int(ctl[C_SOURCE])
-    nan = math.nan
-    for k in range(x_m.shape[0]):
-        x, a, v = x_m[k], a_m[k], v_m[k]
-        check_sensors(state, k, x, a, v)
-        v_src = source_velocity(src, kinds, est_s, est_p, k, x, a, v, nan, est_out)
-        f = bow_and_force(ctl, state, k, v_src, sp, ss, bridge, nut, body_p, body_s, out)
-        observe(ctl, mon_p, mon_s, mic_p, mic_s, k, v, a, out)
-        f = command(state, lp, ls, k, f)
-        record(out, k, x, a, v, nan, nan, nan, f, nan)
-    observe_others(src, kinds, est_s, est_p, out, est_out)
-
-
 class Control:
     """The loop's side of ``HapticDevice.exchange``: the compiled controller's arrays, and one sample from Python."""
 

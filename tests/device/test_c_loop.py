@@ -1,7 +1,8 @@
 """The loop in C (firmware/studyapp_loop.c, through studyapp/device/c_loop.py) equals the numba loop bit for bit.
 
-The numba side is control.run_sensors: control.sample for every sample of a block, then observe_others,
-the path of a device without truth. Both run on a recorded sensor stream of the simulated device (bad
+The numba side is the host's shadow of a device loop run as the model (device/shadow.py run_rows, MODEL):
+control.sample for every sample of a block and every other estimator on it, the path of a device without
+truth (tests/device/test_shadow_rows.py holds it equal to Control.sample called sample by sample). Both run on a recorded sensor stream of the simulated device (bad
 samples put in: NaN, inf, values beyond the estimators' bounds), cut into blocks at control events
 (source, F_max, force scale, bowing, string reset); after every block every output, every estimate and
 every state array (fault, string, motor limits, estimators) must have the same bits. Rates 1-96 kHz, any
@@ -29,6 +30,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from studyapp import estimators
+from studyapp.device import shadow
+from studyapp.device.loop_benchmark import sensor_rows
 from studyapp.errors import ParameterError
 from studyapp.estimators.spec import NYQUIST_FRACTION
 from studyapp.model import control
@@ -155,7 +158,8 @@ def run_both(s):
         block = slice(start, stop)
         o = np.zeros((len(control.OUTPUTS), stop - start))
         e = np.zeros((n_est, stop - start))
-        control.run_sensors(ref.control.arrays, x[block], a[block], v[block], o, e)
+        shadow.run_rows(ref.control.arrays, 0, sensor_rows(x[block], a[block], v[block]), 0.0, shadow.MODEL, o, e,
+                        np.zeros(2))
         out[:, block], est[:, block] = o, e
         c_out[:, block], c_est[:, block] = c.run(x[block], a[block], v[block])
         for i in STATE:

@@ -1,10 +1,14 @@
-"""control.run_sensors (the controller over recorded sensor samples, its sequence written out for speed) equals
-Control.sample called sample by sample with no truth, then observe_others: every output row, every estimate and
-every array of the loop (string, body filter, monitor, microphone, fault), bit for bit."""
+"""The host's compiled shadow of a device loop run as the model (device/shadow.py run_rows, MODEL: the controller
+and every other estimator per row of recorded sensors) equals Control.sample called sample by sample with no
+truth, then observe_others: every output row, every estimate and every array of the loop (string, body filter,
+monitor, microphone, fault), bit for bit. It is the C loop's reference (tests/device/test_c_loop.py) and
+``bench loop``'s numba loop."""
 
 import numpy as np
 import pytest
 
+from studyapp.device import shadow
+from studyapp.device.loop_benchmark import sensor_rows
 from studyapp.model import control
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import LVT_SENSOR
@@ -20,7 +24,7 @@ def make(source, seed):
 
 @pytest.mark.parametrize("source", ["KALLEV", LVT_SENSOR])
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_run_sensors_equals_sample_by_sample(source, seed):
+def test_the_shadows_rows_equal_sample_by_sample(source, seed):
     rec = make(LVT_SENSOR, seed).run(1600)
     x, a, v = (np.array(rec[k]) for k in ("position", "acceleration", "velocity_lvt"))
     rng = np.random.default_rng(seed)
@@ -31,7 +35,8 @@ def test_run_sensors_equals_sample_by_sample(source, seed):
     for start, stop in ((0, 700), (700, 1600)):
         n = stop - start
         out, est = np.zeros((len(control.OUTPUTS), n)), np.zeros((n_est, n))
-        control.run_sensors(block.control.arrays, x[start:stop], a[start:stop], v[start:stop], out, est)
+        rows = sensor_rows(x[start:stop], a[start:stop], v[start:stop])
+        shadow.run_rows(block.control.arrays, 0, rows, 0.0, shadow.MODEL, out, est, np.zeros(2))
         ref, ref_est = np.zeros((len(control.OUTPUTS), n)), np.zeros((n_est, n))
         for k in range(n):
             i = start + k
