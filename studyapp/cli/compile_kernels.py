@@ -139,7 +139,6 @@ def device_core():
             pass
 
 
-# the longest first: a pool of two then ends about together
 # longest first (measured 2026-11-28, a clean cache: 114, 84, 43, 20, 5 and 2 s), so two processes end together
 PARTS = {"closed loop": closed_loop, "device loop's shadow": shadow_of_a_device_loop,
          "estimator bank": estimator_bank, "optimiser kernels": optimiser_kernels, "signal paths": signal_paths,
