@@ -32,7 +32,7 @@ def emulator(tmp_path):
 # A lock-step emulator waits for this host, and a host that waited this long for it has found a fault: these
 # tests hold the two loops equal, not the link's timing (bench device --loop device measures that); a clean
 # clone's first emulator may still be compiling its simulated device while the suite loads both cores.
-SILENCE_S = 30.0
+SILENCE_S = 10.0  # the most a link allows (handshake.check_silence)
 
 
 def _loop(device, params=None, source="LVT"):
