@@ -343,18 +343,22 @@ class LinkDevice(HapticDevice):
 
     def resync(self):
         """Drop every frame waiting on the link (the host was busy, not answering): the next sample is fresh."""
+        self._read_waiting()
+        self._pending.clear()
+        self._forces = []
+        self._first = None
+
+    def _read_waiting(self):
+        """Take every byte already waiting on the link, without waiting."""
         while self.fault is None and self.link.wait(0.0):
             try:
                 data = self.link.read()
             except (OSError, EOFError) as exc:
                 self._link_failed(exc)
                 break
-            self._take(data)
             if not data:
                 break
-        self._pending.clear()
-        self._forces = []
-        self._first = None
+            self._take(data)
 
     def stop_stream(self, timeout=0.2):
         """STOP the stream and wait for the device's STATE (its own counters: late, lost, corrupt); None if none came."""

@@ -361,14 +361,3 @@ class LoopLink(LinkDevice):
         self._begin()
         self._read_waiting()
 
-    def _read_waiting(self):
-        """Take every byte already waiting on the link, without waiting."""
-        while self.fault is None and self.link.wait(0.0):
-            try:
-                data = self.link.read()
-            except (OSError, EOFError) as exc:
-                self._link_failed(exc)
-                break
-            if not data:
-                break
-            self._take(data)
