@@ -103,8 +103,8 @@ class _Numba:
         self.none = np.zeros((0, n))
         self.differs = np.zeros(2)
 
-    def run_loop(self, rows):
-        return shadow.run_rows(self.loop.control.arrays, 0, rows, 0.0, shadow.CHECK, self.out, self.est, self.differs)
+    def run_loop(self, rows, mode=shadow.MODEL):
+        return shadow.run_rows(self.loop.control.arrays, 0, rows, 0.0, mode, self.out, self.est, self.differs)
 
     def run_controller(self, rows):
         shadow.run_rows(self.alone.control.arrays, 0, rows, 0.0, shadow.MODEL, self.out, self.none, self.differs)
@@ -173,7 +173,7 @@ def measure(rate, cores, seconds=None, repeats=None, progress=True):
         checked = sensor_rows(x, a, v, force, bridge)
     if "numba" in runners:  # warm: compile; with the C core, every row's force and bridge velocity compared
         r = runners["numba"]
-        differs = r.run_loop(checked if c_est is not None else rows)
+        differs = r.run_loop(checked, shadow.CHECK) if c_est is not None else r.run_loop(rows)
         if c_est is not None:
             same = bool(differs == -1 and np.array_equal(r.est.view(np.uint64), c_est.view(np.uint64)))
     for core, r in runners.items():
