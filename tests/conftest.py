@@ -5,6 +5,7 @@ are collected first (``pytest_collection_modifyitems``), so the parallel run doe
 """
 
 import studyapp  # noqa: F401
+from tests.hang_guard import pytest_runtest_protocol, pytest_terminal_summary  # noqa: F401
 from tests.jack_server import jack_server  # noqa: F401
 
 
