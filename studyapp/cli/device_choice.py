@@ -26,21 +26,34 @@ def add_device_option(parser):
                              "(serial port, pty, socket://HOST:PORT); default: the one remembered on this machine")
 
 
-def check_device(device, rate):
+def check_device(device, rate, protocol=None):
     """None for the simulated device, else the link (probed: ``ParameterError``, one line, if it is no device)."""
-    return probe_device(device, rate)[0]
+    return probe_device(device, rate, protocol)[0]
 
 
-def probe_device(device, rate):
-    """(link, who runs the loop: "host" or "device") of ``--device``; (None, None) for the simulated device."""
+def protocol_sources(protocol):
+    """Every condition (velocity source) of the protocol's tasks, in the order they first appear."""
+    names = []
+    for task in protocol.tasks:
+        names += [n for n in getattr(protocol.task(task), "conditions", ()) if n not in names]
+    return names
+
+
+def probe_device(device, rate, protocol=None):
+    """(link, who runs the loop: "host" or "device") of ``--device``; (None, None) for the simulated device.
+    A device that lacks a channel one of ``protocol``'s conditions reads is refused (source_channels.py)."""
     if device is None or device == SIMULATED:
         return None, None
+    from studyapp.device import source_channels
     from studyapp.device.link_open import is_link
     from studyapp.device.link_probe import probe
 
     if not is_link(device):
         raise ParameterError(f"--device {device}: allowed is simulated, a serial port, a pty or a pyserial URL")
-    return device, probe(device, rate)["loop"]
+    found = probe(device, rate)
+    if protocol is not None:
+        source_channels.check(protocol_sources(protocol), found["channels"], device)
+    return device, found["loop"]
 
 
 def rig_check_line(protocol, device, say, loop=None):

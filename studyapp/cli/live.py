@@ -95,9 +95,13 @@ def _check_device(args):
         from studyapp.device.handshake import check_silence
 
         check_silence(args.device_silence)
+    from studyapp.device import source_channels
+    from studyapp.model.sources import LVT_SENSOR
+
     options = {"packet": args.device_packet, "latency": args.device_latency}
-    probe(args.device, args.rate, calibration=args.calibration,
-          **{key: value for key, value in options.items() if value is not None})
+    found = probe(args.device, args.rate, calibration=args.calibration,
+                  **{key: value for key, value in options.items() if value is not None})
+    source_channels.check([args.source or LVT_SENSOR], found["channels"], args.device)
 
 
 def _device(info, summary):

@@ -129,7 +129,7 @@ def run(args):
         output_paths.check_audio(args.audio, inputs=[args.protocol, *filter(None, [args.replay_gesture])])
         args.audio = args.audio or "device"
         args.midi = args.midi or "first"
-        link, loop = probe_device(args.device, protocol.rate)
+        link, loop = probe_device(args.device, protocol.rate, protocol)
         if not args.resume:
             args.rig_prediction = rig_check_line(protocol, link, lambda text: print(f"studyapp run: {text}",
                                                                                    file=sys.stderr, flush=True),

@@ -6,8 +6,8 @@ INFO checked, bounded timeouts, two PINGs) and closes it again, importing
 neither numba nor the loop, so that ``studyapp live --device`` refuses a bad
 link with one line and exit code 2 within seconds even on a loaded machine
 (a silent one after ``handshake.HELLO_WAIT``, the time a board may take to boot).
-Returns the INFO's summary (name, serial, round trip, protocol, and who runs
-the loop: "host" or "device", protocol 2); the worker opens the link again
+Returns the INFO's summary (name, serial, round trip, protocol, the channels
+it sends, and who runs the loop: "host" or "device", protocol 2); the worker opens the link again
 for the run (a device answers every HELLO with INFO), with the driver that
 fits it (device_open.py).
 """
@@ -78,5 +78,6 @@ def probe(spec, rate, packet=1, calibration=None, latency=1, ramp_ms=0):
         link.close()
     loop = handshake.loop_of(info, spec)
     return {"name": info.name, "serial": info.serial, "calibration": scales.source, "round_trip_ms": round_trip,
+            "channels": list(scales.kinds),
             "protocol": info.protocol_version, "loop": "device" if loop.loop == lm.DEVICE_LOOP else "host",
             "estimator_kinds": list(loop.kinds)}
