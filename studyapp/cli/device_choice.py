@@ -20,10 +20,17 @@ from studyapp.errors import ParameterError
 SIMULATED = "simulated"
 
 
-def add_device_option(parser):
+HEADLESS_WHY = ("a headless session steps the simulated device as fast as it can, and a device on a link runs "
+                "on its own clock")
+
+
+def add_device_option(parser, headless=False):
+    """``--device``; ``headless``: the command also has ``--headless``, with which a link is refused (say why)."""
+    words = f" (the console's; not with --headless: {HEADLESS_WHY})" if headless else ""
     parser.add_argument("--device", metavar="simulated|PATH_OR_URL", default=None,
                         help="the device: simulated, or a link to a device speaking docs/device-protocol.md "
-                             "(serial port, pty, socket://HOST:PORT); default: the one remembered on this machine")
+                             f"(serial port, pty, socket://HOST:PORT); default: the one remembered on this "
+                             f"machine{words}")
 
 
 def check_device(device, rate, protocol=None):
