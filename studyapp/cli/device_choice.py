@@ -78,7 +78,7 @@ def rig_check_line(protocol, device, say, loop=None):
         if rig.kind == rig_check.DEVICE_LOOP:
             say(f"rig check: {rig.words}; LVT's margin is the model's own, nothing to predict")
         return None
-    say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_ms:.2f} ms "
+    say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_words} "
         "link latency (the model, 5 seeds)…")
     prediction = rig_check.predict(req)
     verdict = rig_check.verdict(prediction, rig)

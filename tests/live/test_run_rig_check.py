@@ -21,7 +21,7 @@ def test_run_prints_the_warning_line_on_a_link_and_nothing_on_the_simulated_devi
     protocol = load_protocol(DEMO)
     req, prediction, warning = rig_check_line(protocol, "/tmp/studyapp-device", said.append)
     assert req.rig.latency_ms == 1.0 and prediction["LVT"] == 3.09
-    assert warning == said[-1] and warning.startswith("warning: at this rig's link latency of 1.00 ms (5 samples")
+    assert warning == said[-1] and warning.startswith("warning: at this rig's link latency of 5 samples (1.00 ms")
     assert "below 1.5x" in said[-2]
     said.clear()
     assert rig_check_line(protocol, None, said.append) is None and said == []
