@@ -39,7 +39,8 @@ def register(sub):
                    help="a device speaking docs/device-protocol.md: a serial port, a pty or a pyserial URL "
                         "(socket://HOST:PORT); default: the simulated device")
     p.add_argument("--device-latency", type=int, default=None, metavar="SAMPLES",
-                   help="samples the host answers ahead of the device's sensor sample (default 5)")
+                   help="samples the host answers ahead of the device's sensor sample: the packet to 1024 "
+                        "(default 5)")
     p.add_argument("--device-packet", type=int, default=None, metavar="SAMPLES",
                    help="samples per sensor frame (default 1)")
     p.add_argument("--device-silence", type=float, default=None, metavar="SECONDS",
