@@ -219,7 +219,8 @@ void sd_payload(sd_device *d, uint8_t *p, uint32_t n) {
         sd_corrupt_frame(d);
         return;
     }
-    if (d->have_seq) d->lost += (uint8_t)(p[1] - d->last_seq - 1u);
+    /* a HELLO starts a new conversation (a host that reopened the link starts its seq at 0): no gap counted */
+    if (d->have_seq && type != HELLO) d->lost += (uint8_t)(p[1] - d->last_seq - 1u);
     d->last_seq = p[1];
     d->have_seq = 1;
     d->corrupt_run = 0;

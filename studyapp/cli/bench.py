@@ -71,7 +71,7 @@ def register(sub):
     p.add_argument("--runs", type=int, default=1, help="runs; the figures are their medians (default 1)")
     p.add_argument("--rate", type=float, default=5000.0, help="the device's rate in Hz (default 5000)")
     p.add_argument("--latency", type=int, default=5, metavar="SAMPLES",
-                   help="samples the host answers ahead (default 5: 1 ms at 5 kHz)")
+                   help="samples the host answers ahead: the packet to 1024 (default 5: 1 ms at 5 kHz)")
     p.add_argument("--packet", type=int, default=None, metavar="SAMPLES",
                    help="samples per sensor (host loop) or telemetry (device loop) frame (default 1; 10 for a "
                         "device loop)")

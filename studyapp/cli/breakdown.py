@@ -1,5 +1,5 @@
 """``studyapp breakdown --source NAME | --all [--rate HZ] [--seeds N] [--first-seed K] [--gesture strokes|hold]
-[--windows seconds|samples] [--latency S] [--packet S] [--jitter S] [--json] [-o FILE]``.
+[--windows seconds|samples] [--latency SAMPLES] [--packet SAMPLES] [--jitter SAMPLES] [--json] [-o FILE]``.
 
 Breakdown F_max (studyapp.model.breakdown) for one source or every source,
 over seeds K..K+N-1 (K = 0 by default). Prints a table (or with ``--json`` one JSON object for
@@ -17,9 +17,9 @@ Each estimator runs with Table 1 made for ``--rate`` (estimators/at_rate.py):
 rate / 5 kHz, so they keep the duration they were tuned for; ``--windows
 samples`` keeps the counts as printed. At 5 kHz the two are the same.
 
-``--latency``, ``--packet`` and ``--jitter`` (seconds, default 0) put the
-simulated device behind a link (studyapp.model.link); the JSON has their keys,
-the CSV their columns (after today's), the Markdown a sentence naming them.
+``--latency``, ``--packet`` and ``--jitter`` (samples at ``--rate``, default 0: cli/link_options.py) put the
+simulated device behind a link (studyapp.model.link); the JSON has their keys (seconds), the CSV their columns
+(after today's), the Markdown a sentence naming them in samples and ms.
 """
 
 from studyapp.cli import link_options
@@ -100,7 +100,7 @@ def run(args):
     breakdown.check_gesture(args.gesture, "--gesture")
     breakdown.check_duration(args.duration, "--duration")
     check_windows(args.windows, "--windows")
-    link = link_options.spec(args)
+    link = link_options.spec(args, args.rate)
     if args.output:
         check_output(args.output)
 
@@ -220,5 +220,6 @@ def _link_sentence(result):
     """The link the device ran behind, from a result's ``LINK_COLUMNS`` (seconds)."""
     if not any(result[name] for name in LINK_COLUMNS):
         return "The simulated device is on an ideal link (latency, packet and jitter 0: the paper's loop)."
-    times = ", ".join(f"{name} {result[name] * 1000:g} ms" for name in LINK_COLUMNS)
+    times = ", ".join(f"{name} {round(result[name] * result['rate'])} samples ({result[name] * 1000:g} ms)"
+                      for name in LINK_COLUMNS)
     return f"The simulated device is behind a link (`studyapp.model.link`): {times}."

@@ -20,27 +20,47 @@ from studyapp.errors import ParameterError
 SIMULATED = "simulated"
 
 
-def add_device_option(parser):
+HEADLESS_WHY = ("a headless session steps the simulated device as fast as it can, and a device on a link runs "
+                "on its own clock")
+
+
+def add_device_option(parser, headless=False):
+    """``--device``; ``headless``: the command also has ``--headless``, with which a link is refused (say why)."""
+    words = f" (the console's; not with --headless: {HEADLESS_WHY})" if headless else ""
     parser.add_argument("--device", metavar="simulated|PATH_OR_URL", default=None,
                         help="the device: simulated, or a link to a device speaking docs/device-protocol.md "
-                             "(serial port, pty, socket://HOST:PORT); default: the one remembered on this machine")
+                             f"(serial port, pty, socket://HOST:PORT); default: the one remembered on this "
+                             f"machine{words}")
 
 
-def check_device(device, rate):
+def check_device(device, rate, protocol=None):
     """None for the simulated device, else the link (probed: ``ParameterError``, one line, if it is no device)."""
-    return probe_device(device, rate)[0]
+    return probe_device(device, rate, protocol)[0]
 
 
-def probe_device(device, rate):
-    """(link, who runs the loop: "host" or "device") of ``--device``; (None, None) for the simulated device."""
+def protocol_sources(protocol):
+    """Every condition (velocity source) of the protocol's tasks, in the order they first appear."""
+    names = []
+    for task in protocol.tasks:
+        names += [n for n in getattr(protocol.task(task), "conditions", ()) if n not in names]
+    return names
+
+
+def probe_device(device, rate, protocol=None):
+    """(link, who runs the loop: "host" or "device") of ``--device``; (None, None) for the simulated device.
+    A device that lacks a channel one of ``protocol``'s conditions reads is refused (source_channels.py)."""
     if device is None or device == SIMULATED:
         return None, None
+    from studyapp.device import source_channels
     from studyapp.device.link_open import is_link
     from studyapp.device.link_probe import probe
 
     if not is_link(device):
         raise ParameterError(f"--device {device}: allowed is simulated, a serial port, a pty or a pyserial URL")
-    return device, probe(device, rate)["loop"]
+    found = probe(device, rate)
+    if protocol is not None:
+        source_channels.check(protocol_sources(protocol), found["channels"], device)
+    return device, found["loop"]
 
 
 def rig_check_line(protocol, device, say, loop=None):
@@ -58,7 +78,7 @@ def rig_check_line(protocol, device, say, loop=None):
         if rig.kind == rig_check.DEVICE_LOOP:
             say(f"rig check: {rig.words}; LVT's margin is the model's own, nothing to predict")
         return None
-    say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_ms:.2f} ms "
+    say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_words} "
         "link latency (the model, 5 seeds)…")
     prediction = rig_check.predict(req)
     verdict = rig_check.verdict(prediction, rig)

@@ -95,7 +95,8 @@ def run(args):
         from studyapp.gui.app import default_protocol
 
         protocol = args.protocol or default_protocol()
-        check_device(args.device, load_protocol(protocol).rate if protocol else 5000.0)
+        loaded = load_protocol(protocol) if protocol else None
+        check_device(args.device, loaded.rate if loaded else 5000.0, loaded)
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")
     if args.measure_scope is not None and not 0.5 <= args.measure_scope <= 600:

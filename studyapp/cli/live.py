@@ -39,7 +39,8 @@ def register(sub):
                    help="a device speaking docs/device-protocol.md: a serial port, a pty or a pyserial URL "
                         "(socket://HOST:PORT); default: the simulated device")
     p.add_argument("--device-latency", type=int, default=None, metavar="SAMPLES",
-                   help="samples the host answers ahead of the device's sensor sample (default 5)")
+                   help="samples the host answers ahead of the device's sensor sample: the packet to 1024 "
+                        "(default 5)")
     p.add_argument("--device-packet", type=int, default=None, metavar="SAMPLES",
                    help="samples per sensor frame (default 1)")
     p.add_argument("--device-silence", type=float, default=None, metavar="SECONDS",
@@ -95,9 +96,13 @@ def _check_device(args):
         from studyapp.device.handshake import check_silence
 
         check_silence(args.device_silence)
+    from studyapp.device import source_channels
+    from studyapp.model.sources import LVT_SENSOR
+
     options = {"packet": args.device_packet, "latency": args.device_latency}
-    probe(args.device, args.rate, calibration=args.calibration,
-          **{key: value for key, value in options.items() if value is not None})
+    found = probe(args.device, args.rate, calibration=args.calibration,
+                  **{key: value for key, value in options.items() if value is not None})
+    source_channels.check([args.source or LVT_SENSOR], found["channels"], args.device)
 
 
 def _device(info, summary):

@@ -3,7 +3,9 @@
 [--replay-gesture EVENTS] [--device simulated|PATH_OR_URL] [--experimenter NAME] [--session-number N]
 [--notes TEXT] [--order-row N]``: run one participant's session.
 
-``--device`` (the console only): the device the participant holds (cli/device_choice.py). On a device on a
+``--device`` (the console only): the device the participant holds (cli/device_choice.py). With ``--headless``
+only ``simulated`` is allowed: a headless session steps the simulated device as fast as it can, and a device on a
+link runs on its own clock (``--help`` says so). On a device on a
 link, a session with an adjustment task is first checked by the model (live/rig_check.py): when the link's
 latency makes LVT's predicted breakdown fall below 1.5x the best estimator's, a ``studyapp run: warning: ...``
 line says so, and the console asks again at Start.
@@ -32,7 +34,7 @@ simulated participant's hand moves as that session's participant bowed
 """
 
 from studyapp.cli import number_options
-from studyapp.cli.device_choice import add_device_option
+from studyapp.cli.device_choice import HEADLESS_WHY, SIMULATED, add_device_option
 from studyapp.cli.session_info_options import add_session_info_options, session_info_of
 
 
@@ -60,7 +62,7 @@ def register(sub):
     parser.add_argument("--replay-gesture", metavar="EVENTS",
                         help="the simulated participant bows as logged in EVENTS (a session's events.jsonl "
                              "or folder; needs --simulated-participant)")
-    add_device_option(parser)
+    add_device_option(parser, headless=True)
     add_session_info_options(parser)
     parser.set_defaults(func=run)
 
@@ -102,7 +104,10 @@ def run(args):
     if args.headless and args.audio not in (None, "wav", "null"):
         raise UserError(f"--audio {args.audio}: allowed headless is wav (audio.wav in the session folder) or null")
     if args.headless:
-        for option in ("midi", "participant_screen", "device"):
+        if args.device not in (None, SIMULATED):
+            raise UserError(f"--device {args.device}: allowed with --headless is only simulated: {HEADLESS_WHY}; "
+                            "run it without --headless (the console)")
+        for option in ("midi", "participant_screen"):
             if getattr(args, option) is not None:
                 raise UserError(f"--{option.replace('_', '-')}: allowed only without --headless (the console's)")
     if args.replay_gesture is not None and not args.simulated_participant:
@@ -129,7 +134,7 @@ def run(args):
         output_paths.check_audio(args.audio, inputs=[args.protocol, *filter(None, [args.replay_gesture])])
         args.audio = args.audio or "device"
         args.midi = args.midi or "first"
-        link, loop = probe_device(args.device, protocol.rate)
+        link, loop = probe_device(args.device, protocol.rate, protocol)
         if not args.resume:
             args.rig_prediction = rig_check_line(protocol, link, lambda text: print(f"studyapp run: {text}",
                                                                                    file=sys.stderr, flush=True),

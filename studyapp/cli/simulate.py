@@ -90,7 +90,7 @@ def run(args):
     check_playable(rate, check_f0(calibration.F0 if args.f0 is None else args.f0))
     check_source(args.source)
     check_gesture(args.gesture)
-    link = link_options.spec(args)
+    link = link_options.spec(args, rate)
     samples = int(round(args.duration * rate))
     check_disk(args.output, Path(args.output).suffix.lower(), samples, len(recording.COLUMNS))
 

@@ -11,25 +11,28 @@ that serial number and channel::
     velocity = { gain = 1.0e-5, offset = 0.0 }       # (m/s) per count, m/s
     acceleration = { gain = 4.9e-3, offset = 0.0 }   # (m/s^2) per count, m/s^2
 
-Channels not named keep the device's calibration. Every value is checked: a
-gain finite and non-zero, an offset finite, no other key; a bad file is one
-line naming the file, the field and what is allowed.
+Channels not named keep the device's calibration. Each channel's table needs
+both gain and offset (a missing one is named). Every value is checked as
+INFO's are (messages.scale_problem): a gain non-zero, both finite and within
++-1000 SI units (per count), no other key; a bad file is one line naming the
+file, the field and what is allowed. A file with no entry for the device's
+serial is refused, naming both serials: a file made for another rig is never
+silently ignored.
 """
 
-import math
 import tomllib
 
+from studyapp.device import messages
 from studyapp.errors import ParameterError
 
 CHANNELS = ("position", "acceleration", "velocity")  # INFO's channel kinds 0, 1, 2
 FIELDS = ("gain", "offset")
 
 
-def _number(path, where, value, nonzero):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or \
-            (nonzero and value == 0):
-        allowed = "a finite non-zero number" if nonzero else "a finite number"
-        raise ParameterError(f"{path}: {where} = {value!r}: allowed is {allowed}")
+def _number(path, where, field, value):
+    problem = messages.scale_problem(field, value)
+    if problem:
+        raise ParameterError(f"{path}: {where}.{problem}")
     return float(value)
 
 
@@ -53,10 +56,16 @@ def load(path):
             where = f"[{serial!r}].{channel}"
             if channel not in CHANNELS:
                 raise ParameterError(f"{path}: {where}: unknown channel; allowed are {', '.join(CHANNELS)}")
-            if not isinstance(values, dict) or set(values) != set(FIELDS):
+            if not isinstance(values, dict):
                 raise ParameterError(f"{path}: {where}: allowed is a table {{ gain = G, offset = O }}")
-            entry[channel] = (_number(path, f"{where}.gain", values["gain"], True),
-                              _number(path, f"{where}.offset", values["offset"], False))
+            missing = [key for key in FIELDS if key not in values]
+            unknown = sorted(set(values) - set(FIELDS))
+            if missing or unknown:
+                what = f"no {' and no '.join(missing)}" if missing else f"unknown key {unknown[0]!r}"
+                raise ParameterError(f"{path}: {where}: {what}; allowed is a table {{ gain = G, offset = O }}, "
+                                     "both required")
+            entry[channel] = (_number(path, where, "gain", values["gain"]),
+                              _number(path, where, "offset", values["offset"]))
         table[serial] = entry
     return table
 
@@ -70,9 +79,12 @@ def apply(device_channels, serial, path):
     channels = dict(device_channels)
     if path is None:
         return channels, "device"
-    entry = load(path).get(serial)
+    table = load(path)
+    entry = table.get(serial)
     if entry is None:
-        return channels, "device"
+        raise ParameterError(f"--calibration {path}: no entry for the device's serial {serial!r}; the file has "
+                             f"{', '.join(repr(k) for k in table) or 'none'} (a file made for another device "
+                             "is refused, not ignored)")
     for channel, pair in entry.items():
         if channel not in channels:
             raise ParameterError(f"{path}: [{serial!r}].{channel}: the device has no {channel} channel; "

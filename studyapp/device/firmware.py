@@ -16,7 +16,8 @@ START, STOP -> applied, then STATE; FORCE -> stored by tag; KEEPALIVE feeds
 the watchdog. A START whose packet exceeds INFO's max_packet is corrupt.
 While streaming, SENSORS goes out once ``packet`` samples are in, stamped
 with the first one's counter. The safety core's reports go out as FAULT.
-A gap in the host's ``seq`` counts as ``lost``.
+A gap in the host's ``seq`` counts as ``lost``, except at a HELLO, which starts a new
+conversation (a host that reopens the link starts its seq at 0 again).
 """
 
 from studyapp.device import messages
@@ -70,7 +71,7 @@ class Firmware:
         except ProtocolError:
             self.side.corrupt_frame()
             return
-        if self._last_seq is not None:
+        if self._last_seq is not None and not isinstance(message, messages.Hello):  # HELLO: a new conversation
             self.lost += (seq - self._last_seq - 1) & 0xFF
         self._last_seq = seq
         side = self.side

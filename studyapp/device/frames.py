@@ -9,8 +9,8 @@ per started 254 bytes).
 ``FrameReader`` takes the byte stream as it comes (any split) and returns the
 payloads of the frames that check. A run between two delimiters that is not
 a valid frame (bad COBS, a CRC that fails, shorter than type, seq and CRC,
-longer than ``MAX_ENCODED``) is counted in ``corrupt`` and dropped; the
-reader resynchronises on the next 0x00. An empty run (two delimiters in a
+longer than ``MAX_ENCODED``) is counted in ``corrupt`` and dropped (``last_error``
+says why, for a handshake's refusal); the reader resynchronises on the next 0x00. An empty run (two delimiters in a
 row, or one before the first frame) is no frame and not counted: a sender
 may send 0x00 first to end any partial frame at the receiver.
 """
@@ -56,8 +56,10 @@ class FrameReader:
     def __init__(self):
         self._run = bytearray()
         self._overlong = False
+        self._length = 0  # bytes of the current run, an overlong one's too
         self.frames = 0
         self.corrupt = 0
+        self.last_error = None  # why the newest dropped run did not check
 
     def feed(self, data):
         data = bytes(data)
@@ -77,6 +79,7 @@ class FrameReader:
         return payloads
 
     def _append(self, chunk):
+        self._length += len(chunk)
         if self._overlong:
             return
         self._run += chunk
@@ -85,18 +88,21 @@ class FrameReader:
             self._run.clear()
 
     def _finish(self):
-        run, overlong = bytes(self._run), self._overlong
+        run, overlong, length = bytes(self._run), self._overlong, self._length
         self._run.clear()
         self._overlong = False
+        self._length = 0
         if overlong:
             self.corrupt += 1
+            self.last_error = f"frame of {length} bytes: longer than the largest, {MAX_ENCODED}"
             return None
         if not run:
             return None
         try:
             payload = decode(run)
-        except ProtocolError:
+        except ProtocolError as exc:
             self.corrupt += 1
+            self.last_error = str(exc)
             return None
         self.frames += 1
         return payload

@@ -6,9 +6,24 @@ another protocol version, a version 2 device whose loop section does not
 parse or whose loop this host cannot run beside it (``check_loop``), runs at a rate other than the loop's,
 declares force limits above the motor's (model/limits.py: 200 N impulsive,
 60 N sustained), has no position channel, or sends fewer samples per frame
-than asked. A device that does not answer HELLO within ``HELLO_TIMEOUT`` in
-``HELLO_TRIES`` tries is refused too: the whole handshake is bounded (about
-1 s), never a hang.
+than asked. An INFO that does not parse (a name that is not UTF-8, no
+channel, a gain that is not finite, ...: messages.py's checks) is refused
+naming its field and value, not taken for silence. A device that sends no INFO
+within ``HELLO_WAIT`` is refused too (naming the last frame that did not check,
+if one came): the host sends HELLO every ``HELLO_EVERY`` until then, so that
+a board that resets when its port opens (an Arduino's bootloader, 1-2 s) is
+answered once it runs; the whole handshake is bounded, never a hang.
+
+The latency the host answers at (``check_latency``) is at least ``packet``
+samples: a frame leaves the device after its last sample's actuation, so
+under the loop order (docs/device-protocol.md: receive, sample, actuate,
+send) the force for the frame's first sample k, tagged k + latency, can be
+on time only from latency = packet on (with packet - 1 it is always late);
+and at most ``MAX_LATENCY`` = 1024: the device drops a force tagged 1024 or
+more samples ahead of its clock, and the answer to a frame of samples
+k..k+p-1 reaches it at sample k + p at the earliest, its newest force tagged
+k + latency + p - 1, so 1023 ahead at most (tests/device/test_latency_range.py
+measures both ends on the emulator).
 
 Calibration: SI = gain * raw + offset per channel, INFO's own or the lab's
 TOML file's (calibration_file.py); a float64 channel with gain 1 and offset 0
@@ -24,31 +39,33 @@ refusal: a link that loses a handshake frame will not stream.
 import math
 import statistics
 import time
+from collections import namedtuple
 
-from studyapp.device import calibration_file
+from studyapp.device import calibration_file, device_side
 from studyapp.device import loop_messages as lm
 from studyapp.device import messages as msg
 from studyapp.device.errors import ProtocolError
 from studyapp.errors import ParameterError
 
-HELLO_TIMEOUT = 0.4  # s per HELLO
-HELLO_TRIES = 2
+HELLO_WAIT = 3.0  # s the host waits for INFO: an Arduino-style board boots for 1-2 s after its port opens
+HELLO_EVERY = 0.25  # s between HELLOs while waiting (a HELLO sent while the board boots is lost)
 PINGS = 20
 PING_TIMEOUT = 0.2  # s
 CHANNEL_NAMES = calibration_file.CHANNELS  # INFO's channel kinds 0, 1, 2
-MAX_LATENCY = 0xFFFF
+MAX_LATENCY = device_side.RING  # samples: a force then reaches the device at most RING - 1 ahead, which it keeps
 VERSIONS = (msg.PROTOCOL_VERSION, lm.LOOP_VERSION)  # 1: the loop on the host; 2: either side runs it
 
 
-def check_latency(latency):
-    """The latency in samples (1..65535), or ``ParameterError``."""
+def check_latency(latency, packet=1):
+    """The latency in samples (``packet``..``MAX_LATENCY``), or ``ParameterError`` saying why the ends are there."""
     try:
         value = int(latency)
     except (TypeError, ValueError):
         value = 0
-    if value != latency or not 1 <= value <= MAX_LATENCY:
-        raise ParameterError(f"device latency = {latency!r}: allowed is a whole number of samples from 1 to "
-                             f"{MAX_LATENCY}")
+    if value != latency or not packet <= value <= MAX_LATENCY:
+        raise ParameterError(f"device latency = {latency!r}: allowed is a whole number of samples from the packet "
+                             f"({packet}: a force for a frame's first sample is late below it) to {MAX_LATENCY} "
+                             f"(above it the device drops forces tagged {device_side.RING} or more samples ahead)")
     return value
 
 
@@ -106,6 +123,9 @@ class Scales:
         return out["position"], out.get("acceleration", zeros), out.get("velocity", zeros)
 
 
+BadFrame = namedtuple("BadFrame", "what info")  # a frame that did not check while shaking hands; info: an INFO's
+
+
 def _refuse(link, what):
     raise ParameterError(f"device at {link}: {what}; refused")
 
@@ -157,16 +177,26 @@ def scales(info, serial, calibration_path):
 
 
 def greet(send, receive, link, rate, motor_limits, packet, calibration_path):
-    """HELLO until INFO comes (bounded); the checked INFO and its ``Scales``."""
-    for _ in range(HELLO_TRIES):
+    """HELLO every ``HELLO_EVERY`` until INFO comes, for at most ``HELLO_WAIT``; the checked INFO and its ``Scales``.
+
+    ``receive(timeout)`` gives the next message, a ``BadFrame`` or None; an INFO that does not parse is refused at
+    once, naming its field; other frames that do not check (a board's boot noise) are waited through."""
+    end = time.monotonic() + HELLO_WAIT
+    noise = None
+    while time.monotonic() < end:
         send(msg.Hello(protocol_version=msg.PROTOCOL_VERSION))  # HELLO(1), as the protocol has it for both
-        end = time.monotonic() + HELLO_TIMEOUT
-        while (left := end - time.monotonic()) > 0:
+        until = min(end, time.monotonic() + HELLO_EVERY)
+        while (left := until - time.monotonic()) > 0:
             reply = receive(left)
-            if isinstance(reply, msg.Info):
+            if isinstance(reply, BadFrame):
+                if reply.info:
+                    _refuse(link, f"its INFO: {reply.what}")
+                noise = reply.what
+            elif isinstance(reply, msg.Info):
                 check_info(reply, link, rate, motor_limits, packet)
                 return reply, scales(reply, reply.serial, calibration_path)
-    raise ParameterError(f"device at {link}: no answer to HELLO within {HELLO_TRIES * HELLO_TIMEOUT:g} s; "
+    heard = "" if noise is None else f" (the last frame that came did not check: {noise})"
+    raise ParameterError(f"device at {link}: no answer to HELLO within {HELLO_WAIT:g} s{heard}; "
                          "allowed is a device speaking docs/device-protocol.md")
 
 

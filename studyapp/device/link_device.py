@@ -77,8 +77,8 @@ class LinkDevice(HapticDevice):
                  silence=SILENCE):
         self.spec = str(spec)
         self.rate = float(rate)
-        self.latency = handshake.check_latency(latency)
         self.packet = handshake.check_packet(packet)
+        self.latency = handshake.check_latency(latency, self.packet)
         self.calibration_path = calibration
         self.ramp_ms = handshake.check_ramp(ramp_ms)
         self.motor_limits = limits
@@ -191,8 +191,10 @@ class LinkDevice(HapticDevice):
         for payload in self._reader.feed(data):
             try:
                 seq, message = self._parse(payload)
-            except ProtocolError:
+            except ProtocolError as exc:
                 self._reader.corrupt += 1
+                if payload[0] == msg.INFO and not self._streaming:  # the handshake refuses it by its field
+                    self._queue.append(handshake.BadFrame(str(exc), True))
                 continue
             if self._seq_in is not None:
                 gap = (seq - self._seq_in - 1) & 0xFF

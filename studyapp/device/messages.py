@@ -47,8 +47,23 @@ MAX_FORCES = 64
 TEXT_MAX = 32
 MAX_CHANNELS = 8
 PAYLOAD_MAX = 1024
+GAIN_MAX = 1e3  # SI units per count (m, m/s^2, m/s): a sensor's count is nm to mm, never a kilometre
+OFFSET_MAX = 1e3  # SI units
 HEADER = struct.Struct("<BB")
 SENSORS_HEADER = struct.Struct("<IBB")
+
+
+def scale_problem(field, value):
+    """None if ``value`` is a usable calibration ``field`` ("gain" or "offset"), else ``"field = value: allowed ..."``.
+
+    SI = gain x raw + offset: a gain of 0 makes every sample 0, and bounds keep a count channel's SI values finite
+    and physical (a gain of -1e300 with an offset of 1e300 overflows or cancels to nonsense)."""
+    bound = GAIN_MAX if field == "gain" else OFFSET_MAX
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if number and math.isfinite(value) and abs(value) <= bound and (value != 0 or field == "offset"):
+        return None
+    what = f"a number from -{bound:g} to {bound:g}" + (", not 0" if field == "gain" else "")
+    return f"{field} = {value!r}: allowed is {what} (SI units{' per count' if field == 'gain' else ''})"
 
 
 def _check(ok, name, value, allowed):
@@ -246,8 +261,9 @@ class Channel:
     def check(self, i=0):
         _check(self.kind in KIND_NAMES, f"INFO.channel[{i}].kind", self.kind, "0 position, 1 acceleration, 2 velocity")
         _check(self.format in FORMAT_CODES, f"INFO.channel[{i}].format", self.format, "0 f64, 1 i32, 2 i16")
-        _check_finite(f"INFO.channel[{i}].gain", self.gain)
-        _check_finite(f"INFO.channel[{i}].offset", self.offset)
+        problem = scale_problem("gain", self.gain) or scale_problem("offset", self.offset)
+        if problem:
+            raise ProtocolError(f"INFO.channel[{i}].{problem}")
         if self.format == F64:
             _check(self.gain == 1.0 and self.offset == 0.0, f"INFO.channel[{i}] gain, offset",
                    (self.gain, self.offset), "1 and 0 for an f64 channel (it is sent in SI)")

@@ -148,7 +148,7 @@ class DevicePanel(QWidget):
     # the rig check ---------------------------------------------------------------------------------
     def show_predicting(self, rig):
         self.table.setVisible(False)
-        self.check.setText(f"predicting the bowing breakdown at {rig.latency_ms:.2f} ms latency ({rig.words})…")
+        self.check.setText(f"predicting the bowing breakdown at {rig.latency_words} of latency ({rig.words})…")
         self.progress.setRange(0, 0)
         self.progress.setVisible(True)
 
@@ -173,5 +173,5 @@ class DevicePanel(QWidget):
         self.table.setFixedHeight(height + 2 * self.table.frameWidth())
         self.table.setVisible(True)
         colour = "#c00" if verdict.warns else "#070"
-        self.check.setText(f"predicted at {verdict.rig.latency_ms:.2f} ms latency ({verdict.rig.words}): "
+        self.check.setText(f"predicted at {verdict.rig.latency_words} of latency ({verdict.rig.words}): "
                            f"<span style='color:{colour}'>{verdict.text}</span>")

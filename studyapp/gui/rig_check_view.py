@@ -70,7 +70,7 @@ class RigCheckView:
         if prediction is None:
             if not rig_check.needs_check(req.rig):
                 return ()
-            text = (f"The rig check (the model's bowing breakdown at this rig's {req.rig.latency_ms:.2f} ms link "
+            text = (f"The rig check (the model's bowing breakdown at this rig's {req.rig.latency_words} link "
                     "latency) is still running. Start the session without it?")
         else:
             verdict = rig_check.verdict(prediction, req.rig)

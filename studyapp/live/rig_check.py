@@ -59,11 +59,16 @@ class Rig:
             return "the loop runs on the device: the paper's own loop (latency 0)"
         if self.kind == SIMULATED:
             return "the simulated device: the paper's own loop (latency 0)"
-        return f"the loop runs on the host, {self.latency_ms:.2f} ms across the link"
+        return f"the loop runs on the host, {self.latency_words} across the link"
 
     @property
     def latency_ms(self):
         return 1e3 * self.latency
+
+    @property
+    def latency_words(self):
+        """The link's latency as every command line counts it, samples, with its ms beside (issue 41 item 6)."""
+        return f"{self.latency_samples} samples ({self.latency_ms:.2f} ms)"
 
 
 def rig_of(config, loop=None):
@@ -150,8 +155,8 @@ class Verdict:
         """The warning line before an adjustment-task session (None when the rig keeps the effect)."""
         if not self.warns:
             return None
-        return (f"warning: at this rig's link latency of {self.rig.latency_ms:.2f} ms "
-                f"({self.rig.latency_samples} samples at {self.rig.rate:g} Hz) the model predicts LVT's bowing "
+        return (f"warning: at this rig's link latency of {self.rig.latency_samples} samples "
+                f"({self.rig.latency_ms:.2f} ms at {self.rig.rate:g} Hz) the model predicts LVT's bowing "
                 f"breakdown at {self.margin:.2f}x the best estimator's ({self.best}), below {MARGIN:g}x: the "
                 "paper's effect (LVT nearly twice the estimators) is not expected on this rig (docs/devices.md)")
 

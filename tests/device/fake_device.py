@@ -5,6 +5,9 @@ unless asked. ``FakeDevice(info=..., hello=True)`` opens a pty in this process
 and serves it from a thread; ``path`` is the slave's name. After START it sends
 the SENSORS frames the test pushes with ``sensors(sample, rows)`` or raw
 bytes with ``raw(data)``, and records every host message in ``received``.
+``reply``: wire bytes sent for every HELLO instead of INFO (a malicious INFO);
+``boot``: seconds after the first host byte during which HELLO goes unanswered
+(a board that resets when its port opens), ``noise`` written once then.
 """
 
 import os
@@ -22,9 +25,13 @@ INFO = messages.Info(protocol_version=1, firmware_major=0, firmware_minor=1, rat
 
 
 class FakeDevice:
-    def __init__(self, info=INFO, hello=True):
+    def __init__(self, info=INFO, hello=True, reply=None, boot=0.0, noise=b""):
         self.info = info
         self.hello = hello
+        self.reply = reply
+        self.boot = boot
+        self.noise = noise
+        self._woken = None  # time.monotonic() of the first host byte
         self.master, slave = os.openpty()
         tty.setraw(slave)
         self.path = os.ttyname(slave)
@@ -46,10 +53,18 @@ class FakeDevice:
             except OSError:
                 time.sleep(0.001)  # no slave open yet (EIO)
                 continue
+            if self._woken is None:
+                self._woken = time.monotonic()
+                if self.noise:
+                    self.raw(self.noise)
             for payload in self._reader.feed(data):
                 _, message = messages.parse(payload)
                 self.received.append(message)
-                if isinstance(message, messages.Hello) and self.hello:
+                if time.monotonic() - self._woken < self.boot:
+                    continue
+                if isinstance(message, messages.Hello) and self.reply is not None:
+                    self.raw(self.reply)
+                elif isinstance(message, messages.Hello) and self.hello:
                     self.send(self.info)
                 elif isinstance(message, messages.Ping):
                     self.send(messages.Pong(nonce=message.nonce, sample=0))

@@ -101,7 +101,7 @@ def test_the_panel_shows_the_device_the_prediction_and_start_warns(device_consol
     assert stored == {"kind": "link", "link": "/tmp/studyapp-device", "info": INFO}
     events = [json.loads(line) for line in (session.folder / "events.jsonl").read_text().splitlines()]
     check = next(e for e in events if e["type"] == "rig_check")
-    assert check["started_anyway"] and check["warning"].startswith("warning: at this rig's link latency of 1.00 ms")
+    assert check["started_anyway"] and check["warning"].startswith("warning: at this rig's link latency of 5 samples (1.00 ms")
     assert check["prediction"] == AT_1MS and check["lvt_margin"] == pytest.approx(3.09 / 2.89)
 
 

@@ -37,7 +37,7 @@ def test_the_rig_of_an_engine_config():
     link = rig_check.rig_of(EngineConfig(rate=5000.0, device="/tmp/dev", device_latency=5))
     assert link.kind == "link" and link.latency == pytest.approx(1e-3) and link.latency_ms == pytest.approx(1.0)
     assert rig_check.needs_check(link)
-    assert "on the host, 1.00 ms across the link" in link.words
+    assert "on the host, 5 samples (1.00 ms) across the link" in link.words
 
 
 def test_a_device_that_runs_the_loop_is_the_papers_own_loop():
@@ -69,7 +69,7 @@ def test_the_verdict_its_text_and_warning_line():
     assert not keeps.warns and keeps.warning is None and "at least 1.5x" in keeps.text
     warns = rig_check.verdict({"LOWPASS": 2.85, "KALLEV": 2.46, "LVT": 3.09}, rig)
     assert warns.warns and warns.margin == pytest.approx(3.09 / 2.85)
-    assert warns.warning == ("warning: at this rig's link latency of 1.00 ms (5 samples at 5000 Hz) the model "
+    assert warns.warning == ("warning: at this rig's link latency of 5 samples (1.00 ms at 5000 Hz) the model "
                              "predicts LVT's bowing breakdown at 1.08x the best estimator's (LOWPASS), below 1.5x: "
                              "the paper's effect (LVT nearly twice the estimators) is not expected on this rig "
                              "(docs/devices.md)")

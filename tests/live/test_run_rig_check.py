@@ -21,7 +21,7 @@ def test_run_prints_the_warning_line_on_a_link_and_nothing_on_the_simulated_devi
     protocol = load_protocol(DEMO)
     req, prediction, warning = rig_check_line(protocol, "/tmp/studyapp-device", said.append)
     assert req.rig.latency_ms == 1.0 and prediction["LVT"] == 3.09
-    assert warning == said[-1] and warning.startswith("warning: at this rig's link latency of 1.00 ms (5 samples")
+    assert warning == said[-1] and warning.startswith("warning: at this rig's link latency of 5 samples (1.00 ms")
     assert "below 1.5x" in said[-2]
     said.clear()
     assert rig_check_line(protocol, None, said.append) is None and said == []
@@ -40,9 +40,21 @@ def test_device_is_refused_headless(tmp_path):
                            "--simulated-participant", "--headless", "--device", "/tmp/x", "--results",
                            str(tmp_path)], capture_output=True, text=True, timeout=300, cwd=ROOT,
                           env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
-    assert proc.returncode == 2 and proc.stderr.strip().splitlines()[-1].endswith(
-        "--device: allowed only without --headless (the console's)")
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and lines[0].endswith(
+        "--device /tmp/x: allowed with --headless is only simulated: a headless session steps the simulated device "
+        "as fast as it can, and a device on a link runs on its own clock; run it without --headless (the console)")
     assert not any(tmp_path.iterdir())
+
+
+def test_run_help_says_why_a_device_is_refused_headless():
+    """Issue 41 item 12: ``--help`` did not say that ``--headless --device`` is refused."""
+    proc = subprocess.run([sys.executable, "-m", "studyapp", "run", "--help"], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    text = " ".join(proc.stdout.split())
+    assert proc.returncode == 0
+    assert ("(the console's; not with --headless: a headless session steps the simulated device as fast as it can, "
+            "and a device on a link runs on its own clock)") in text
 
 
 def test_a_device_that_is_no_link_is_one_line_before_anything_starts(tmp_path):

@@ -124,10 +124,11 @@ def test_first_seed_gives_the_same_seeds_the_same_values(tmp_path, capsys):
     (["--source", "LVT", "--duration", "0"], "--duration 0.0: allowed is a number of seconds from 0.5 to 60"),
     (["--source", "LVT", "--windows", "ms"], "--windows 'ms': allowed are seconds, samples"),
     (["--source", "LVT", "--all"], "not allowed with argument"),
-    (["--source", "LVT", "--latency", "-0.001"], "--latency -0.001: allowed is a number of seconds from 0 to 1"),
-    (["--source", "LVT", "--packet", "2"], "--packet 2.0: allowed is a number of seconds from 0 to 1"),
-    (["--source", "LVT", "--jitter", "nan"], "argument --jitter: 'nan' is not a finite number"),
-    (["--source", "LVT", "--latency", "1ms"], "argument --latency: invalid float value: '1ms'"),
+    (["--source", "LVT", "--latency", "-1"], "--latency -1: allowed is a whole number of samples from 0 to 5000"),
+    (["--source", "LVT", "--packet", "0.001"], "--packet 0.001: allowed is a whole number of samples from 0 to 5000 "
+                                               "(1 s at 5000 Hz); 0.001 s would be 5"),
+    (["--source", "LVT", "--jitter", "nan"], "--jitter nan: allowed is a whole number of samples"),
+    (["--source", "LVT", "--latency", "1ms"], "--latency '1ms': allowed is a whole number of samples"),
     ([], "one of the arguments --source --all is required"),
 ])
 def test_bad_input_is_one_line_exit_2_and_no_file(never_broken, tmp_path, capsys, argv, words):

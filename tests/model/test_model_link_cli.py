@@ -1,5 +1,6 @@
-"""``--latency``, ``--packet``, ``--jitter`` on ``breakdown`` and ``simulate`` (issue 29 item 1): the outputs say
-the link, bad values are one line and exit 2 with nothing written; the console's prediction function."""
+"""``--latency``, ``--packet``, ``--jitter`` on ``breakdown`` and ``simulate`` (issue 29 item 1), in samples as on
+every command line (issue 41 item 6: they were seconds here, samples in ``live`` and ``bench``): the outputs say the
+link, bad values are one line and exit 2 with nothing written; the console's prediction function."""
 
 import csv
 import json
@@ -12,7 +13,7 @@ from studyapp.io import recording
 from studyapp.model import breakdown, link_prediction
 from studyapp.model.link import LinkSpec
 
-LINK = ["--latency", "0.0004", "--packet", "0.001", "--jitter", "0.0002"]
+LINK = ["--latency", "2", "--packet", "5", "--jitter", "1"]  # samples at 5 kHz: 0.4 ms, 1 ms, 0.2 ms
 
 
 @pytest.fixture
@@ -39,15 +40,16 @@ def test_breakdown_outputs_say_the_link(seen_links, tmp_path, capsys):
     assert [float(row[k]) for k in ("latency", "packet", "jitter")] == [0.0004, 0.001, 0.0002]
     assert main(["breakdown", "--source", "LVT", "--seeds", "2", *LINK, "-o", str(out_md)]) == 0
     text = out_md.read_text()
-    assert "behind a link (`studyapp.model.link`): latency 0.4 ms, packet 1 ms, jitter 0.2 ms." in text
-    assert "--latency 0.0004 --packet 0.001 --jitter 0.0002 -o" in text  # the command that regenerates it
+    assert ("behind a link (`studyapp.model.link`): latency 2 samples (0.4 ms), packet 5 samples (1 ms), jitter 1 "
+            "samples (0.2 ms).") in text
+    assert "--latency 2 --packet 5 --jitter 1 -o" in text  # the command that regenerates it
     assert main(["breakdown", "--source", "LVT", "--seeds", "1", "-o", str(out_md)]) == 0
     assert "on an ideal link" in out_md.read_text() and "--latency" not in out_md.read_text()
 
 
 def test_simulate_records_the_link_in_the_metadata(tmp_path):
     out = tmp_path / "s.npz"
-    assert main(["simulate", "--fmax", "2", "--duration", "0.05", "--latency", "0.0002", "--packet", "0.001",
+    assert main(["simulate", "--fmax", "2", "--duration", "0.05", "--latency", "1", "--packet", "5",
                  "-o", str(out)]) == 0
     link = recording.load(out).meta["link"]
     assert link == {"latency": 0.0002, "packet": 0.001, "jitter": 0.0, "loss": 0.0, "latency_samples": 1,
@@ -57,10 +59,14 @@ def test_simulate_records_the_link_in_the_metadata(tmp_path):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["--latency", "-1"], "--latency -1.0: allowed is a number of seconds from 0 to 1"),
-    (["--packet", "5"], "--packet 5.0: allowed is a number of seconds from 0 to 1"),
-    (["--jitter", "inf"], "argument --jitter: 'inf' is not a finite number"),
-    (["--latency", "soon"], "argument --latency: invalid float value: 'soon'"),
+    (["--latency", "-1"], "--latency -1: allowed is a whole number of samples from 0 to 5000 (1 s at 5000 Hz)"),
+    (["--packet", "5001"], "--packet 5001: allowed is a whole number of samples from 0 to 5000"),
+    (["--jitter", "inf"], "--jitter inf: allowed is a whole number of samples"),
+    (["--latency", "soon"], "--latency 'soon': allowed is a whole number of samples"),
+    (["--latency", "0.0004"], "--latency 0.0004: allowed is a whole number of samples from 0 to 5000 (1 s at 5000 Hz); "
+                              "0.0004 s would be 2"),
+    (["--rate", "10000", "--packet", "2.5"], "--packet 2.5: allowed is a whole number of samples from 0 to 10000 (1 s "
+                                             "at 10000 Hz)"),
 ])
 def test_simulate_refuses_bad_link_values(tmp_path, capsys, argv, words):
     assert main(["simulate", "--duration", "0.05", *argv, "-o", str(tmp_path / "s.npz")]) == 2
