@@ -49,11 +49,13 @@ figures: $(STAMP)
 	PYTHONPATH=. $(PY) scripts/regenerate_figures.py -o $(FIGURES) $(if $(ONLY),--only $(ONLY)) $(if $(CHECK),--check)
 
 # the loop on an ARM Cortex-M7 under qemu (docs/firmware-arm.md): installs the cross compiler, newlib and
-# qemu-system-arm (scripts/system-deps-arm.txt, about 800 MB; only here: setup and CI never do), then compares
-# the ARM loop with this machine's bit for bit and counts its instructions: make arm [ARGS="--seconds 2"]
+# qemu-system-arm (scripts/system-deps-arm.txt, about 800 MB; only here: setup and CI never do), runs its tests
+# (make test skips the qemu ones), then compares the ARM loop with this machine's bit for bit and counts its
+# instructions: make arm [ARGS="--seconds 2"]
 arm: $(STAMP)
 	@scripts/install-system-deps scripts/system-deps-arm.txt
 	$(VENV)/bin/studyapp compile
+	STUDYAPP_ARM=1 $(PY) -m pytest -q tests/device/test_arm_loop.py
 	PYTHONPATH=. $(PY) scripts/arm_loop.py $(ARGS)
 	PYTHONPATH=. $(PY) scripts/arm_insn_mix.py
 
