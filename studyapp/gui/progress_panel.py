@@ -48,9 +48,10 @@ class ProgressPanel(QGroupBox):
         p.addWidget(self.response_label)
         p.addWidget(self.pickup_label)
 
-    def show_state(self, state, stopped_by="operator"):
+    def show_state(self, state, stop_text=STATE_WORDS[State.EMERGENCY]):
+        """``stop_text``: what holds the force while the state is EMERGENCY (the controller's ``stop_text``)."""
         emergency = state == State.EMERGENCY
-        self.state_label.setText(force_off_text(stopped_by) if emergency else STATE_WORDS[state])
+        self.state_label.setText(stop_text if emergency else STATE_WORDS[state])
         self.state_label.setStyleSheet("font-weight: bold;" + (" color: #c00;" if emergency else ""))
         if state in REST:
             self.task_label.setText("")

@@ -47,6 +47,7 @@ from pathlib import Path
 from studyapp.engine.config import HANG_TIMEOUT
 from studyapp.engine.events import DeviceHealth, DeviceInfo
 from studyapp.engine.load_margin import busy_warning, load_per_core
+from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.enrolment import apparatus_is_simulated, check_same_player
@@ -92,7 +93,8 @@ class SessionController:
         self.fed = 0  # end (sample number) of the telemetry read while a trial ran
         self.trial_serial = 0  # counts steps started (restarts too); tags the step's samples and controls
         self.sound = MasterSound()  # the console's master volume and mute (master_sound.py)
-        self.stopped_by = "operator"  # who pressed the emergency stop last (states.emergency)
+        self.stopped_by = "operator"  # who pressed the emergency stop last (states.emergency), or "fault"
+        self.fault = ""  # the fault the engine latched on its own that stopped the session (states.fault_stop)
         self.simulated = False  # the simulated participant plays the session (apparatus "participant")
         self.abort_reason = None  # why the session is being aborted, when not the experimenter's Abort
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
@@ -221,6 +223,21 @@ class SessionController:
         ``by``: who stopped, ``operator`` (the console) or ``participant`` (Esc on the participant's window)."""
         self.stopped_by = by
         self.fire("emergency")
+
+    def fault_stop(self, fault):
+        """The engine latched ``fault`` on its own during a session: the session stops as for the emergency stop."""
+        if self.state in (State.RUNNING, State.PAUSED):
+            self.stopped_by, self.fault = "fault", str(fault)
+            self.fire("fault")
+
+    @property
+    def stop_text(self):
+        """What holds the force at zero, and what to do, in the experimenter's words (the EMERGENCY state's)."""
+        if self.stopped_by != "fault":
+            return force_off_text(self.stopped_by)
+        return (f"Stopped by a fault: {self.fault or 'the engine latched a fault'}. Force off, nothing sounds. "
+                "Check the device (powered, connected), then press Resume: it re-arms the device, reopens its link "
+                "if it had gone, and repeats the trial")
 
     def clear_emergency(self):
         """Unlatch the emergency stop (the experimenter's decision); a session's trial then starts again."""

@@ -61,6 +61,8 @@ EXPECTED = {
     (S.CLEARING, "cleared"): S.RUNNING,
     (S.CLEARING, "clear_timeout"): S.EMERGENCY,  # the worker never confirmed: the stop holds again
     (S.CLEARING, "engine_failed"): S.ENGINE_LOST,
+    (S.RUNNING, "fault"): S.EMERGENCY,  # the engine latched a fault of its own (a device's): the session stops
+    (S.PAUSED, "fault"): S.EMERGENCY,
 }
 
 
@@ -163,6 +165,10 @@ def take(c, state, event):
     elif event == "cleared":
         c.host.engine.latched = False
         c.poll()
+    elif event == "fault":  # the worker latches a fault, its force word still set: not a stop
+        c.host.engine.latched = True
+        c.status_watch.next_status = 0.0
+        c.poll()
     elif event == "clear_timeout":
         c.host.engine.latched = True  # the worker never confirms the clear
         started = c.clock()
@@ -171,6 +177,29 @@ def take(c, state, event):
     else:
         {"abort": c.abort, "pause": c.pause, "resume": c.resume, "emergency": c.emergency_stop,
          "clear": c.clear_emergency, "restart": c.restart_engine, "done": lambda: c.fire("done")}[event]()
+
+
+def test_a_fault_of_the_engines_own_stops_the_session_says_so_and_resume_repeats_the_trial(controller):
+    # issue 41, item 7: on main a device fault left the session "Running" with no force
+    c = controller
+    messages = []
+    c.events.message.connect(lambda text, level, topic: messages.append((level, text)))
+    start(c)
+    up(c)
+    c.host.engine.latched = True
+    c.status_watch.next_status = 0.0
+    c.poll()
+    assert c.state == S.EMERGENCY and c.stopped_by == "fault"
+    assert c.stop_text.startswith("Stopped by a fault:") and "press Resume" in c.stop_text
+    assert ("error", c.stop_text) in messages
+    assert not c.accepting  # no knob or pad is taken against a force that is off
+    c.clear_emergency()
+    assert c.state == S.CLEARING
+    c.host.engine.latched = False
+    c.poll()
+    assert c.state == S.RUNNING
+    c.emergency_stop()  # the operator's stop afterwards reads as the operator's
+    assert c.stop_text.startswith("Emergency stop (operator)")
 
 
 def test_a_clear_the_worker_never_confirms_gives_the_stop_back_instead_of_clearing_for_good(controller):
