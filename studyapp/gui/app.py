@@ -99,7 +99,7 @@ def main(args):
     controller, console = build(args)
     size = getattr(args, "size", None)
     if size is not None:
-        console.resize(*size)
+        console.set_size(*size)
     console.show()
     if screen is not None:
         place(console, screen)  # never over the console's session buttons (participant_placement.py)

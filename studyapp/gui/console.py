@@ -1,11 +1,11 @@
 """The experimenter console: one window to set up, run, watch and stop a study session.
 
-Left: session set-up and the apparatus found, and the session's progress
-(task, trial x of y, the page the participant sees with the headphone level
-check's confirm (``PageControls``), the current condition), the run sheet,
-notes and master volume (``SessionTools``), in a scroll area; below them,
-always in view, the tick that hides the condition (blinding), the session's
-buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
+Left: session set-up and the apparatus found, the run sheet, notes and
+master volume (``SessionTools``), in a scroll area; below them, always in
+view, the session's progress (its state, task, trial x of y, the current
+condition), the tick that hides the condition (blinding), the page the
+participant sees with the headphone level check's confirm (``PageControls``),
+the session's buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
 scope with the on-screen knobs and pads and the bowing pad; the analysis view
 (``AnalysisView``) of a results folder; the session's log. Bottom: the status
 bar (loop rate, load, deadline misses, audio underruns, faults, scope frame
@@ -121,7 +121,6 @@ class Console(QMainWindow):
         dv = QVBoxLayout(details)
         dv.setContentsMargins(0, 0, 0, 0)
         dv.addWidget(self.setup)
-        dv.addWidget(self.progress)
         self.tools = SessionTools(controller, self.setup, self.blind.isChecked)  # run sheet, notes, sound
         dv.addWidget(self.tools)
         dv.addStretch(1)
@@ -135,6 +134,7 @@ class Console(QMainWindow):
         self.left_column = left  # the set-up, progress and session buttons: never covered by the participant
         lv = QVBoxLayout(left)
         lv.addWidget(scroll, 1)
+        lv.addWidget(self.progress)  # in view without scrolling: a tall rig check above never hides it
         lv.addWidget(self.blind)  # in view without scrolling, at 1,366 x 768 too
         lv.addWidget(self.page_controls)  # the level check's confirm stays in view, as the buttons do
         lv.addWidget(self.buttons)
@@ -219,6 +219,11 @@ class Console(QMainWindow):
         small = (width, height) != PREFERRED_SIZE
         self.setWindowState(self.windowState() | Qt.WindowState.WindowMaximized if small
                             else self.windowState() & ~Qt.WindowState.WindowMaximized)
+
+    def set_size(self, width, height):
+        """``width`` x ``height`` px, not maximised (``studyapp gui --size``: offscreen too, whose screen is smaller)."""
+        self.setWindowState(self.windowState() & ~Qt.WindowState.WindowMaximized)
+        self.resize(width, height)
 
     def keyPressEvent(self, event):
         if event.key() == Qt.Key.Key_Space:  # the participant's space bar: the bow, never a button
@@ -334,7 +339,7 @@ class Console(QMainWindow):
 
     def _on_state(self, state):
         emergency = state == State.EMERGENCY
-        self.progress.show_state(state, self.controller.stopped_by)
+        self.progress.show_state(state, self.controller.stop_text)
         active = self.controller.in_session
         self.buttons.show_state(state, active)
         self.setup.set_editable(not active)
