@@ -21,6 +21,7 @@ the session (pause is a deliberate click); a space press that reaches the
 console goes to the participant's bow instead, as in the participant's
 window.
 
+*File > Quit* (Ctrl+Q) closes the console as its window's close button does.
 Abort, and closing the console, while a session runs ask first (``confirm``;
 ``abort_session(confirm=False)``, the default, is the programmatic abort, and
 ``shut_down()`` closes without asking).
@@ -53,6 +54,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from studyapp.engine.worker import TIMER_TAKES_OVER
 from studyapp.errors import UserError
 from studyapp.experiment.tasks import task_type
 from studyapp.gui.analysis_view import AnalysisView
@@ -89,6 +91,7 @@ class Console(QMainWindow):
         self.confirmation = None
         self._typed = None  # the session fields as typed, while a resumed session shows its own
         self._midi_shown = None
+        self._engine_info = {}  # the running engine's info, its pacing as it is now
         self.caller = GuiThreadCaller(self)
         self.setWindowTitle("studyapp — experimenter console")
 
@@ -175,6 +178,10 @@ class Console(QMainWindow):
         self.show_participant.toggled.connect(self.participant_window.setVisible)
         analyse = QAction("Analyse the results folder", self)
         analyse.triggered.connect(self.analyse_results)
+        self.quit_action = QAction("&Quit", self)  # asks first while a session runs (closeEvent)
+        self.quit_action.setShortcut(QKeySequence("Ctrl+Q"))
+        self.quit_action.triggered.connect(self.close)
+        self.menuBar().addMenu("&File").addAction(self.quit_action)
         view_menu = self.menuBar().addMenu("&View")
         view_menu.addAction(self.show_participant)
         view_menu.addAction(analyse)
@@ -330,6 +337,7 @@ class Console(QMainWindow):
         if state == "starting":
             self.notices = {}
             self._midi_shown = None
+        self._engine_info = dict(info) if state == "running" else {}
         self.setup.show_engine(state, info, config, self.notices)
         self.rig.engine_state(state)
         self.status.show_engine(state, info)
@@ -390,6 +398,10 @@ class Console(QMainWindow):
     def _on_message(self, text, level, topic):
         if topic:
             self.notices[topic] = text
+        if TIMER_TAKES_OVER in text and self._engine_info:  # the pacing line follows the clock in charge
+            self._engine_info = {**self._engine_info, "paced": "timer"}
+            self.setup.show_pacing("timer", text)
+            self.status.show_engine("running", self._engine_info)
         self.log.appendPlainText(("[fault] " if level == "error" else "") + text)
         if level in COLOURS:
             self.status.show_message(text, MESSAGE_MS, COLOURS[level])

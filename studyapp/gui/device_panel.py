@@ -148,8 +148,8 @@ class DevicePanel(QWidget):
         text = "<br>".join(lines)
         self.summary.setText(f"{text}<br><span style='color:#a60'>{risk}</span>" if risk else text)
 
-    def show_health(self, trial, health, totals):
-        self.health.setText(device_words.health(trial, health))
+    def show_health(self, trial, health, totals, where=None):
+        self.health.setText(device_words.health(where or f"trial {trial}", health))
 
     # the rig check ---------------------------------------------------------------------------------
     def show_predicting(self, rig):

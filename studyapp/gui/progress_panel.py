@@ -70,7 +70,9 @@ class ProgressPanel(QGroupBox):
         self._tidy()
 
     def show_trial(self, trial, step, total, phase, number, of):
-        self.task_label.setText("Task: " + task_type(trial.task).heading(trial))
+        # a practice trial is no repetition of the study's ("adjustment, repetition 2" on practice: issue 41)
+        heading = f"{trial.task}, practice" if phase == "practice" else task_type(trial.task).heading(trial)
+        self.task_label.setText("Task: " + heading)
         counted = "" if phase == "page" else f"{'Practice' if phase == 'practice' else 'Trial'} {number} of {of}, "
         self.trial_label.setText(f"{counted}step {step + 1} of {total}")
         self.progress_bar.setRange(0, total)

@@ -13,6 +13,7 @@ from studyapp.engine.events import DeviceInfo
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.session import SIMULATED_DEVICE
+from studyapp.live import device_words
 from studyapp.live.apparatus import preview_actions
 from studyapp.live.rig_check import rig_of
 
@@ -21,6 +22,7 @@ class Devices:
     def __init__(self, live):
         self.live = live
         self.info = None  # the link device's latest handshake (DeviceInfo), None on the simulated device
+        self.steps = {}  # the engine's trial tag -> the session's step it tags (steps.py), for the health line
 
     def choose(self, device):
         live = self.live
@@ -38,7 +40,9 @@ class Devices:
             self.info = dict(record.info)
             live.events.device.emit(info=self.info)
             return
-        live.events.device_health.emit(trial=record.trial, health=record.health, totals=record.totals)
+        session = live.session
+        where = device_words.step_words(record.trial, self.steps, len(session.schedule) if session else 0)
+        live.events.device_health.emit(trial=record.trial, health=record.health, totals=record.totals, where=where)
         if live.runner is not None:
             live.runner.log(records.device_health(record.trial, record.health, record.totals))
 

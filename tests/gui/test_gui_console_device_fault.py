@@ -9,6 +9,7 @@ against nothing, and one Resume on the restarted emulator re-arms it, reopens th
 
 import json
 import signal
+import time
 
 import pytest
 
@@ -49,6 +50,7 @@ def test_a_device_fault_stops_the_session_and_one_resume_on_the_restarted_emulat
         console.set_bowing(True)
         wait_until(qapp, lambda: controller.runner.task.fmax > 0, 30)
 
+        faulted_at = time.monotonic()
         if end == "killed":  # the device gone at once: the host latches the link's fault
             emulator.signal(signal.SIGKILL)
             emulator.kill()
@@ -64,6 +66,9 @@ def test_a_device_fault_stops_the_session_and_one_resume_on_the_restarted_emulat
         assert said.startswith("Stopped by a fault:") and "press Resume" in said, said
         assert console.progress.state_label.wordWrap()  # the whole text, never cut
         assert console.pause_button.text() == "Resume" and console.pause_button.isEnabled()
+        # the pacing line follows the timer taking over (it read "paced by the device" to the end: item 12)
+        wait_until(qapp, lambda: "paced by the timer" in console.setup.engine.text(), 10)
+        assert "timer-paced" in console.status.labels["engine"].text()
         log_before = console.log.toPlainText()
         console.press_pad(0)  # a confirm while the force is off: not taken, so not refused as "listen longer"
         qapp.processEvents()
@@ -77,11 +82,15 @@ def test_a_device_fault_stops_the_session_and_one_resume_on_the_restarted_emulat
         assert "did not confirm the clear" not in console.log.toPlainText()
         assert not controller.engine.status()["fault_latched"]
         step = controller.runner.trial.step
+        health = console.device_panel.health.text()
+        assert health and "trial -" not in health, health  # a held page named by its step, never "trial -5"
     finally:
         console.shut_down()
         emulator.kill()
     events = [json.loads(line) for line in (session.folder / "events.jsonl").read_text().splitlines()]
     stop = next(e for e in events if e["type"] == "emergency_stop")
     assert stop["by"] == "fault" and stop["fault"]
+    # logged as the console sees the fault, not tens of seconds later (item 12: about 43 s late)
+    assert stop["mono"] - faulted_at < 5.0, stop["mono"] - faulted_at
     assert any(e["type"] == "emergency_clear" for e in events)
     assert step == 0  # the trial repeated, not skipped
