@@ -58,9 +58,16 @@ def rig_check_line(protocol, device, say, loop=None):
         if rig.kind == rig_check.DEVICE_LOOP:
             say(f"rig check: {rig.words}; LVT's margin is the model's own, nothing to predict")
         return None
-    say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_ms:.2f} ms "
-        "link latency (the model, 5 seeds)…")
-    prediction = rig_check.predict(req)
+    cache = rig_check.PredictionCache(rig_check.cache_path())
+    prediction = cache.get(req)
+    if prediction is None:
+        say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at "
+            f"{rig.latency_ms:.2f} ms link latency (the model, 5 seeds)…")
+        prediction = rig_check.predict(req)
+        cache.put(req, prediction)
+    else:
+        say(f"rig check: the prediction at {rig.latency_ms:.2f} ms link latency kept from an earlier launch "
+            f"({rig_check.cache_path()})")
     verdict = rig_check.verdict(prediction, rig)
     say(f"rig check: {verdict.text}")
     if verdict.warning is not None:

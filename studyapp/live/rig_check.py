@@ -25,12 +25,17 @@ console's question at Start and in ``studyapp run``'s progress).
 A protocol without an adjustment task, or without LVT or another estimator in
 it, has nothing to check (``request`` is None / the margin is nan: no
 warning). ``PredictionCache`` keeps each result per ``Request.key``:
-(protocol hash, latency, packet, rate).
+(protocol hash, latency, packet, rate), in memory and, for ``predict``'s own
+results, on disk (``cache_path``) so a relaunch does not compute it again.
 """
 
+import json
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
+from studyapp.io.atomic import atomic_open
 from studyapp.model import link_prediction
 from studyapp.model.link_prediction import MARGIN
 from studyapp.model.sources import LVT_SENSOR, TRUE
@@ -175,14 +180,57 @@ def rows(prediction):
     return [(name, "stable to 200 N" if math.isinf(v) else f"{v:.2f} N") for name, v in ordered]
 
 
-class PredictionCache:
-    """Predictions kept per ``Request.key`` (protocol hash, latency, packet, rate)."""
+def cache_path():
+    """The predictions kept between launches: ``$STUDYAPP_RIG_PREDICTIONS`` (a file; the tests' own), else
+    ``$XDG_CACHE_HOME/studyapp/rig_predictions.json`` (~/.cache)."""
+    given = os.environ.get("STUDYAPP_RIG_PREDICTIONS")
+    if given:
+        return Path(given)
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "studyapp" / "rig_predictions.json"
 
-    def __init__(self):
+
+class PredictionCache:
+    """Predictions kept per ``Request.key`` (protocol hash, latency, packet, rate); with a ``path``, on disk too.
+
+    The file (JSON, written whole: io/atomic.py) is read at start and written at each ``put``, so a relaunch
+    (``gui --screenshot``, ``run`` then its console) shows a rig's prediction at once instead of minutes of
+    searches (issue 41, item 10). Only ``predict``'s own results go there (``RigPrediction`` keeps a test's
+    stand-in in memory). A file that cannot be read or written is ignored: it only saves time."""
+
+    VERSION = 1
+
+    def __init__(self, path=None):
+        self.path = None if path is None else Path(path)
         self._kept = {}
+        if self.path is not None:
+            self._kept = self._load()
 
     def get(self, req):
         return self._kept.get(req.key)
 
     def put(self, req, prediction):
         self._kept[req.key] = dict(prediction)
+        if self.path is not None:
+            self._save()
+
+    def _load(self):
+        try:
+            stored = json.loads(self.path.read_text())
+            if stored.get("version") != self.VERSION:
+                return {}
+            return {(str(h), float(lat), float(pk), float(rate)): {n: math.inf if v is None else float(v)
+                                                                  for n, v in prediction.items()}
+                    for (h, lat, pk, rate), prediction in stored["predictions"]}
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return {}
+
+    def _save(self):
+        stored = {"version": self.VERSION,
+                  "predictions": [[list(key), {n: None if math.isinf(v) else v for n, v in prediction.items()}]
+                                  for key, prediction in self._kept.items()]}
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_open(self.path) as f:
+                json.dump(stored, f)
+        except OSError:
+            pass

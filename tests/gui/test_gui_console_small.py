@@ -56,3 +56,32 @@ def test_the_pacing_line_follows_the_timer_taking_over_from_the_device(bare_cons
     assert "paced by the timer" in console.setup.engine.text()
     assert "paced by the device" not in console.setup.engine.text()
     assert "timer-paced" in console.status.labels["engine"].text()
+
+
+def test_a_relaunch_shows_the_kept_prediction_without_computing_it(qapp, monkeypatch, tmp_path):
+    # issue 41, item 10: each launch searched again (7.5 min under load for sinclair2014)
+    from studyapp.gui.rig_prediction import RigPrediction
+    from studyapp.live import rig_check
+    from tests.gui.conftest import wait_until
+
+    monkeypatch.setenv("STUDYAPP_RIG_PREDICTIONS", str(tmp_path / "rig_predictions.json"))
+    calls = []
+
+    def model(req, progress=None):
+        calls.append(req.key)
+        return {"LVT": 3.09, "LOWPASS": 2.85}
+
+    monkeypatch.setattr(rig_check, "predict", model)  # as the model's own: kept on disk
+    req = rig_check.Request(("LVT", "LOWPASS"), {}, rig_check.Rig("link", 5000.0, 5), "hash")
+    shown = []
+    first = RigPrediction(rig_check.predict)
+    first.finished.connect(lambda r, p: shown.append(p))
+    first.run(req)
+    wait_until(qapp, lambda: shown, 60)
+    assert calls == [req.key]
+    relaunched = RigPrediction(rig_check.predict)
+    relaunched.finished.connect(lambda r, p: shown.append(p))
+    relaunched.run(req)
+    assert shown[-1] == {"LVT": 3.09, "LOWPASS": 2.85} and calls == [req.key]  # at once, not computed again
+    stand_in = RigPrediction(lambda r, progress=None: {"LVT": 99.0})  # a test's stand-in is never kept
+    assert stand_in.cache.path is None

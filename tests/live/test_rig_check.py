@@ -92,6 +92,27 @@ def test_the_cache_keeps_a_prediction_per_protocol_latency_packet_and_rate():
     assert cache.get(rig_check.request(protocol, rig_check.Rig("simulated", 5000.0))) is None
 
 
+def test_predictions_are_kept_on_disk_keyed_as_in_memory(tmp_path):
+    # issue 41, item 10: a relaunch (gui --screenshot, run then its console) computed the prediction again
+    protocol = load_protocol(DEMO)
+    path = tmp_path / "cache" / "rig_predictions.json"
+    at_1ms = rig_check.request(protocol, rig_check.Rig("link", 5000.0, 5))
+    rig_check.PredictionCache(path).put(at_1ms, {"LVT": 3.09, "LOWPASS": math.inf})
+    again = rig_check.PredictionCache(path)  # another launch
+    assert again.get(rig_check.request(protocol, rig_check.Rig("link", 5000.0, 5))) == {"LVT": 3.09,
+                                                                                       "LOWPASS": math.inf}
+    assert again.get(rig_check.request(protocol, rig_check.Rig("link", 5000.0, 1))) is None
+    assert again.get(rig_check.request(protocol, rig_check.Rig("link", 2500.0, 5))) is None
+    path.write_text("{not json")
+    assert rig_check.PredictionCache(path).get(at_1ms) is None  # a damaged file only costs the time
+
+
+def test_the_cache_lies_under_xdg_cache_home(monkeypatch, tmp_path):
+    monkeypatch.delenv("STUDYAPP_RIG_PREDICTIONS")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert rig_check.cache_path() == tmp_path / "studyapp" / "rig_predictions.json"
+
+
 @pytest.mark.parametrize("samples, warns", [(0, False), (5, True)])
 def test_the_model_keeps_the_effect_at_latency_0_and_warns_at_1_ms(samples, warns):
     """The demo's adjustment conditions (LOWPASS, LEVANT, LVT), 1 seed of 2 s trials: at latency 0 LVT's breakdown
