@@ -149,3 +149,28 @@ def test_session_json_and_the_export_carry_the_device(tmp_path):
     assert set(by.get_group("S01").device_latency_ms) == {0.0}
     assert set(by.get_group("L01").device) == {"studyapp emulator"}
     assert set(by.get_group("L01").device_serial) == {"EMU-0042"} and set(by.get_group("L01").device_latency_ms) == {1.0}
+
+
+def test_each_response_carries_the_device_of_the_engine_run_that_answered_it(tmp_path):
+    # issue 41, item 9: a session started on the emulator and resumed on the simulated device was exported with
+    # the emulator on every row, though the resumed runs' engine records had no device
+    from studyapp.experiment import records
+
+    protocol = load_protocol(trials_only_demo(tmp_path))
+    session = Session.create(protocol, "R01", tmp_path / "r", seed=4,
+                             device={"kind": "link", "link": "/tmp/dev", "info": INFO})
+    engine = {"rate": 5000.0, "block": 10, "audio": "null", "midi": "none", "paced": "device", "realtime": False}
+    session.log.append(records.engine({**engine, "device": INFO}, 4))
+    run_simulated(session, trials=2).finish("aborted")
+    session.close()
+    resumed = Session.resume(protocol, "R01", tmp_path / "r")
+    resumed.log.append(records.engine({**engine, "paced": "timer"}, 4))  # the simulated device: no ``device``
+    run_simulated(resumed).finish()
+    resumed.close()
+    frame = export_responses(tmp_path / "r").sort_values("step")
+    first, rest = frame[frame.step < 2], frame[frame.step >= 2]
+    assert len(first) >= 2 and len(rest) >= 1
+    assert set(first.device) == {"studyapp emulator"} and set(first.device_serial) == {"EMU-0042"}
+    assert set(first.device_latency_ms) == {1.0}
+    assert set(rest.device) == {"simulated"} and rest.device_serial.isna().all()
+    assert set(rest.device_latency_ms) == {0.0}
