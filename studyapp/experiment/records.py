@@ -109,6 +109,11 @@ def emergency_stop(by: str = "operator", fault: str | None = None) -> dict:
                                                                        "fault": fault}
 
 
+def rig_change(before: dict, now: dict, accepted: bool = True) -> dict:
+    """A session resumed on another device than its last engine run's (session.json's ``device`` form)."""
+    return {"type": "rig_change", "before": before, "now": now, "accepted": accepted}
+
+
 def emergency_clear() -> dict:
     return {"type": "emergency_clear"}
 

@@ -258,7 +258,8 @@ class Console(QMainWindow):
             session = self.controller.start_session(
                 self.setup.participant_id, self.setup.results_folder, resume=self.setup.resume.isChecked(),
                 seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"},
-                details=self.setup.session_info, logged=logged)
+                details=self.setup.session_info, logged=logged,
+                confirm_rig=lambda question: self.confirm("Resume on another rig?", question))
         except (UserError, RuntimeError) as exc:
             self.setup.show_error(str(exc))
             return None

@@ -63,7 +63,7 @@ from studyapp.live.engine_host import EngineHost
 from studyapp.live.evented import EventGroup
 from studyapp.live.hand import Hand
 from studyapp.live.master_sound import MasterSound
-from studyapp.live.devices import Devices
+from studyapp.live.devices import Devices, rig_words
 from studyapp.live.states import REST, TRANSITIONS, State
 from studyapp.live.status_watch import StatusWatch
 from studyapp.live.trial_media import TrialMedia
@@ -166,11 +166,13 @@ class SessionController:
         self.controls.engine_replaced()
 
     def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None,
-                      logged=()):
+                      logged=(), confirm_rig=None):
         """Open the participant's session (``UserError`` when refused) and start its engine.
 
         ``details``: ``experimenter``, ``session_number``, ``notes``, ``order_row`` (experiment/session_info.py).
         ``logged``: records for the session's log before its trials (the rig check's warning, rig_check.record).
+        ``confirm_rig(question)``: asked when a resumed session last ran on another device (False: not resumed);
+        None takes the change. Either way a change taken is logged (``rig_change``) and said.
         """
         if self.protocol is None:
             raise UserError("no protocol loaded: choose one first")
@@ -184,6 +186,15 @@ class SessionController:
         if resume:
             check_same_player(results, self.protocol.study, participant, simulated)
             session = Session.resume(self.protocol, participant, results, seed=seed, **(details or {}))
+            change = self.devices.change(session)
+            if change is not None:
+                before, now, question = change
+                if confirm_rig is not None and not confirm_rig(question):
+                    session.close()
+                    raise UserError(f"not resumed: the session last ran on {rig_words(before)}, the console runs on "
+                                    f"{rig_words(now)} (choose that device in Apparatus, or resume here)")
+                logged = (records.rig_change(before, now), *logged)
+                self.message(f"resumed on another rig: {question.rsplit('. ', 1)[0]}", level="warning")
         else:
             described = {"device": self.apparatus.device or "simulated", "engine": "real-time", **(apparatus or {})}
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,

@@ -6,11 +6,12 @@ from pathlib import Path
 import pytest
 
 from studyapp.engine import commands as cmd
+from studyapp.errors import UserError
 from studyapp.experiment.session_log import read_events
 from studyapp.model.fmax_knob import fmax_from_knob
 from studyapp.live.controller import TRANSITIONS, SessionController, State
 from studyapp.live.status_watch import CLEAR_TIMEOUT
-from tests.live.fakes import LATENCY, FakeHost
+from tests.live.fakes import LATENCY, LINK_INFO, FakeHost
 
 PROTOCOL = """
 [study]
@@ -516,3 +517,30 @@ def test_a_turn_the_worker_applied_before_an_emergency_stop_is_logged_but_not_gi
     assert late == [{"step": 1, "task": "adjustment", "type": "late_control", "control": "knob1", "value": 60}]
     assert not any(e["type"] == "knob" and e["task"] == "adjustment" for e in events)
     assert engine.fmax == 0.0
+
+
+def test_a_session_resumed_on_another_rig_is_asked_about_and_logged(controller):
+    # issue 41, item 9: P01 started on the emulator, aborted, resumed on the simulated device with no question
+    c = controller
+    c.apparatus.device, c.devices.info = "/tmp/emulator", dict(LINK_INFO)  # the console runs on a link device
+    start(c)
+    up(c)  # its engine record carries the device (the fake engine reports the console's device below)
+    c.abort()
+    c.apparatus.device, c.devices.info = None, None  # now the simulated device
+    asked = []
+
+    def refuse(question):
+        asked.append(question)
+        return False
+
+    with pytest.raises(UserError, match="last ran on studyapp emulator \\(serial EMU-0000\\)"):
+        c.start_session("P01", c.results, resume=True, confirm_rig=refuse)
+    assert not c.in_session and "the simulated device" in asked[0]
+    c.start_session("P01", c.results, resume=True, confirm_rig=lambda question: True)
+    up(c)
+    changes = [e for e in log(c) if e["type"] == "rig_change"]
+    assert len(changes) == 1 and changes[0]["now"] == {"kind": "simulated", "latency_ms": 0.0}
+    assert changes[0]["before"]["info"]["serial"] == "EMU-0000"
+    c.abort()
+    c.start_session("P01", c.results, resume=True, confirm_rig=lambda question: pytest.fail("asked again"))
+    up(c)  # the last run was on the simulated device already: nothing to ask
