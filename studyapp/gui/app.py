@@ -56,6 +56,7 @@ def build(args):
     device = _device(getattr(args, "device", None))
     controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"),
                                    device=device)
+    controller.apparatus.device_options = dict(getattr(args, "link_options", None) or {})  # --device-latency, ...
     console = Console(controller)
     console.device_panel.show_choice(device)
     kept = getattr(args, "rig_prediction", None)  # studyapp run predicted it already

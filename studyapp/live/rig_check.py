@@ -41,6 +41,11 @@ from studyapp.model.link_prediction import MARGIN
 from studyapp.model.sources import LVT_SENSOR, TRUE
 
 ADJUSTMENT = "adjustment"
+# what the experimenter can change, with the controls that exist (issue 41, item 10: the warning named a doc)
+REMEDY = ("To change it: a device that runs the loop itself keeps the effect on any link (docs/devices.md, "
+          "\"The loop on the device\"); or answer the device fewer samples ahead if its round trip allows "
+          "(now {samples}): start the console with `studyapp gui --device LINK --device-latency SAMPLES` "
+          "(`--device-silence SECONDS` for the silence bound), as `studyapp live` takes them")
 SIMULATED, DEVICE_LOOP = "simulated", "device-loop"
 
 
@@ -158,7 +163,8 @@ class Verdict:
         return (f"warning: at this rig's link latency of {self.rig.latency_ms:.2f} ms "
                 f"({self.rig.latency_samples} samples at {self.rig.rate:g} Hz) the model predicts LVT's bowing "
                 f"breakdown at {self.margin:.2f}x the best estimator's ({self.best}), below {MARGIN:g}x: the "
-                "paper's effect (LVT nearly twice the estimators) is not expected on this rig (docs/devices.md)")
+                "paper's effect (LVT nearly twice the estimators) is not expected on this rig. "
+                f"{REMEDY.format(samples=self.rig.latency_samples)}")
 
 
 def verdict(prediction, rig):

@@ -71,8 +71,9 @@ def test_the_verdict_its_text_and_warning_line():
     assert warns.warns and warns.margin == pytest.approx(3.09 / 2.85)
     assert warns.warning == ("warning: at this rig's link latency of 1.00 ms (5 samples at 5000 Hz) the model "
                              "predicts LVT's bowing breakdown at 1.08x the best estimator's (LOWPASS), below 1.5x: "
-                             "the paper's effect (LVT nearly twice the estimators) is not expected on this rig "
-                             "(docs/devices.md)")
+                             "the paper's effect (LVT nearly twice the estimators) is not expected on this rig. "
+                             + rig_check.REMEDY.format(samples=5))
+    assert "(now 5)" in warns.warning and "--device-latency SAMPLES" in warns.warning
     alone = rig_check.verdict({"LVT": 3.0}, rig)
     assert math.isnan(alone.margin) and not alone.warns and alone.warning is None
     record = rig_check.record(rig_check.verdict({"LOWPASS": math.inf, "LVT": 3.0}, rig), started_anyway=True)
