@@ -236,8 +236,9 @@ class SessionController:
         self.fire("emergency")
 
     def fault_stop(self, fault):
-        """The engine latched ``fault`` on its own during a session: the session stops as for the emergency stop."""
-        if self.state in (State.RUNNING, State.PAUSED):
+        """The engine latched ``fault`` on its own: a session stops as for the emergency stop; at rest the preview
+        holds it the same way (Resume clears it)."""
+        if self.state in (State.RUNNING, State.PAUSED, *REST):
             self.stopped_by, self.fault = "fault", str(fault)
             self.fire("fault")
 

@@ -7,7 +7,7 @@
     RUNNING / PAUSED  --engine_failed-->  ENGINE_LOST  --restart-->  RESTARTING
     RESTARTING  --engine_up-->  RUNNING (the trial again)   --engine_failed-->  ENGINE_LOST
     any  --emergency-->  EMERGENCY  --clear-->  CLEARING  --cleared-->  RUNNING (the trial again) or rest
-    RUNNING / PAUSED  --fault-->  EMERGENCY (the engine latched a fault of its own: a device's, the loop's)
+    RUNNING / PAUSED / rest  --fault-->  EMERGENCY (the engine latched a fault of its own: a device's, the loop's)
                                                   CLEARING  --clear_timeout-->  EMERGENCY (the stop holds again)
 
 ``TRANSITIONS`` maps (state, event) to a function of the controller
@@ -200,8 +200,10 @@ def emergency(c):
 
 
 def fault_stop(c):
-    """The engine latched a fault of its own (``c.fault``): the force is zero already; held as an emergency stop."""
-    c.runner.log(records.emergency_stop("fault", fault=c.fault))
+    """The engine latched a fault of its own (``c.fault``): the force is zero already; held as an emergency stop
+    (at rest too: the preview's fault is cleared by Resume, not only by an emergency stop first)."""
+    if c.runner is not None:
+        c.runner.log(records.emergency_stop("fault", fault=c.fault))
     return _force_off(c)
 
 
@@ -276,7 +278,7 @@ TRANSITIONS = _table(
     ((State.RESTARTING,), "engine_up", restart_trial),
     ((State.RESTARTING,), "engine_failed", restart_failed),
     (EVERY, "emergency", emergency),
-    ((State.RUNNING, State.PAUSED), "fault", fault_stop),
+    ((State.RUNNING, State.PAUSED, *REST), "fault", fault_stop),
     ((State.EMERGENCY,), "engine_up", hold_new_engine),
     ((State.EMERGENCY,), "clear", clear),
     ((State.CLEARING,), "cleared", cleared),

@@ -14,7 +14,7 @@ device's, the loop's guard), never a stop: during a session it stops the
 session (``fault_stop``), checked at every status read.
 """
 
-from studyapp.live.states import State
+from studyapp.live.states import REST, State
 
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
 CLEAR_TIMEOUT = 5.0  # s a cleared stop may wait for the worker's word that it cleared; then the stop holds again
@@ -43,7 +43,7 @@ class StatusWatch:
             if live.runner is None:
                 live.events.selection.emit(source=status["source"], fmax=status["fmax"])
         force_enabled = bool(engine.status_block.force_enable)
-        if status["fault_latched"] and force_enabled and live.state in (State.RUNNING, State.PAUSED):
+        if status["fault_latched"] and force_enabled and live.state in (State.RUNNING, State.PAUSED, *REST):
             live.fault_stop(status["fault"] or "safety fault")  # the engine's own fault, not a stop (which clears the force word)
         elif clearing and not status["fault_latched"] and force_enabled:
             live.fire("cleared")

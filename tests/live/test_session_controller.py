@@ -64,6 +64,7 @@ EXPECTED = {
     (S.CLEARING, "engine_failed"): S.ENGINE_LOST,
     (S.RUNNING, "fault"): S.EMERGENCY,  # the engine latched a fault of its own (a device's): the session stops
     (S.PAUSED, "fault"): S.EMERGENCY,
+    **{(rest, "fault"): S.EMERGENCY for rest in (S.IDLE, S.FINISHED, S.ABORTED)},  # the preview's fault too
 }
 
 
