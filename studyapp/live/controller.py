@@ -190,6 +190,7 @@ class SessionController:
             if change is not None:
                 before, now, question = change
                 if confirm_rig is not None and not confirm_rig(question):
+                    session.log.append(records.rig_change(before, now, accepted=False))
                     session.close()
                     raise UserError(f"not resumed: the session last ran on {rig_words(before)}, the console runs on "
                                     f"{rig_words(now)} (choose that device in Apparatus, or resume here)")

@@ -44,7 +44,7 @@ class StatusWatch:
                 live.events.selection.emit(source=status["source"], fmax=status["fmax"])
         force_enabled = bool(engine.status_block.force_enable)
         if status["fault_latched"] and force_enabled and live.state in (State.RUNNING, State.PAUSED, *REST):
-            live.fault_stop(status["fault"] or "safety fault")  # the engine's own fault, not a stop (which clears the force word)
+            live.fault_stop(status["fault"] or "safety fault")  # the engine's own: a stop clears the force word
         elif clearing and not status["fault_latched"] and force_enabled:
             live.fire("cleared")
         elif clearing and now - self.clearing_since > CLEAR_TIMEOUT:

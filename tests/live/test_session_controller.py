@@ -540,8 +540,9 @@ def test_a_session_resumed_on_another_rig_is_asked_about_and_logged(controller):
     c.start_session("P01", c.results, resume=True, confirm_rig=lambda question: True)
     up(c)
     changes = [e for e in log(c) if e["type"] == "rig_change"]
-    assert len(changes) == 1 and changes[0]["now"] == {"kind": "simulated", "latency_ms": 0.0}
-    assert changes[0]["before"]["info"]["serial"] == "EMU-0000"
+    assert [change["accepted"] for change in changes] == [False, True]  # the refusal logged too
+    assert changes[1]["now"] == {"kind": "simulated", "latency_ms": 0.0}
+    assert changes[1]["before"]["info"]["serial"] == "EMU-0000"
     c.abort()
     c.start_session("P01", c.results, resume=True, confirm_rig=lambda question: pytest.fail("asked again"))
     up(c)  # the last run was on the simulated device already: nothing to ask
