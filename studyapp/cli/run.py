@@ -102,7 +102,7 @@ def run(args):
     if args.headless and args.audio not in (None, "wav", "null"):
         raise UserError(f"--audio {args.audio}: allowed headless is wav (audio.wav in the session folder) or null")
     if args.headless:
-        for option in ("midi", "participant_screen", "device"):
+        for option in ("midi", "participant_screen", "device", "device_latency", "device_silence"):
             if getattr(args, option) is not None:
                 raise UserError(f"--{option.replace('_', '-')}: allowed only without --headless (the console's)")
     if args.replay_gesture is not None and not args.simulated_participant:
