@@ -87,8 +87,11 @@ def test_a_relaunch_shows_the_kept_prediction_without_computing_it(qapp, monkeyp
     assert stand_in.cache.path is None
 
 
+@pytest.mark.slow
 def test_sigterm_closes_the_console_cleanly(tmp_path):
-    # issue 41, item 12: SIGTERM's default ended the console with its engine's shared memory leaked
+    # issue 41, item 12: SIGTERM's default ended the console with its engine's shared memory leaked. Closing
+    # waits for an engine still starting (EngineHost): at a load of 20 the console took 136 s to build and 80 s
+    # to close after the signal (2026-11-28), hence the long bounds
     import os
     import signal
     import subprocess
@@ -111,7 +114,7 @@ def test_sigterm_closes_the_console_cleanly(tmp_path):
         assert proc.poll() is None, proc.stderr.read()[-2000:]
         time.sleep(3.0)  # its engine starting or running: what a SIGTERM meets in use
         proc.send_signal(signal.SIGTERM)
-        _, err = proc.communicate(timeout=180)
+        _, err = proc.communicate(timeout=300)
     finally:
         if proc.poll() is None:
             proc.kill()
