@@ -1,12 +1,21 @@
-"""Import studyapp before anything imports numba, so its cache directory is set (studyapp.numba_cache).
+"""Import studyapp before anything imports numba, so its cache directory is set (studyapp.numba_cache); the rig
+check's kept predictions go to a folder of this run.
 
 The dummy JACK server fixture (``jack_server``) serves the engine and the GUI tests alike. The long files
 are collected first (``pytest_collection_modifyitems``), so the parallel run does not end on one of them.
 """
 
+import os
+import tempfile
+
 import studyapp  # noqa: F401
 from tests.hang_guard import pytest_runtest_protocol, pytest_terminal_summary  # noqa: F401
 from tests.jack_server import jack_server  # noqa: F401
+
+# the rig check's predictions kept between launches (live/rig_check.py): the suite's own, in a folder of this run,
+# never the user's (a test's stand-in prediction must not be shown as a rig's), inherited by the commands it runs
+os.environ["STUDYAPP_RIG_PREDICTIONS"] = os.path.join(tempfile.mkdtemp(prefix="studyapp-tests-"),
+                                                      "rig_predictions.json")
 
 
 def pytest_collection_modifyitems(config, items):

@@ -31,6 +31,28 @@ def add_device_option(parser, headless=False):
                         help="the device: simulated, or a link to a device speaking docs/device-protocol.md "
                              f"(serial port, pty, socket://HOST:PORT); default: the one remembered on this "
                              f"machine{words}")
+    parser.add_argument("--device-latency", type=int, default=None, metavar="SAMPLES",
+                        help="samples the host answers ahead of a link device's sensor sample, as for live "
+                             "(default 5); the rig check predicts at it")
+    parser.add_argument("--device-silence", type=float, default=None, metavar="SECONDS",
+                        help="a link device silent for longer is a device fault, as for live (default 0.02)")
+
+
+def link_options(args, link):
+    """``EngineConfig``'s ``device_*`` fields the console's engines take from ``--device-latency`` and
+    ``--device-silence`` (checked: ``ParameterError``, one line); refused without a link device."""
+    from studyapp.device import handshake
+
+    given = {"device_latency": getattr(args, "device_latency", None),
+             "device_silence": getattr(args, "device_silence", None)}
+    given = {key: value for key, value in given.items() if value is not None}
+    if given and link is None:
+        raise ParameterError("--device-latency and --device-silence need --device PATH_OR_URL (a link device)")
+    if "device_latency" in given:
+        handshake.check_latency(given["device_latency"])
+    if "device_silence" in given:
+        given["device_silence"] = handshake.check_silence(given["device_silence"])
+    return given
 
 
 def check_device(device, rate, protocol=None):
@@ -63,14 +85,17 @@ def probe_device(device, rate, protocol=None):
     return device, found["loop"]
 
 
-def rig_check_line(protocol, device, say, loop=None):
+def rig_check_line(protocol, device, say, loop=None, latency=None):
     """Predict the protocol's adjustment conditions on the rig (``say`` the progress); returns (request, prediction,
     warning line or None), or None when there is nothing to check. ``loop``: "device" for a device that runs the
     loop itself (``probe_device``)."""
     from studyapp.engine.config import EngineConfig
     from studyapp.live import rig_check
 
-    rig = rig_check.rig_of(EngineConfig(rate=protocol.rate, device=device), loop)
+    config = EngineConfig(rate=protocol.rate, device=device)
+    if latency is not None:
+        config.device_latency = int(latency)
+    rig = rig_check.rig_of(config, loop)
     req = rig_check.request(protocol, rig)
     if req is None:
         return None
@@ -78,9 +103,16 @@ def rig_check_line(protocol, device, say, loop=None):
         if rig.kind == rig_check.DEVICE_LOOP:
             say(f"rig check: {rig.words}; LVT's margin is the model's own, nothing to predict")
         return None
-    say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_words} "
-        "link latency (the model, 5 seeds)…")
-    prediction = rig_check.predict(req)
+    cache = rig_check.PredictionCache(rig_check.cache_path())
+    prediction = cache.get(req)
+    if prediction is None:
+        say(f"rig check: predicting the bowing breakdown of {len(req.conditions)} conditions at {rig.latency_words} "
+            "link latency (the model, 5 seeds)…")
+        prediction = rig_check.predict(req)
+        cache.put(req, prediction)
+    else:
+        say(f"rig check: the prediction at {rig.latency_words} link latency kept from an earlier launch "
+            f"({rig_check.cache_path()})")
     verdict = rig_check.verdict(prediction, rig)
     say(f"rig check: {verdict.text}")
     if verdict.warning is not None:

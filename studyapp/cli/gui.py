@@ -90,13 +90,19 @@ def run(args):
     _check_before_the_console(args, protocol)
     require_display()
     if args.device is not None:
-        from studyapp.cli.device_choice import check_device
+        from studyapp.cli.device_choice import check_device, link_options
         from studyapp.experiment.protocol import load_protocol
         from studyapp.gui.app import default_protocol
 
         protocol = args.protocol or default_protocol()
         loaded = load_protocol(protocol) if protocol else None
-        check_device(args.device, loaded.rate if loaded else 5000.0, loaded)
+        link = check_device(args.device, loaded.rate if loaded else 5000.0, loaded)
+        args.link_options = link_options(args, link)
+    elif args.device_latency is not None or args.device_silence is not None:
+        from studyapp.cli.device_choice import link_options
+        from studyapp.gui.device_panel import remembered
+
+        args.link_options = link_options(args, remembered())
     if args.start and not args.participant:
         raise UserError("--start: allowed only with --participant ID")
     if args.measure_scope is not None and not 0.5 <= args.measure_scope <= 600:

@@ -107,7 +107,7 @@ def run(args):
         if args.device not in (None, SIMULATED):
             raise UserError(f"--device {args.device}: allowed with --headless is only simulated: {HEADLESS_WHY}; "
                             "run it without --headless (the console)")
-        for option in ("midi", "participant_screen"):
+        for option in ("midi", "participant_screen", "device_latency", "device_silence"):
             if getattr(args, option) is not None:
                 raise UserError(f"--{option.replace('_', '-')}: allowed only without --headless (the console's)")
     if args.replay_gesture is not None and not args.simulated_participant:
@@ -129,16 +129,17 @@ def run(args):
         if not lock_taken(Path(args.results) / protocol.study / args.participant):  # the holder's refusal first
             check_same_player(args.results, protocol.study, args.participant, args.simulated_participant)
     if not args.headless:
-        from studyapp.cli.device_choice import probe_device, rig_check_line
+        from studyapp.cli.device_choice import link_options, probe_device, rig_check_line
 
         output_paths.check_audio(args.audio, inputs=[args.protocol, *filter(None, [args.replay_gesture])])
         args.audio = args.audio or "device"
         args.midi = args.midi or "first"
         link, loop = probe_device(args.device, protocol.rate, protocol)
+        args.link_options = link_options(args, link)
         if not args.resume:
             args.rig_prediction = rig_check_line(protocol, link, lambda text: print(f"studyapp run: {text}",
                                                                                    file=sys.stderr, flush=True),
-                                                 loop)
+                                                 loop, args.link_options.get("device_latency"))
         return _run_in_gui(args)
 
     from studyapp.experiment.hand_trace import ReplayingHand

@@ -335,13 +335,20 @@ class LinkDevice(HapticDevice):
 
         ``ParameterError`` (one line) when the device is still not there; the fault stays latched then.
         """
-        if self.fault is not None and self.link_lost:
-            self.close()
-            self._open()
-            self.link_lost = False
-        self.fault = None
-        self.resync()
-        self.arm(ramp_ms)
+        reopen = self.fault is not None and self.link_lost
+        for _ in range(2):
+            if reopen:
+                self.close()
+                self._open()
+                self.link_lost = False
+            self.fault = None
+            self.resync()
+            self.arm(ramp_ms)
+            # a link found gone only now (a device restarted while a silence fault held it): reopen it at once,
+            # or this Resume would fail and only the next one work (issue 41, item 8)
+            reopen = self.fault is not None and self.link_lost
+            if not reopen:
+                break
 
     def resync(self):
         """Drop every frame waiting on the link (the host was busy, not answering): the next sample is fresh."""

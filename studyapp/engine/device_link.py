@@ -92,7 +92,10 @@ class DeviceLink:
         except UserError as exc:
             self.notice(f"device: cannot re-arm: {exc}", "warning")
             return False
-        return self.device.fault is None
+        if self.device.fault is not None:
+            self.notice(f"device: cannot re-arm: {self.device.fault}", "warning")
+            return False
+        return True
 
     def status(self):
         return {key: self.device.health[name] for key, name in STATUS.items()}

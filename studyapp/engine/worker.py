@@ -69,6 +69,8 @@ from studyapp.model.controls import as_actions
 
 REALTIME_PRIORITY = 5  # below JACK's own threads (10 and 9 by default)
 
+TIMER_TAKES_OVER = "the timer paces the loop now"  # the notice the console follows (its pacing line)
+
 
 def make_device(config):
     """The configured device: a link (path or URL: studyapp/device/link_device.py, or loop_link.py for a device
@@ -325,7 +327,7 @@ class Worker(ControlRouting):
             if pacing.wait(self.k):
                 status.set(audio_paced=False)
                 self.notice(f"{'device: it faulted' if self.link else 'audio: the device stopped calling back'}; "
-                            "the timer paces the loop now", "warning", "device" if self.link else "audio")
+                            f"{TIMER_TAKES_OVER}", "warning", "device" if self.link else "audio")
             started = time.monotonic()
             self.drain()
             if self.stopping:

@@ -44,7 +44,9 @@ device_serial, device_latency_ms``.
 - ``device``: ``simulated``, or the name a device on a link gave in its
   handshake; ``device_serial`` its serial number (empty on the simulated
   device); ``device_latency_ms`` the link's latency (the host's answer-ahead,
-  ms; 0 on the simulated device). From session.json's ``device``; empty for
+  ms; 0 on the simulated device). From the ``engine`` record of the run that
+  answered (each engine run of a session logs one: a session resumed on another
+  rig has each response's own), else session.json's ``device``; empty for
   a session stored before it was.
 - ``experimenter``, ``session_number``, ``order_row``: from session.json
   (``session_info``); empty when not given, or for a session stored before
@@ -74,6 +76,7 @@ from studyapp.errors import InputDataError, UserError
 from studyapp.experiment import records
 from studyapp.experiment.enrolment import is_simulated
 from studyapp.experiment.log_scan import written_twice
+from studyapp.experiment.session import SIMULATED_DEVICE
 from studyapp.experiment.session_description import read_description
 from studyapp.experiment.session_files import EVENTS_FILE, SESSION_FILE
 from studyapp.experiment.session_log import read_log
@@ -138,7 +141,10 @@ def _session_rows(folder, problems):
         return []
     health = _trial_health(log.events)
     rows = []
+    held = {}  # the device of the engine run answering now (its ``engine`` record); before any, session.json's
     for event in log.events:
+        if event.get("type") == "engine":
+            held = engine_device_columns(event)
         if event.get("type") != "response":
             continue
         wrong = records.response_problem(event, TASK_TYPES)
@@ -149,9 +155,20 @@ def _session_rows(folder, problems):
                 "time": event["wall"], "step": event["step"], "duration": event.get("duration"),
                 "practice": event.get("practice") is True,
                 "simulated": event.get("simulated", common["simulated"]) is True}
+        base.update(held)
         base.update(health.get(event["step"], {}))
         rows += [{**base, **row} for row in task_type(event["task"]).export_rows(event)]
     return rows
+
+
+def engine_device_columns(engine):
+    """The device columns of the responses an engine run answered: its ``engine`` record's ``device`` (a link
+    device's handshake), or the simulated device when the record has none (issue 41, item 9: a session resumed on
+    another rig was exported with the device it started on)."""
+    device = engine.get("device")
+    if isinstance(device, dict):
+        return device_columns({"kind": "link", "info": device})
+    return device_columns(dict(SIMULATED_DEVICE))
 
 
 def device_columns(device):

@@ -103,8 +103,15 @@ def abort(reason: str | None = None) -> dict:
     return {"type": "abort"} if reason is None else {"type": "abort", "reason": reason}
 
 
-def emergency_stop(by: str = "operator") -> dict:
-    return {"type": "emergency_stop", "by": by}
+def emergency_stop(by: str = "operator", fault: str | None = None) -> dict:
+    """The force stopped: by the ``operator`` or the ``participant``, or by a ``fault`` the engine latched (its text)."""
+    return {"type": "emergency_stop", "by": by} if fault is None else {"type": "emergency_stop", "by": by,
+                                                                       "fault": fault}
+
+
+def rig_change(before: dict, now: dict, accepted: bool = True) -> dict:
+    """A session resumed on another device than its last engine run's (session.json's ``device`` form)."""
+    return {"type": "rig_change", "before": before, "now": now, "accepted": accepted}
 
 
 def emergency_clear() -> dict:

@@ -17,6 +17,7 @@ screen; a screen that does not exist is refused before anything starts.
 import signal
 from pathlib import Path
 
+from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
 from studyapp.errors import UserError
@@ -56,6 +57,7 @@ def build(args):
     device = _device(getattr(args, "device", None))
     controller = SessionController(audio=getattr(args, "audio", "device"), midi=getattr(args, "midi", "first"),
                                    device=device)
+    controller.apparatus.device_options = dict(getattr(args, "link_options", None) or {})  # --device-latency, ...
     console = Console(controller)
     console.device_panel.show_choice(device)
     kept = getattr(args, "rig_prediction", None)  # studyapp run predicted it already
@@ -99,7 +101,7 @@ def main(args):
     controller, console = build(args)
     size = getattr(args, "size", None)
     if size is not None:
-        console.resize(*size)
+        console.set_size(*size)
     console.show()
     if screen is not None:
         place(console, screen)  # never over the console's session buttons (participant_placement.py)
@@ -119,8 +121,12 @@ def main(args):
         console.unattended = ScopeBenchmark(console, args.measure_scope)
     if getattr(args, "start", False) and not (getattr(args, "screenshot", None) or getattr(args, "measure_scope", None)):
         _start_when_possible(console, getattr(args, "seed", None))
-    # Ctrl-C in the terminal closes the console cleanly (Python sees signals between Qt events)
-    signal.signal(signal.SIGINT, lambda *_: console.shut_down())
+    # Ctrl-C in the terminal, and SIGTERM (a session manager, `kill`), close the console cleanly: the session
+    # aborted and logged, the engine stopped, its shared memory released (Python sees signals between Qt events;
+    # SIGTERM's default left "leaked shared_memory objects", issue 41, item 12)
+    # (queued: a signal before the event loop runs still closes it once it does)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: QTimer.singleShot(0, console.shut_down))
     code = app.exec()
     console.shut_down()  # an unattended run may leave a session running: no one to ask
     return code

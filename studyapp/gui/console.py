@@ -1,11 +1,11 @@
 """The experimenter console: one window to set up, run, watch and stop a study session.
 
-Left: session set-up and the apparatus found, and the session's progress
-(task, trial x of y, the page the participant sees with the headphone level
-check's confirm (``PageControls``), the current condition), the run sheet,
-notes and master volume (``SessionTools``), in a scroll area; below them,
-always in view, the tick that hides the condition (blinding), the session's
-buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
+Left: session set-up and the apparatus found, the run sheet, notes and
+master volume (``SessionTools``), in a scroll area; below them, always in
+view, the session's progress (its state, task, trial x of y, the current
+condition), the tick that hides the condition (blinding), the page the
+participant sees with the headphone level check's confirm (``PageControls``),
+the session's buttons (Start, Pause/Resume, Abort, EMERGENCY STOP). Right, in tabs: the live
 scope with the on-screen knobs and pads and the bowing pad; the analysis view
 (``AnalysisView``) of a results folder; the session's log. Bottom: the status
 bar (loop rate, load, deadline misses, audio underruns, faults, scope frame
@@ -21,6 +21,7 @@ the session (pause is a deliberate click); a space press that reaches the
 console goes to the participant's bow instead, as in the participant's
 window.
 
+*File > Quit* (Ctrl+Q) closes the console as its window's close button does.
 Abort, and closing the console, while a session runs ask first (``confirm``;
 ``abort_session(confirm=False)``, the default, is the programmatic abort, and
 ``shut_down()`` closes without asking).
@@ -53,6 +54,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from studyapp.engine.worker import TIMER_TAKES_OVER
 from studyapp.errors import UserError
 from studyapp.experiment.tasks import task_type
 from studyapp.gui.analysis_view import AnalysisView
@@ -89,6 +91,7 @@ class Console(QMainWindow):
         self.confirmation = None
         self._typed = None  # the session fields as typed, while a resumed session shows its own
         self._midi_shown = None
+        self._engine_info = {}  # the running engine's info, its pacing as it is now
         self.caller = GuiThreadCaller(self)
         self.setWindowTitle("studyapp — experimenter console")
 
@@ -121,7 +124,6 @@ class Console(QMainWindow):
         dv = QVBoxLayout(details)
         dv.setContentsMargins(0, 0, 0, 0)
         dv.addWidget(self.setup)
-        dv.addWidget(self.progress)
         self.tools = SessionTools(controller, self.setup, self.blind.isChecked)  # run sheet, notes, sound
         dv.addWidget(self.tools)
         dv.addStretch(1)
@@ -135,6 +137,7 @@ class Console(QMainWindow):
         self.left_column = left  # the set-up, progress and session buttons: never covered by the participant
         lv = QVBoxLayout(left)
         lv.addWidget(scroll, 1)
+        lv.addWidget(self.progress)  # in view without scrolling: a tall rig check above never hides it
         lv.addWidget(self.blind)  # in view without scrolling, at 1,366 x 768 too
         lv.addWidget(self.page_controls)  # the level check's confirm stays in view, as the buttons do
         lv.addWidget(self.buttons)
@@ -175,6 +178,10 @@ class Console(QMainWindow):
         self.show_participant.toggled.connect(self.participant_window.setVisible)
         analyse = QAction("Analyse the results folder", self)
         analyse.triggered.connect(self.analyse_results)
+        self.quit_action = QAction("&Quit", self)  # asks first while a session runs (closeEvent)
+        self.quit_action.setShortcut(QKeySequence("Ctrl+Q"))
+        self.quit_action.triggered.connect(self.close)
+        self.menuBar().addMenu("&File").addAction(self.quit_action)
         view_menu = self.menuBar().addMenu("&View")
         view_menu.addAction(self.show_participant)
         view_menu.addAction(analyse)
@@ -220,6 +227,11 @@ class Console(QMainWindow):
         self.setWindowState(self.windowState() | Qt.WindowState.WindowMaximized if small
                             else self.windowState() & ~Qt.WindowState.WindowMaximized)
 
+    def set_size(self, width, height):
+        """``width`` x ``height`` px, not maximised (``studyapp gui --size``: offscreen too, whose screen is smaller)."""
+        self.setWindowState(self.windowState() & ~Qt.WindowState.WindowMaximized)
+        self.resize(width, height)
+
     def keyPressEvent(self, event):
         if event.key() == Qt.Key.Key_Space:  # the participant's space bar: the bow, never a button
             self.participant_window.keyPressEvent(event)
@@ -246,7 +258,8 @@ class Console(QMainWindow):
             session = self.controller.start_session(
                 self.setup.participant_id, self.setup.results_folder, resume=self.setup.resume.isChecked(),
                 seed=seed, apparatus={"participant": "simulated" if self.setup.simulated.isChecked() else "human"},
-                details=self.setup.session_info, logged=logged)
+                details=self.setup.session_info, logged=logged,
+                confirm_rig=lambda question: self.confirm("Resume on another rig?", question))
         except (UserError, RuntimeError) as exc:
             self.setup.show_error(str(exc))
             return None
@@ -325,6 +338,7 @@ class Console(QMainWindow):
         if state == "starting":
             self.notices = {}
             self._midi_shown = None
+        self._engine_info = dict(info) if state == "running" else {}
         self.setup.show_engine(state, info, config, self.notices)
         self.rig.engine_state(state)
         self.status.show_engine(state, info)
@@ -334,7 +348,7 @@ class Console(QMainWindow):
 
     def _on_state(self, state):
         emergency = state == State.EMERGENCY
-        self.progress.show_state(state, self.controller.stopped_by)
+        self.progress.show_state(state, self.controller.stop_text)
         active = self.controller.in_session
         self.buttons.show_state(state, active)
         self.setup.set_editable(not active)
@@ -385,6 +399,10 @@ class Console(QMainWindow):
     def _on_message(self, text, level, topic):
         if topic:
             self.notices[topic] = text
+        if TIMER_TAKES_OVER in text and self._engine_info:  # the pacing line follows the clock in charge
+            self._engine_info = {**self._engine_info, "paced": "timer"}
+            self.setup.show_pacing("timer", text)
+            self.status.show_engine("running", self._engine_info)
         self.log.appendPlainText(("[fault] " if level == "error" else "") + text)
         if level in COLOURS:
             self.status.show_message(text, MESSAGE_MS, COLOURS[level])

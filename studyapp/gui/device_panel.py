@@ -39,6 +39,12 @@ KINDS = ("simulated", "link")
 KIND_KEY, LINK_KEY = "device/kind", "device/link"
 
 
+def breakable(text):
+    """``text`` with a line-break chance after each "/" (a zero-width space): a long link path or calibration
+    file wraps at the panel's width instead of running past it, cut mid-line (issue 41, item 11)."""
+    return text.replace("/", "/\u200b")
+
+
 def settings():
     return QSettings("studyapp", "studyapp")
 
@@ -128,22 +134,22 @@ class DevicePanel(QWidget):
             self.summary.setText(device_words.SIMULATED)
         elif state == "failed":
             if "waiting for the handshake" in self.summary.text():
-                self.summary.setText(f"link {device}: not opened")
+                self.summary.setText(breakable(f"link {device}: not opened"))
             self.health.setText("<span style='color:#c00'>the engine on this link failed or stopped: see the "
                                 "log</span>")
         else:
             self.health.setText("")
-            self.summary.setText(f"link {device}: waiting for the handshake…")
+            self.summary.setText(breakable(f"link {device}: waiting for the handshake…"))
 
     def show_info(self, info):
-        lines = [device_words.handshake(info), f"calibration: {device_words.calibration(info)}",
+        lines = [device_words.handshake(info), breakable(f"calibration: {device_words.calibration(info)}"),
                  device_words.latency(info)]
         risk = device_words.late_risk(info)
         text = "<br>".join(lines)
         self.summary.setText(f"{text}<br><span style='color:#a60'>{risk}</span>" if risk else text)
 
-    def show_health(self, trial, health, totals):
-        self.health.setText(device_words.health(trial, health))
+    def show_health(self, trial, health, totals, where=None):
+        self.health.setText(device_words.health(where or f"trial {trial}", health))
 
     # the rig check ---------------------------------------------------------------------------------
     def show_predicting(self, rig):

@@ -38,31 +38,46 @@ class ProgressPanel(QGroupBox):
         for label in (self.state_label, self.task_label, self.trial_label, self.condition_label,
                       self.response_label, self.pickup_label):
             label.setWordWrap(True)
+        self.condition_caption = QLabel("Current condition:")
         p = QVBoxLayout(self)
         p.addWidget(self.state_label)
         p.addWidget(self.task_label)
         p.addWidget(self.trial_label)
         p.addWidget(self.progress_bar)
-        p.addWidget(QLabel("Current condition:"))
+        p.addWidget(self.condition_caption)
         p.addWidget(self.condition_label)
         p.addWidget(self.response_label)
         p.addWidget(self.pickup_label)
+        self._tidy()
 
-    def show_state(self, state, stopped_by="operator"):
+    def _tidy(self):
+        """Empty lines take no room: the box stays in view below the set-up at 1,366 x 768 (issue 41, item 11)."""
+        for label in (self.task_label, self.trial_label, self.condition_label, self.response_label,
+                      self.pickup_label):
+            label.setVisible(bool(label.text()))
+        self.condition_caption.setVisible(bool(self.condition_label.text()))
+        self.progress_bar.setVisible(bool(self.trial_label.text()))
+
+    def show_state(self, state, stop_text=STATE_WORDS[State.EMERGENCY]):
+        """``stop_text``: what holds the force while the state is EMERGENCY (the controller's ``stop_text``)."""
         emergency = state == State.EMERGENCY
-        self.state_label.setText(force_off_text(stopped_by) if emergency else STATE_WORDS[state])
+        self.state_label.setText(stop_text if emergency else STATE_WORDS[state])
         self.state_label.setStyleSheet("font-weight: bold;" + (" color: #c00;" if emergency else ""))
         if state in REST:
             self.task_label.setText("")
             if state != State.IDLE:
                 self.trial_label.setText(STATE_WORDS[state])
+        self._tidy()
 
     def show_trial(self, trial, step, total, phase, number, of):
-        self.task_label.setText("Task: " + task_type(trial.task).heading(trial))
+        # a practice trial is no repetition of the study's ("adjustment, repetition 2" on practice: issue 41)
+        heading = f"{trial.task}, practice" if phase == "practice" else task_type(trial.task).heading(trial)
+        self.task_label.setText("Task: " + heading)
         counted = "" if phase == "page" else f"{'Practice' if phase == 'practice' else 'Trial'} {number} of {of}, "
         self.trial_label.setText(f"{counted}step {step + 1} of {total}")
         self.progress_bar.setRange(0, total)
         self.progress_bar.setValue(step)
+        self._tidy()
 
     def show_selection(self, source, fmax):
         text = source or "none selected yet"
@@ -72,10 +87,13 @@ class ProgressPanel(QGroupBox):
 
     def show_condition(self, hidden):
         self.condition_label.setText("hidden (blinding)" if hidden else self.condition_text)
+        self._tidy()
 
     def show_response(self, response, step):
         self.response_label.setText(task_type(response["task"]).response_text(response))
         self.progress_bar.setValue(step + 1)
+        self._tidy()
 
     def show_pickup(self, control, pending, text):
         self.pickup_label.setText(f"{control}: {text}" if pending else "")
+        self._tidy()

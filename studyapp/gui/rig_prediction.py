@@ -1,7 +1,7 @@
 """The rig check's prediction off the GUI thread: a ``QRunnable`` on a ``QThreadPool`` of its own.
 
 ``RigPrediction.run(req)`` returns at once: a cached result (rig_check.PredictionCache,
-per protocol hash, latency, packet and rate) is announced straight away,
+per protocol hash, latency, packet and rate; kept on disk between launches) is announced straight away,
 else the prediction (``predict(req, progress=...)``, 20-25 s of one core for
 nine conditions over 5 seeds) runs on a pool thread at the lowest CPU
 priority (the engine's worker and the GUI come first), reporting
@@ -84,7 +84,8 @@ class RigPrediction(QObject):
             pool = QThreadPool(self)
             pool.setMaxThreadCount(1)
         self.pool = pool
-        self.cache = rig_check.PredictionCache()
+        # on disk for the model's own predictions only: a test's stand-in must never be shown as a rig's
+        self.cache = rig_check.PredictionCache(rig_check.cache_path() if predict is rig_check.predict else None)
         self.current = None  # the request being shown
         self._running = {}  # key -> (request, its cancel event), while its job is queued or runs
         self._signals = _Signals()

@@ -134,6 +134,7 @@ class SetupPanel(QWidget):
         self.audio = QLabel("")
         self.midi = QLabel("")
         self.engine = QLabel("")
+        self._engine_words = ""  # rate and block of the running engine (its pacing line, show_pacing)
         for label in (self.audio, self.midi, self.engine):
             label.setWordWrap(True)
         apparatus = QGroupBox("Apparatus")
@@ -243,7 +244,8 @@ class SetupPanel(QWidget):
             audio = info.get("audio", "?")
             self.audio.setText(_with_notice(_audio_words(audio), notices.get("audio")))
             self.show_midi(info.get("midi", "none"), notices.get("midi"))
-            self.engine.setText(f"{info['rate']:g} Hz, blocks of {info['block']}, paced by the {info['paced']}")
+            self._engine_words = f"{info['rate']:g} Hz, blocks of {info['block']}"
+            self.show_pacing(info["paced"])
         elif state == "starting":
             for label in (self.audio, self.midi):
                 label.setText("looking…")
@@ -251,6 +253,11 @@ class SetupPanel(QWidget):
         else:
             self.engine.setText(state)
 
+
+    def show_pacing(self, clock, why=""):
+        """The engine line's pacing: ``clock`` (device, audio, timer), with ``why`` it changed (the notice)."""
+        words = f"{self._engine_words}, paced by the {clock}"
+        self.engine.setText(_with_notice(words, why) if why else words)
 
     def show_midi(self, description, notice=None):
         """The MIDI line for the engine's ``description`` of its input (and its latest MIDI notice)."""

@@ -47,6 +47,7 @@ from pathlib import Path
 from studyapp.engine.config import HANG_TIMEOUT
 from studyapp.engine.events import DeviceHealth, DeviceInfo
 from studyapp.engine.load_margin import busy_warning, load_per_core
+from studyapp.engine.safety import force_off_text
 from studyapp.errors import UserError
 from studyapp.experiment import records
 from studyapp.experiment.enrolment import apparatus_is_simulated, check_same_player
@@ -62,7 +63,7 @@ from studyapp.live.engine_host import EngineHost
 from studyapp.live.evented import EventGroup
 from studyapp.live.hand import Hand
 from studyapp.live.master_sound import MasterSound
-from studyapp.live.devices import Devices
+from studyapp.live.devices import Devices, rig_words
 from studyapp.live.states import REST, TRANSITIONS, State
 from studyapp.live.status_watch import StatusWatch
 from studyapp.live.trial_media import TrialMedia
@@ -92,7 +93,8 @@ class SessionController:
         self.fed = 0  # end (sample number) of the telemetry read while a trial ran
         self.trial_serial = 0  # counts steps started (restarts too); tags the step's samples and controls
         self.sound = MasterSound()  # the console's master volume and mute (master_sound.py)
-        self.stopped_by = "operator"  # who pressed the emergency stop last (states.emergency)
+        self.stopped_by = "operator"  # who pressed the emergency stop last (states.emergency), or "fault"
+        self.fault = ""  # the fault the engine latched on its own that stopped the session (states.fault_stop)
         self.simulated = False  # the simulated participant plays the session (apparatus "participant")
         self.abort_reason = None  # why the session is being aborted, when not the experimenter's Abort
         self.last_session = None  # the folder of the latest session started here (notes after it ends)
@@ -164,11 +166,13 @@ class SessionController:
         self.controls.engine_replaced()
 
     def start_session(self, participant, results="results", resume=False, seed=None, apparatus=None, details=None,
-                      logged=()):
+                      logged=(), confirm_rig=None):
         """Open the participant's session (``UserError`` when refused) and start its engine.
 
         ``details``: ``experimenter``, ``session_number``, ``notes``, ``order_row`` (experiment/session_info.py).
         ``logged``: records for the session's log before its trials (the rig check's warning, rig_check.record).
+        ``confirm_rig(question)``: asked when a resumed session last ran on another device (False: not resumed);
+        None takes the change. Either way a change taken is logged (``rig_change``) and said.
         """
         if self.protocol is None:
             raise UserError("no protocol loaded: choose one first")
@@ -182,6 +186,16 @@ class SessionController:
         if resume:
             check_same_player(results, self.protocol.study, participant, simulated)
             session = Session.resume(self.protocol, participant, results, seed=seed, **(details or {}))
+            change = self.devices.change(session)
+            if change is not None:
+                before, now, question = change
+                if confirm_rig is not None and not confirm_rig(question):
+                    session.log.append(records.rig_change(before, now, accepted=False))
+                    session.close()
+                    raise UserError(f"not resumed: the session last ran on {rig_words(before)}, the console runs on "
+                                    f"{rig_words(now)} (choose that device in Apparatus, or resume here)")
+                logged = (records.rig_change(before, now), *logged)
+                self.message(f"resumed on another rig: {question.rsplit('. ', 1)[0]}", level="warning")
         else:
             described = {"device": self.apparatus.device or "simulated", "engine": "real-time", **(apparatus or {})}
             session = Session.create(self.protocol, participant, results, seed=seed, apparatus=described,
@@ -221,6 +235,22 @@ class SessionController:
         ``by``: who stopped, ``operator`` (the console) or ``participant`` (Esc on the participant's window)."""
         self.stopped_by = by
         self.fire("emergency")
+
+    def fault_stop(self, fault):
+        """The engine latched ``fault`` on its own: a session stops as for the emergency stop; at rest the preview
+        holds it the same way (Resume clears it)."""
+        if self.state in (State.RUNNING, State.PAUSED, *REST):
+            self.stopped_by, self.fault = "fault", str(fault)
+            self.fire("fault")
+
+    @property
+    def stop_text(self):
+        """What holds the force at zero, and what to do, in the experimenter's words (the EMERGENCY state's)."""
+        if self.stopped_by != "fault":
+            return force_off_text(self.stopped_by)
+        return (f"Stopped by a fault: {self.fault or 'the engine latched a fault'}. Force off, nothing sounds. "
+                "Check the device (powered, connected), then press Resume: it re-arms the device, reopens its link "
+                "if it had gone, and repeats the trial")
 
     def clear_emergency(self):
         """Unlatch the emergency stop (the experimenter's decision); a session's trial then starts again."""

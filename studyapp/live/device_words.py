@@ -7,7 +7,7 @@ source (the handshake's own gains, or a TOML file), the round trip measured
 at open (PING probe: median and 99th percentile) and the link's latency (the
 samples the host answers ahead, and the same in ms), or "loop on the device" for a
 device that runs the loop itself (protocol 2: latency 0, the paper's loop). From a ``DeviceHealth``:
-a trial's frame counts, the problems first.
+a step's frame counts, the problems first, the step named as the console counts it (``step_words``).
 """
 
 UNITS = {"position": "m", "velocity": "m/s", "acceleration": "m/s²"}
@@ -53,8 +53,20 @@ def late_risk(info):
     return None
 
 
-def health(trial, counts):
-    """A trial's frame counts: ``trial 3: 5000 frames, 0 corrupt, ...``."""
+def health(where, counts):
+    """A step's frame counts: ``step 3 of 12: 5000 frames, ...`` (``where``: ``step_words``)."""
     frames = counts.get("frames", 0)
     problems = ", ".join(f"{counts.get(key, 0)} {key}" for key in PROBLEMS)
-    return f"trial {trial}: {frames} frames, {counts.get('samples', 0)} samples; {problems}"
+    return f"{where}: {frames} frames, {counts.get('samples', 0)} samples; {problems}"
+
+
+def step_words(tag, steps, total):
+    """The engine's trial ``tag`` in the experimenter's words: the session's step it ran (``steps``: tag ->
+    step index, ``total`` steps), else the tag itself. The engine tags a held page with its tag negated:
+    the console said "trial -5" (issue 41, item 12)."""
+    step = steps.get(abs(int(tag)))
+    if step is not None:
+        return f"step {step + 1} of {total}"
+    if tag == 0:
+        return "no step (the engine's start, or the preview)"
+    return f"trial {tag}" if tag > 0 else f"a held page ({-tag})"

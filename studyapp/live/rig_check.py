@@ -25,17 +25,27 @@ console's question at Start and in ``studyapp run``'s progress).
 A protocol without an adjustment task, or without LVT or another estimator in
 it, has nothing to check (``request`` is None / the margin is nan: no
 warning). ``PredictionCache`` keeps each result per ``Request.key``:
-(protocol hash, latency, packet, rate).
+(protocol hash, latency, packet, rate), in memory and, for ``predict``'s own
+results, on disk (``cache_path``) so a relaunch does not compute it again.
 """
 
+import json
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
+from studyapp.io.atomic import atomic_open
 from studyapp.model import link_prediction
 from studyapp.model.link_prediction import MARGIN
 from studyapp.model.sources import LVT_SENSOR, TRUE
 
 ADJUSTMENT = "adjustment"
+# what the experimenter can change, with the controls that exist (issue 41, item 10: the warning named a doc)
+REMEDY = ("To change it: a device that runs the loop itself keeps the effect on any link (docs/devices.md, "
+          "\"The loop on the device\"); or answer the device fewer samples ahead if its round trip allows "
+          "(now {samples}): start the console with `studyapp gui --device LINK --device-latency SAMPLES` "
+          "(`--device-silence SECONDS` for the silence bound), as `studyapp live` takes them")
 SIMULATED, DEVICE_LOOP = "simulated", "device-loop"
 
 
@@ -158,7 +168,8 @@ class Verdict:
         return (f"warning: at this rig's link latency of {self.rig.latency_samples} samples "
                 f"({self.rig.latency_ms:.2f} ms at {self.rig.rate:g} Hz) the model predicts LVT's bowing "
                 f"breakdown at {self.margin:.2f}x the best estimator's ({self.best}), below {MARGIN:g}x: the "
-                "paper's effect (LVT nearly twice the estimators) is not expected on this rig (docs/devices.md)")
+                "paper's effect (LVT nearly twice the estimators) is not expected on this rig. "
+                f"{REMEDY.format(samples=self.rig.latency_samples)}")
 
 
 def verdict(prediction, rig):
@@ -180,14 +191,57 @@ def rows(prediction):
     return [(name, "stable to 200 N" if math.isinf(v) else f"{v:.2f} N") for name, v in ordered]
 
 
-class PredictionCache:
-    """Predictions kept per ``Request.key`` (protocol hash, latency, packet, rate)."""
+def cache_path():
+    """The predictions kept between launches: ``$STUDYAPP_RIG_PREDICTIONS`` (a file; the tests' own), else
+    ``$XDG_CACHE_HOME/studyapp/rig_predictions.json`` (~/.cache)."""
+    given = os.environ.get("STUDYAPP_RIG_PREDICTIONS")
+    if given:
+        return Path(given)
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "studyapp" / "rig_predictions.json"
 
-    def __init__(self):
+
+class PredictionCache:
+    """Predictions kept per ``Request.key`` (protocol hash, latency, packet, rate); with a ``path``, on disk too.
+
+    The file (JSON, written whole: io/atomic.py) is read at start and written at each ``put``, so a relaunch
+    (``gui --screenshot``, ``run`` then its console) shows a rig's prediction at once instead of minutes of
+    searches (issue 41, item 10). Only ``predict``'s own results go there (``RigPrediction`` keeps a test's
+    stand-in in memory). A file that cannot be read or written is ignored: it only saves time."""
+
+    VERSION = 1
+
+    def __init__(self, path=None):
+        self.path = None if path is None else Path(path)
         self._kept = {}
+        if self.path is not None:
+            self._kept = self._load()
 
     def get(self, req):
         return self._kept.get(req.key)
 
     def put(self, req, prediction):
         self._kept[req.key] = dict(prediction)
+        if self.path is not None:
+            self._save()
+
+    def _load(self):
+        try:
+            stored = json.loads(self.path.read_text())
+            if stored.get("version") != self.VERSION:
+                return {}
+            return {(str(h), float(lat), float(pk), float(rate)): {n: math.inf if v is None else float(v)
+                                                                  for n, v in prediction.items()}
+                    for (h, lat, pk, rate), prediction in stored["predictions"]}
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return {}
+
+    def _save(self):
+        stored = {"version": self.VERSION,
+                  "predictions": [[list(key), {n: None if math.isinf(v) else v for n, v in prediction.items()}]
+                                  for key, prediction in self._kept.items()]}
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_open(self.path) as f:
+                json.dump(stored, f)
+        except OSError:
+            pass

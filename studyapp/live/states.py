@@ -7,6 +7,7 @@
     RUNNING / PAUSED  --engine_failed-->  ENGINE_LOST  --restart-->  RESTARTING
     RESTARTING  --engine_up-->  RUNNING (the trial again)   --engine_failed-->  ENGINE_LOST
     any  --emergency-->  EMERGENCY  --clear-->  CLEARING  --cleared-->  RUNNING (the trial again) or rest
+    RUNNING / PAUSED / rest  --fault-->  EMERGENCY (the engine latched a fault of its own: a device's, the loop's)
                                                   CLEARING  --clear_timeout-->  EMERGENCY (the stop holds again)
 
 ``TRANSITIONS`` maps (state, event) to a function of the controller
@@ -23,7 +24,14 @@ its force scale at its next block, ``studyapp.engine.safety``), F_max is set
 to 0, the bow lifted, the knobs unmapped. Clearing unlatches it and, once the
 engine reports it cleared, starts the current trial again from its beginning
 (as a resumed session does: an adjustment trial from F_max = 0), never back at
-the F_max that was in force. Engine failure: if the worker dies or hangs
+the F_max that was in force. A fault the engine latches on its own during a session (a device on a link
+that faulted, went silent or closed; the loop's own guard) stops the session
+the same way (``fault_stop``, ``stopped_by`` "fault", the fault's text in the
+state's words, ``stop_text``): the force is already zero, and a session left
+"Running" with no force would take the participant's confirms against
+nothing heard. Resume clears it as it clears the emergency stop (re-arming
+the device, reopening its link if it had gone) and repeats the trial.
+Engine failure: if the worker dies or hangs
 during a session (its watchdog zeroes the force), the session waits in
 ENGINE_LOST; restarting starts a new engine and, once it runs, the current
 trial again from its beginning.
@@ -31,7 +39,6 @@ trial again from its beginning.
 
 from enum import StrEnum
 
-from studyapp.engine.safety import force_off_text
 from studyapp.experiment import records
 from studyapp.experiment.session_info import order_text
 from studyapp.experiment.session_runner import SessionRunner
@@ -184,16 +191,30 @@ def restart_failed(c):
 
 # the emergency stop -------------------------------------------------------------------------------------
 def emergency(c):
+    if c.stopped_by == "fault":  # a clear the engine did not confirm gives the fault's stop back: nothing new
+        return _force_off(c)
     c.apparatus.disable_force(c.stopped_by)
+    if c.runner is not None and c.state != State.EMERGENCY:
+        c.runner.log(records.emergency_stop(c.stopped_by))
+    return _force_off(c)
+
+
+def fault_stop(c):
+    """The engine latched a fault of its own (``c.fault``): the force is zero already; held as an emergency stop
+    (at rest too: the preview's fault is cleared by Resume, not only by an emergency stop first)."""
+    if c.runner is not None:
+        c.runner.log(records.emergency_stop("fault", fault=c.fault))
+    return _force_off(c)
+
+
+def _force_off(c):
     c.media.reference_tone(False)
     loop = c.runner.loop if c.runner is not None else None
     if loop is not None and c.engine is not None and loop.engine is c.engine:
         loop.hold(True)
     else:
         c.apparatus.silence()
-    if c.runner is not None and c.state != State.EMERGENCY:
-        c.runner.log(records.emergency_stop(c.stopped_by))
-    c.message(force_off_text(c.stopped_by), level="error")
+    c.message(c.stop_text, level="error")
     c.events.bowing.emit(on=False)
     return State.EMERGENCY
 
@@ -257,6 +278,7 @@ TRANSITIONS = _table(
     ((State.RESTARTING,), "engine_up", restart_trial),
     ((State.RESTARTING,), "engine_failed", restart_failed),
     (EVERY, "emergency", emergency),
+    ((State.RUNNING, State.PAUSED, *REST), "fault", fault_stop),
     ((State.EMERGENCY,), "engine_up", hold_new_engine),
     ((State.EMERGENCY,), "clear", clear),
     ((State.CLEARING,), "cleared", cleared),

@@ -9,10 +9,12 @@ latched and its force word is set again. A clear the worker does not confirm
 within ``CLEAR_TIMEOUT`` (a worker whose loop latched its own fault refuses
 it) gives the emergency stop back (``clear_timeout``) with an error message
 naming the fault and force state: the console is never left "Clearing" for
-good.
+good. A fault latched with the force word still set is the engine's own (a
+device's, the loop's guard), never a stop: during a session it stops the
+session (``fault_stop``), checked at every status read.
 """
 
-from studyapp.live.states import State
+from studyapp.live.states import REST, State
 
 STATUS_PERIOD = 0.25  # s between status events (the status bar needs no more)
 CLEAR_TIMEOUT = 5.0  # s a cleared stop may wait for the worker's word that it cleared; then the stop holds again
@@ -41,7 +43,9 @@ class StatusWatch:
             if live.runner is None:
                 live.events.selection.emit(source=status["source"], fmax=status["fmax"])
         force_enabled = bool(engine.status_block.force_enable)
-        if clearing and not status["fault_latched"] and force_enabled:
+        if status["fault_latched"] and force_enabled and live.state in (State.RUNNING, State.PAUSED, *REST):
+            live.fault_stop(status["fault"] or "safety fault")  # the engine's own: a stop clears the force word
+        elif clearing and not status["fault_latched"] and force_enabled:
             live.fire("cleared")
         elif clearing and now - self.clearing_since > CLEAR_TIMEOUT:
             live.message(f"the engine did not confirm the clear within {CLEAR_TIMEOUT:g} s (fault latched: "

@@ -21,6 +21,7 @@ from studyapp.live.apparatus import trial_actions
 def make_loop(c, estimators, source, seed):
     """The runner's ``make_loop`` (``seed`` unused: the engine keeps the session's, engine_loop.py)."""
     c.trial_serial += 1
+    c.devices.steps[c.trial_serial] = c.runner.trial.step
     task = c.runner.task
     positions = {f"knob{i + 1}": int(v) for i, v in task.knob_positions().items() if v is not None}
     loop = c.apparatus.loop(estimators, source, c.protocol.gesture, c.trial_serial,
@@ -50,6 +51,7 @@ def start_step(c, held):
     if page is not None:
         c.controls.page_appears()
         c.trial_serial += 1
+        c.devices.steps[c.trial_serial] = trial.step
         c.apparatus.hold_page(c.trial_serial)
         c.media.cue("start")  # a page's span in audio_cues.csv too (the level check's tone is recorded)
         c.media.reference_tone(page.kind == "calibration")

@@ -44,3 +44,24 @@ def test_the_timeout_says_how_long_it_waited_and_for_what(qapp, capsys, monkeypa
     assert capsys.readouterr().err.strip() == \
         f"studyapp gui: error: the engine is {state} 240 s after the console opened: {why}"
     assert not bowing.timer.isActive() and exits == [1]
+
+
+def test_while_it_waits_it_says_so_every_15_s_with_the_rig_checks_searches(qapp, capsys):
+    # issue 41, item 10: an offscreen console with the default protocol said nothing for 240 s
+    from studyapp.gui.preview_bowing import REPORT_EVERY, PreviewBowing
+
+    now = [1000.0]
+    console = _Console("starting", False, 0)
+    bar = SimpleNamespace(isVisible=lambda: True, value=lambda: 7, maximum=lambda: 45)
+    console.device_panel = SimpleNamespace(progress=bar)
+    bowing = PreviewBowing(console, timeout=240.0, clock=lambda: now[0])
+    bowing._check()
+    assert capsys.readouterr().err == ""
+    now[0] += REPORT_EVERY
+    bowing._check()
+    assert capsys.readouterr().err.strip() == ("studyapp gui: waiting 15 s (at most 240): the engine is starting; "
+                                               "rig check (in the background): 7 of 45 searches")
+    now[0] += 1.0
+    bowing._check()
+    assert capsys.readouterr().err == ""  # one line per 15 s, not one per check
+    bowing.timer.stop()

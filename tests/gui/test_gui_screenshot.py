@@ -58,3 +58,18 @@ def test_screenshot_at_a_lab_laptops_size_with_the_papers_protocol(xvfb_display,
     assert stop_red.mean() > 0.005  # the EMERGENCY STOP button is in the picture
     force_orange = np.all(np.abs(pixels.astype(int) - (255, 127, 14)) <= 1, axis=1)
     assert force_orange.sum() > 500  # the scope drew the force
+
+
+def test_an_offscreen_screenshot_at_1366x768_is_1366x768(tmp_path):
+    # issue 41, item 11: offscreen (no X server, Qt's 800 x 800 offscreen screen) the console was maximised
+    # to that screen and forced wider by its minimum width: a 1084 x 796 picture
+    from matplotlib.image import imread
+
+    path = tmp_path / "console-offscreen.png"
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
+    done = subprocess.run(
+        [sys.executable, "-m", "studyapp", "gui", "--protocol", str(DEMO), "--screenshot", str(path),
+         "--size", "1366x768", "--audio", "null", "--midi", "none", "--results", str(tmp_path / "results")],
+        cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert imread(path).shape[:2] == (768, 1366)

@@ -37,12 +37,17 @@ class FakeStatusBlock:
         self.force_enable = False
 
 
+LINK_INFO = {"name": "studyapp emulator", "serial": "EMU-0000", "latency_ms": 1.0}  # a fake link device's handshake
+
+
 class FakeEngine:
     def __init__(self, config):
         self.config = config
         self.names = list(config.estimators)
         self.info = {"rate": config.rate, "block": 10, "audio": "null", "midi": "none", "paced": "timer",
                      "realtime": False, "names": self.names}
+        if config.device:  # a device on a link: its handshake, as the engine's info carries it
+            self.info.update(paced="device", device=dict(LINK_INFO))
         self.sent = []
         self.faults = []
         self.status_block = FakeStatusBlock()

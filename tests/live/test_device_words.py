@@ -19,8 +19,18 @@ def test_the_handshake_calibration_and_latency_in_words():
 def test_a_trials_health():
     counts = {"frames": 5000, "samples": 5000, "corrupt": 1, "lost": 0, "missing": 2, "late": 3, "faults": 0,
               "clamped": 0}
-    assert device_words.health(4, counts) == ("trial 4: 5000 frames, 5000 samples; 1 corrupt, 0 lost, 2 missing, "
-                                              "3 late, 0 faults, 0 clamped")
+    assert device_words.health("trial 4", counts) == ("trial 4: 5000 frames, 5000 samples; 1 corrupt, 0 lost, "
+                                                      "2 missing, 3 late, 0 faults, 0 clamped")
+
+
+def test_a_held_pages_tag_is_named_by_its_step_never_as_a_negative_trial():
+    # issue 41, item 12: the console read "trial -5: 5394 frames" for a page the engine held
+    steps = {4: 2, 5: 3}  # engine tags 4 and 5 tagged the session's steps 3 and 4 (from 0: 2 and 3)
+    assert device_words.step_words(-5, steps, 12) == "step 4 of 12"
+    assert device_words.step_words(4, steps, 12) == "step 3 of 12"
+    assert device_words.step_words(0, {}, 0) == "no step (the engine's start, or the preview)"
+    assert device_words.step_words(7, {}, 0) == "trial 7"
+    assert "-" not in device_words.step_words(-7, {}, 0)
 
 
 def test_a_device_loop_says_loop_on_the_device_and_never_warns_of_late_forces():

@@ -128,7 +128,9 @@ def scripted_session(tmp_path):
     engine.latched = True
     c.host.play(0.05)
     c.poll()
-    engine.latched, engine.broken = False, 0.0
+    engine.latched, engine.broken = False, 0.0  # the fault stopped the session (issue 41, item 7): cleared
+    c.clear_emergency()
+    c.poll()
     engine.counters.update(deadline_misses=2, audio_underruns=1, audio_limited=3)
     c.emergency_stop()
     c.host.engine.latched = True

@@ -71,8 +71,9 @@ def test_the_verdict_its_text_and_warning_line():
     assert warns.warns and warns.margin == pytest.approx(3.09 / 2.85)
     assert warns.warning == ("warning: at this rig's link latency of 5 samples (1.00 ms at 5000 Hz) the model "
                              "predicts LVT's bowing breakdown at 1.08x the best estimator's (LOWPASS), below 1.5x: "
-                             "the paper's effect (LVT nearly twice the estimators) is not expected on this rig "
-                             "(docs/devices.md)")
+                             "the paper's effect (LVT nearly twice the estimators) is not expected on this rig. "
+                             + rig_check.REMEDY.format(samples=5))
+    assert "(now 5)" in warns.warning and "--device-latency SAMPLES" in warns.warning
     alone = rig_check.verdict({"LVT": 3.0}, rig)
     assert math.isnan(alone.margin) and not alone.warns and alone.warning is None
     record = rig_check.record(rig_check.verdict({"LOWPASS": math.inf, "LVT": 3.0}, rig), started_anyway=True)
@@ -90,6 +91,27 @@ def test_the_cache_keeps_a_prediction_per_protocol_latency_packet_and_rate():
     assert cache.get(rig_check.request(protocol, rig_check.Rig("link", 5000.0, 5))) == {"LVT": 3.0}
     assert cache.get(rig_check.request(protocol, rig_check.Rig("link", 5000.0, 1))) is None
     assert cache.get(rig_check.request(protocol, rig_check.Rig("simulated", 5000.0))) is None
+
+
+def test_predictions_are_kept_on_disk_keyed_as_in_memory(tmp_path):
+    # issue 41, item 10: a relaunch (gui --screenshot, run then its console) computed the prediction again
+    protocol = load_protocol(DEMO)
+    path = tmp_path / "cache" / "rig_predictions.json"
+    at_1ms = rig_check.request(protocol, rig_check.Rig("link", 5000.0, 5))
+    rig_check.PredictionCache(path).put(at_1ms, {"LVT": 3.09, "LOWPASS": math.inf})
+    again = rig_check.PredictionCache(path)  # another launch
+    assert again.get(rig_check.request(protocol, rig_check.Rig("link", 5000.0, 5))) == {"LVT": 3.09,
+                                                                                       "LOWPASS": math.inf}
+    assert again.get(rig_check.request(protocol, rig_check.Rig("link", 5000.0, 1))) is None
+    assert again.get(rig_check.request(protocol, rig_check.Rig("link", 2500.0, 5))) is None
+    path.write_text("{not json")
+    assert rig_check.PredictionCache(path).get(at_1ms) is None  # a damaged file only costs the time
+
+
+def test_the_cache_lies_under_xdg_cache_home(monkeypatch, tmp_path):
+    monkeypatch.delenv("STUDYAPP_RIG_PREDICTIONS")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert rig_check.cache_path() == tmp_path / "studyapp" / "rig_predictions.json"
 
 
 @pytest.mark.parametrize("samples, warns", [(0, False), (5, True)])
@@ -128,3 +150,28 @@ def test_session_json_and_the_export_carry_the_device(tmp_path):
     assert set(by.get_group("S01").device_latency_ms) == {0.0}
     assert set(by.get_group("L01").device) == {"studyapp emulator"}
     assert set(by.get_group("L01").device_serial) == {"EMU-0042"} and set(by.get_group("L01").device_latency_ms) == {1.0}
+
+
+def test_each_response_carries_the_device_of_the_engine_run_that_answered_it(tmp_path):
+    # issue 41, item 9: a session started on the emulator and resumed on the simulated device was exported with
+    # the emulator on every row, though the resumed runs' engine records had no device
+    from studyapp.experiment import records
+
+    protocol = load_protocol(trials_only_demo(tmp_path))
+    session = Session.create(protocol, "R01", tmp_path / "r", seed=4,
+                             device={"kind": "link", "link": "/tmp/dev", "info": INFO})
+    engine = {"rate": 5000.0, "block": 10, "audio": "null", "midi": "none", "paced": "device", "realtime": False}
+    session.log.append(records.engine({**engine, "device": INFO}, 4))
+    run_simulated(session, trials=2).finish("aborted")
+    session.close()
+    resumed = Session.resume(protocol, "R01", tmp_path / "r")
+    resumed.log.append(records.engine({**engine, "paced": "timer"}, 4))  # the simulated device: no ``device``
+    run_simulated(resumed).finish()
+    resumed.close()
+    frame = export_responses(tmp_path / "r").sort_values("step")
+    first, rest = frame[frame.step < 2], frame[frame.step >= 2]
+    assert len(first) >= 2 and len(rest) >= 1
+    assert set(first.device) == {"studyapp emulator"} and set(first.device_serial) == {"EMU-0042"}
+    assert set(first.device_latency_ms) == {1.0}
+    assert set(rest.device) == {"simulated"} and rest.device_serial.isna().all()
+    assert set(rest.device_latency_ms) == {0.0}

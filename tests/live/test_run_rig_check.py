@@ -67,3 +67,28 @@ def test_a_device_that_is_no_link_is_one_line_before_anything_starts(tmp_path):
     lines = proc.stderr.strip().splitlines()
     assert proc.returncode == 2 and len(lines) == 1 and str(regular) in lines[0] and "regular file" in lines[0]
     assert not (tmp_path / "results").exists()
+
+
+def test_the_warnings_controls_exist_on_the_console_and_reach_its_engines(monkeypatch):
+    # issue 41, item 10: the warning named docs/devices.md; the console had no control for the latency or silence
+    import argparse
+    import re
+
+    from studyapp.cli import device_choice
+    from studyapp.errors import ParameterError
+
+    named = set(re.findall(r"--device-[a-z]+", rig_check.REMEDY))
+    assert named == {"--device-latency", "--device-silence"}
+    done = subprocess.run([sys.executable, "-m", "studyapp", "gui", "--help"], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT)
+    assert done.returncode == 0 and all(option in done.stdout for option in named)
+    args = argparse.Namespace(device_latency=2, device_silence=0.5)
+    assert device_choice.link_options(args, "/tmp/dev") == {"device_latency": 2, "device_silence": 0.5}
+    with pytest.raises(ParameterError, match="need --device"):
+        device_choice.link_options(args, None)
+    with pytest.raises(ParameterError, match="device latency = 0"):
+        device_choice.link_options(argparse.Namespace(device_latency=0, device_silence=None), "/tmp/dev")
+    said = []
+    monkeypatch.setattr(rig_check, "predict", lambda req: {"LOWPASS": 2.89, "LEVANT": 2.89, "LVT": 3.09})
+    req, _, warning = rig_check_line(load_protocol(DEMO), "/tmp/studyapp-device", said.append, latency=2)
+    assert req.rig.latency_samples == 2 and "(now 2)" in warning

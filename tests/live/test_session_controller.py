@@ -6,11 +6,12 @@ from pathlib import Path
 import pytest
 
 from studyapp.engine import commands as cmd
+from studyapp.errors import UserError
 from studyapp.experiment.session_log import read_events
 from studyapp.model.fmax_knob import fmax_from_knob
 from studyapp.live.controller import TRANSITIONS, SessionController, State
 from studyapp.live.status_watch import CLEAR_TIMEOUT
-from tests.live.fakes import LATENCY, FakeHost
+from tests.live.fakes import LATENCY, LINK_INFO, FakeHost
 
 PROTOCOL = """
 [study]
@@ -61,6 +62,9 @@ EXPECTED = {
     (S.CLEARING, "cleared"): S.RUNNING,
     (S.CLEARING, "clear_timeout"): S.EMERGENCY,  # the worker never confirmed: the stop holds again
     (S.CLEARING, "engine_failed"): S.ENGINE_LOST,
+    (S.RUNNING, "fault"): S.EMERGENCY,  # the engine latched a fault of its own (a device's): the session stops
+    (S.PAUSED, "fault"): S.EMERGENCY,
+    **{(rest, "fault"): S.EMERGENCY for rest in (S.IDLE, S.FINISHED, S.ABORTED)},  # the preview's fault too
 }
 
 
@@ -163,6 +167,10 @@ def take(c, state, event):
     elif event == "cleared":
         c.host.engine.latched = False
         c.poll()
+    elif event == "fault":  # the worker latches a fault, its force word still set: not a stop
+        c.host.engine.latched = True
+        c.status_watch.next_status = 0.0
+        c.poll()
     elif event == "clear_timeout":
         c.host.engine.latched = True  # the worker never confirms the clear
         started = c.clock()
@@ -171,6 +179,29 @@ def take(c, state, event):
     else:
         {"abort": c.abort, "pause": c.pause, "resume": c.resume, "emergency": c.emergency_stop,
          "clear": c.clear_emergency, "restart": c.restart_engine, "done": lambda: c.fire("done")}[event]()
+
+
+def test_a_fault_of_the_engines_own_stops_the_session_says_so_and_resume_repeats_the_trial(controller):
+    # issue 41, item 7: on main a device fault left the session "Running" with no force
+    c = controller
+    messages = []
+    c.events.message.connect(lambda text, level, topic: messages.append((level, text)))
+    start(c)
+    up(c)
+    c.host.engine.latched = True
+    c.status_watch.next_status = 0.0
+    c.poll()
+    assert c.state == S.EMERGENCY and c.stopped_by == "fault"
+    assert c.stop_text.startswith("Stopped by a fault:") and "press Resume" in c.stop_text
+    assert ("error", c.stop_text) in messages
+    assert not c.accepting  # no knob or pad is taken against a force that is off
+    c.clear_emergency()
+    assert c.state == S.CLEARING
+    c.host.engine.latched = False
+    c.poll()
+    assert c.state == S.RUNNING
+    c.emergency_stop()  # the operator's stop afterwards reads as the operator's
+    assert c.stop_text.startswith("Emergency stop (operator)")
 
 
 def test_a_clear_the_worker_never_confirms_gives_the_stop_back_instead_of_clearing_for_good(controller):
@@ -487,3 +518,31 @@ def test_a_turn_the_worker_applied_before_an_emergency_stop_is_logged_but_not_gi
     assert late == [{"step": 1, "task": "adjustment", "type": "late_control", "control": "knob1", "value": 60}]
     assert not any(e["type"] == "knob" and e["task"] == "adjustment" for e in events)
     assert engine.fmax == 0.0
+
+
+def test_a_session_resumed_on_another_rig_is_asked_about_and_logged(controller):
+    # issue 41, item 9: P01 started on the emulator, aborted, resumed on the simulated device with no question
+    c = controller
+    c.apparatus.device, c.devices.info = "/tmp/emulator", dict(LINK_INFO)  # the console runs on a link device
+    start(c)
+    up(c)  # its engine record carries the device (the fake engine reports the console's device below)
+    c.abort()
+    c.apparatus.device, c.devices.info = None, None  # now the simulated device
+    asked = []
+
+    def refuse(question):
+        asked.append(question)
+        return False
+
+    with pytest.raises(UserError, match="last ran on studyapp emulator \\(serial EMU-0000\\)"):
+        c.start_session("P01", c.results, resume=True, confirm_rig=refuse)
+    assert not c.in_session and "the simulated device" in asked[0]
+    c.start_session("P01", c.results, resume=True, confirm_rig=lambda question: True)
+    up(c)
+    changes = [e for e in log(c) if e["type"] == "rig_change"]
+    assert [change["accepted"] for change in changes] == [False, True]  # the refusal logged too
+    assert changes[1]["now"] == {"kind": "simulated", "latency_ms": 0.0}
+    assert changes[1]["before"]["info"]["serial"] == "EMU-0000"
+    c.abort()
+    c.start_session("P01", c.results, resume=True, confirm_rig=lambda question: pytest.fail("asked again"))
+    up(c)  # the last run was on the simulated device already: nothing to ask
