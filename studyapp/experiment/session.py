@@ -63,6 +63,7 @@ from studyapp.provenance import environment
 from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
+from studyapp.experiment.folder_links import refuse_links
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
 from studyapp.experiment.log_scan import written_twice
@@ -199,6 +200,7 @@ class Session:
         order_row = check_order_row(protocol, order_row)
         study_folder = Path(results) / protocol.study
         participant_folder = study_folder / participant
+        refuse_links(results, participant_folder)  # read-only, before anything is made or written
         if not lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
             _refuse_existing(participant_folder, participant)
         try:
@@ -291,9 +293,11 @@ class Session:
             raise UserError(f"{given[0].replace('_', ' ')}: set when a session starts, not when it is resumed: "
                             "allowed is to leave it empty with resume")
         participant_folder = Path(results) / protocol.study / participant
+        refuse_links(results, participant_folder)
         if not session_folders(participant_folder):
             raise UserError(f"participant {participant!r} has no session to resume in {participant_folder}: "
                             "allowed is to start one without --resume")
+        refuse_links(results, session_folders(participant_folder)[-1])
         if not lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
             read_description(session_folders(participant_folder)[-1])
         lock = ParticipantLock(participant_folder, participant)
@@ -346,12 +350,8 @@ class Session:
 
 
 def _check_owner(info, participant, participant_folder, folder):
-    """Refuse to continue a session that is not ``participant``'s own: a participant folder copied or linked
-    under another ID (its log names the session's participant; its real path, the folder's)."""
-    real = Path(os.path.realpath(participant_folder))
-    if real.name != participant:
-        raise UserError(f"{participant_folder}: a link to {real}, the folder of participant {real.name!r}: "
-                        f"allowed is to resume {real.name!r} by its own ID")
+    """Refuse to continue a session that is not ``participant``'s own: a participant folder copied under another
+    ID (its log names the session's participant; a folder linked is refused before, by ``refuse_links``)."""
     if info["participant"] != participant:
         raise UserError(f"{folder}: holds a session of participant {info['participant']!r} (its log says so), not "
                         f"of {participant!r}: a participant folder copied or renamed is not resumed: allowed is "
