@@ -79,6 +79,7 @@ from studyapp.experiment.session_info import (
 from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
 from studyapp.experiment.session_log import LogLock, LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
 from studyapp.io.free_names import first_free
+from studyapp.io.wav_header import repair_wav
 
 CREATED = records.SESSION_CREATED
 SIMULATED_DEVICE = {"kind": "simulated", "latency_ms": 0.0}  # session.json's ``device`` on the simulated device
@@ -327,10 +328,11 @@ class Session:
                                 "under another participant ID")
             events = log.events
             done = {e.get("step") for e in events if e.get("type") == "response"}
+            heard = repair_recordings(folder)  # under the lock: no engine of this session writes them now
             if all(t["step"] in done for t in info["schedule"]):
-                # resuming is the way to repair a session, a complete one too: its session.json,
-                # and the session_end a kill after the last response kept from being written
-                repaired = []
+                # resuming is the way to repair a session, a complete one too: its session.json, its
+                # recordings' headers, and the session_end a kill after the last response kept from being written
+                repaired = [f"{len(heard)} recording header(s) repaired"] if heard else []
                 if rebuild:
                     _rebuild_description(folder, info)
                     repaired.append("its session.json rebuilt from events.jsonl")
@@ -346,7 +348,9 @@ class Session:
                 log_lock.release()
             lock.release()
             raise
-        return cls(folder, lock, log_lock)
+        session = cls(folder, lock, log_lock)
+        session.notes.extend(heard)
+        return session
 
 
 def _check_owner(info, participant, participant_folder, folder):
@@ -356,6 +360,12 @@ def _check_owner(info, participant, participant_folder, folder):
         raise UserError(f"{folder}: holds a session of participant {info['participant']!r} (its log says so), not "
                         f"of {participant!r}: a participant folder copied or renamed is not resumed: allowed is "
                         f"to resume {info['participant']!r} in its own folder, or to start {participant!r} anew")
+
+
+def repair_recordings(folder):
+    """Make the headers of the session's recordings (``audio*.wav``) match their sizes (``io.wav_header``:
+    a kill between a write and its header's update); one line per file repaired."""
+    return [line for path in sorted(Path(folder).glob("audio*.wav")) if (line := repair_wav(path)) is not None]
 
 
 def lock_taken(participant_folder):
