@@ -17,6 +17,7 @@ screen; a screen that does not exist is refused before anything starts.
 import signal
 from pathlib import Path
 
+from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
 from studyapp.errors import UserError
@@ -97,6 +98,13 @@ def main(args):
     participant = getattr(args, "participant_window", False) or screen_choice is not None or bool(shot)
     screen = choose_screen(screen_choice) if participant else None
     controller, console = build(args)
+    # Ctrl-C in the terminal, and SIGTERM (a logout, a service manager, ``kill``), close the console cleanly:
+    # the session aborted and logged, the engine stopped, its shared memory unlinked. Installed before any
+    # engine starts (SIGTERM's default left 3 segments and 3 semaphores to the resource tracker); the close
+    # is queued, so it runs inside the event loop even when the signal comes before it (Python sees signals
+    # between Qt events)
+    for number in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(number, lambda *_: QTimer.singleShot(0, console.shut_down))
     size = getattr(args, "size", None)
     if size is not None:
         console.resize(*size)
@@ -119,8 +127,6 @@ def main(args):
         console.unattended = ScopeBenchmark(console, args.measure_scope)
     if getattr(args, "start", False) and not (getattr(args, "screenshot", None) or getattr(args, "measure_scope", None)):
         _start_when_possible(console, getattr(args, "seed", None))
-    # Ctrl-C in the terminal closes the console cleanly (Python sees signals between Qt events)
-    signal.signal(signal.SIGINT, lambda *_: console.shut_down())
     code = app.exec()
     console.shut_down()  # an unattended run may leave a session running: no one to ask
     return code
