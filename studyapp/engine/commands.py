@@ -7,6 +7,11 @@ from ``sent`` to the start of the first block run with the new setting). The
 worker applies commands at block boundaries, in order, through a handler table
 (``worker.Worker.HANDLERS``: one method per command type).
 
+Commands whose fields could stop the worker or latch a fault (``InstallActions``,
+``SetHandTarget``) check them when made, and the worker checks them again when
+it obeys them (a command from a pipe was never made here): a bad one is a
+warning, never a dead worker (issue 41, item 17).
+
 An action (model/controls.py: ``FmaxKnob``, ``Select``, ...) maps a control
 (see midi.ControlMap) to commands (``action_commands``). The worker applies
 them itself, in and out of a session, through the mapping in force:
@@ -21,8 +26,10 @@ route whatever the hand turned.
 import time
 from dataclasses import dataclass, field
 
+from studyapp.errors import ParameterError
 from studyapp.model.controls import (
-    LIVE_RANGE, Bowing, FmaxKnob, FmaxLinear, HandTarget, Select, Source, Volume, as_action, as_actions, knob_step,
+    KNOB_MAX, LIVE_RANGE, Bowing, FmaxKnob, FmaxLinear, HandTarget, Select, Source, Volume, as_action, as_actions,
+    hand_target, knob_step,
 )
 
 
@@ -43,7 +50,10 @@ class SetFmax(Command):
 
 @dataclass(frozen=True)
 class SetHandTarget(Command):
-    metres: float  # switches the gesture to "live"
+    metres: float  # switches the gesture to "live"; at most HAND_REACH from the centre (model/limits.py)
+
+    def __post_init__(self):
+        hand_target(self.metres)
 
 
 @dataclass(frozen=True)
@@ -141,7 +151,23 @@ class InstallActions(Command):
     positions: dict | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "actions", as_actions(self.actions))  # typed, whichever spelling was given
+        object.__setattr__(self, "actions", as_actions(self.actions))  # typed and checked, whichever spelling
+        check_install(self)
+
+
+def check_install(install):
+    """Raise ``ParameterError`` unless ``install``'s ``trial`` is a whole number (a tag: negative for a pause)
+    and its ``positions`` None or {control name: knob step 0..127}; checked where it is made and where the
+    worker obeys it."""
+    if not isinstance(install.trial, int) or isinstance(install.trial, bool):
+        raise ParameterError(f"trial = {install.trial!r}: allowed is a whole number")
+    positions = install.positions
+    if positions is None:
+        return
+    if not isinstance(positions, dict) or not all(
+            isinstance(c, str) and isinstance(k, int) and not isinstance(k, bool) and 0 <= k <= KNOB_MAX
+            for c, k in positions.items()):
+        raise ParameterError(f"knob positions {positions!r}: allowed is {{control name: step 0..{KNOB_MAX}}}")
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ events overwritten unread are counted in ``events_dropped`` (also in
 
 import contextlib
 import multiprocessing
+import os
 import threading
 import time
 
@@ -36,7 +37,7 @@ from studyapp.device.link_probe import probe as probe_link
 from studyapp.device.link_open import is_link
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
-from studyapp.engine import guard, midi_hotplug, shm_names
+from studyapp.engine import guard, midi_hotplug, parent_death, shm_names
 from studyapp.engine.audio.sinks import parse as parse_audio
 from studyapp.engine.config import EngineConfig
 from studyapp.engine.event_ring import EventRing
@@ -61,6 +62,7 @@ class Engine(Watchdog):
         self.on_device = on_device or (lambda record: None)  # events.DeviceInfo and DeviceHealth, as they come
         self.names = self._validate()
         self.faults = []
+        self._cleared = 0  # how many of ``faults`` a clear has answered (``faults_since_clear``)
         self.fault_time = None  # time.monotonic() when the watchdog or the worker reported the first fault
         self.tripped = False  # the watchdog found the worker dead or hung
         self.info = {}
@@ -127,15 +129,14 @@ class Engine(Watchdog):
         ctx = multiprocessing.get_context("spawn")
         self._commands = ctx.Queue()
         self._events = EventRing.create()
-        self.guard = ctx.Process(
-            target=guard.main, name="studyapp-guard", daemon=True,
-            args=(self.status_block.name, c.hang_timeout, REALTIME_PRIORITY + 1 if c.realtime else None, self.ring.spec),
-        )
+        # each child dies with this process from its first instant (parent_death.py)
+        entry, args = parent_death.spawn_args(guard.main, self.status_block.name, c.hang_timeout,
+                                              REALTIME_PRIORITY + 1 if c.realtime else None, self.ring.spec, os.getpid())
+        self.guard = ctx.Process(target=entry, name="studyapp-guard", daemon=True, args=args)
         self.guard.start()
-        self.process = ctx.Process(
-            target=main, name="studyapp-engine", daemon=True,
-            args=(c, self.ring.spec, self.status_block.name, self._commands, self._events.name),
-        )
+        entry, args = parent_death.spawn_args(main, c, self.ring.spec, self.status_block.name)
+        self.process = ctx.Process(target=entry, name="studyapp-engine", daemon=True, args=args,
+                                   kwargs={"commands": self._commands, "events_name": self._events.name})
         self.process.start()
         deadline = time.monotonic() + timeout
         while True:
@@ -188,6 +189,14 @@ class Engine(Watchdog):
         if self.tripped:
             raise EngineError("engine: the watchdog stopped this engine; start a new one")
         self.send(cmd.ClearFault())
+        with self._lock:
+            self._cleared = len(self.faults)
+
+    def faults_since_clear(self):
+        """The faults reported since the last ``clear_fault`` (all of them before one): what stopped the
+        engine when it fails, not an emergency stop cleared long before (issue 41, item 12)."""
+        with self._lock:
+            return self.faults[self._cleared:]
 
     # reading ---------------------------------------------------------------
     def _shared(self):

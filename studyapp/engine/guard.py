@@ -43,6 +43,7 @@ import os
 import signal
 import time
 
+from studyapp.engine import parent_death
 from studyapp.engine.ring import Ring
 from studyapp.engine.status import StatusBlock
 from studyapp.engine.telemetry import WITHHELD
@@ -55,17 +56,19 @@ PF_EXITING = 0x4  # /proc/<pid>/stat field 9 (flags): the process has begun to e
 SIGKILL_BIT = 1 << (signal.SIGKILL - 1)  # /proc/<pid>/stat field 31: its pending signals
 
 
-def main(status_name, hang_timeout, priority=None, ring_spec=None):
+def main(status_name, hang_timeout, priority=None, ring_spec=None, parent=None):
     """Entry point of the guard process (spawned by ``Engine.start``); ``priority``: SCHED_FIFO's, or None;
-    ``ring_spec``: the worker's telemetry ring."""
+    ``ring_spec``: the worker's telemetry ring; ``parent``: the PID of the process that spawned it (a parent
+    that died before this line is gone, not PID 1 alive)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
-    parent = os.getppid()
+    parent = os.getppid() if parent is None else parent
     if priority is not None:  # None: the engine runs without real-time priority, and so does its guard
         _try_realtime(priority)
     status = StatusBlock.attach(status_name)
     ring = Ring.attach(ring_spec) if ring_spec is not None else None
     owner = Owner(parent)
     try:
+        parent_death.watched()  # the loop below sees the owner gone within a poll
         watch(status, hang_timeout, owner.state, ring=ring)
     finally:
         owner.close()

@@ -41,7 +41,9 @@ import math
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
 from studyapp.engine.midi import coalesce
-from studyapp.model.controls import KNOB_MAX, FmaxKnob, FmaxLinear, Select, Volume, as_action, knob_step, knob_value
+from studyapp.model.controls import (
+    KNOB_MAX, FmaxKnob, FmaxLinear, Select, Volume, as_action, as_actions, knob_step, knob_value,
+)
 
 LEVEL_ACTIONS = (FmaxKnob, FmaxLinear, Volume, Select)
 
@@ -99,8 +101,13 @@ class ControlRouting:
         self.ratings = {}
 
     def install(self, c):
-        """``InstallActions``: the mapping, its tag and (unless None) the rating knobs' positions from now on."""
-        self.actions = dict(c.actions)
+        """``InstallActions``: the mapping, its tag and (unless None) the rating knobs' positions from now on.
+
+        Checked again here (``ParameterError``, a warning from ``apply``): a command that came through the
+        pipe was never checked by its maker, and a bad knob law would kill the worker at the next knob move."""
+        actions = as_actions(c.actions)
+        cmd.check_install(c)
+        self.actions = actions
         self.trial = int(c.trial)
         if c.positions is not None:
             self.ratings = dict(c.positions)

@@ -53,6 +53,7 @@ import traceback
 from studyapp.device.link_open import is_link
 from studyapp.engine import commands as cmd
 from studyapp.engine import events as ev
+from studyapp.engine import parent_death
 from studyapp.engine.audio.recorder import Recordings
 from studyapp.engine.audio.sinks import open_sink
 from studyapp.engine.device_link import DeviceLink
@@ -311,6 +312,9 @@ class Worker(ControlRouting):
         self.guard.wait()
         status.set(state="running", heartbeat=time.monotonic())
         status.publish(texts=True)
+        # from here the loop sees the parent gone within 50 ms and stops cleanly; handed over before Ready,
+        # after which the thread that started this process may end (parent_death.py)
+        parent_death.watched()
         self.events.put(ev.Ready({
             "rate": self.loop.rate, "block": self.block, "names": list(self.loop.names),
             "audio": self.sink.description, "midi": self.midi.description if self.midi else "none",

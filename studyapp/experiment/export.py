@@ -61,7 +61,9 @@ line. The description comes from the log's CRC-checked ``session_created``
 copy where there is one, a field session.json differs in reported
 (``session_description``); a session in another participant's folder (a
 copied folder) is exported under its own participant, with a warning (``studyapp export`` prints them as warnings, and with ``--strict``
-refuses to write anything). A session whose log two programs wrote at once (a
+refuses to write anything). A session whose folder was copied (the same
+``session_created`` record in two folders) is counted once, the copy reported
+(``session_identity``). A session whose log two programs wrote at once (a
 step with two responses, a repeated ``seq``: ``written_twice``) is skipped the
 same way: which answer counts cannot be told. A complete session is exported
 whole whether or not its ``session_end`` was written. The
@@ -79,6 +81,7 @@ from studyapp.experiment.log_scan import written_twice
 from studyapp.experiment.session import SIMULATED_DEVICE
 from studyapp.experiment.session_description import read_description
 from studyapp.experiment.session_files import EVENTS_FILE, SESSION_FILE
+from studyapp.experiment.session_identity import counted_once
 from studyapp.experiment.session_log import read_log
 from studyapp.experiment.tasks import TASK_TYPES, task_type
 from studyapp.experiment.trial_health import ADDED, HEALTH_COLUMNS
@@ -219,10 +222,13 @@ def export_responses(results_dir, problems=None):
     root = Path(results_dir)
     if not root.is_dir():
         raise UserError(f"{root}: no such results folder")
-    found = []
-    rows = []
+    read, said = [], {}
     for folder in session_folders_under(root):
-        rows.extend(_session_rows(folder, found))
+        said[folder] = []
+        read.append((folder, _session_rows(folder, said[folder])))
+    kept, copies = counted_once(read)  # a copied session folder counts once (session_identity)
+    found = [line for folder, _ in kept for line in said[folder]] + copies
+    rows = [row for _, session_rows in kept for row in session_rows]
     if found and problems is None:
         raise InputDataError(found[0])
     if problems is not None:

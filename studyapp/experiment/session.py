@@ -63,6 +63,7 @@ from studyapp.provenance import environment
 from studyapp.experiment import records
 from studyapp.experiment.data_modes import file_mode, make_folders
 from studyapp.experiment.enrolment import apparatus_is_simulated, enrolment_index
+from studyapp.experiment.folder_links import refuse_links
 from studyapp.experiment.protocol import NAME_ALLOWED, NAME_PATTERN, parse_protocol
 from studyapp.experiment.schedule import Trial, build_schedule
 from studyapp.experiment.log_scan import written_twice
@@ -78,6 +79,7 @@ from studyapp.experiment.session_info import (
 from studyapp.experiment.session_lock import ParticipantLock, StudyLock, remove_if_free
 from studyapp.experiment.session_log import LogLock, LogWriteError, SessionLog, fsync_directory, read_events, read_log, wall_time
 from studyapp.io.free_names import first_free
+from studyapp.io.wav_header import repair_wav
 
 CREATED = records.SESSION_CREATED
 SIMULATED_DEVICE = {"kind": "simulated", "latency_ms": 0.0}  # session.json's ``device`` on the simulated device
@@ -199,6 +201,7 @@ class Session:
         order_row = check_order_row(protocol, order_row)
         study_folder = Path(results) / protocol.study
         participant_folder = study_folder / participant
+        refuse_links(results, participant_folder)  # read-only, before anything is made or written
         if not lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
             _refuse_existing(participant_folder, participant)
         try:
@@ -291,9 +294,11 @@ class Session:
             raise UserError(f"{given[0].replace('_', ' ')}: set when a session starts, not when it is resumed: "
                             "allowed is to leave it empty with resume")
         participant_folder = Path(results) / protocol.study / participant
+        refuse_links(results, participant_folder)
         if not session_folders(participant_folder):
             raise UserError(f"participant {participant!r} has no session to resume in {participant_folder}: "
                             "allowed is to start one without --resume")
+        refuse_links(results, session_folders(participant_folder)[-1])
         if not lock_taken(participant_folder):  # read-only, before the lock: a refusal changes nothing
             read_description(session_folders(participant_folder)[-1])
         lock = ParticipantLock(participant_folder, participant)
@@ -323,10 +328,11 @@ class Session:
                                 "under another participant ID")
             events = log.events
             done = {e.get("step") for e in events if e.get("type") == "response"}
+            heard = repair_recordings(folder)  # under the lock: no engine of this session writes them now
             if all(t["step"] in done for t in info["schedule"]):
-                # resuming is the way to repair a session, a complete one too: its session.json,
-                # and the session_end a kill after the last response kept from being written
-                repaired = []
+                # resuming is the way to repair a session, a complete one too: its session.json, its
+                # recordings' headers, and the session_end a kill after the last response kept from being written
+                repaired = [f"{len(heard)} recording header(s) repaired"] if heard else []
                 if rebuild:
                     _rebuild_description(folder, info)
                     repaired.append("its session.json rebuilt from events.jsonl")
@@ -342,20 +348,24 @@ class Session:
                 log_lock.release()
             lock.release()
             raise
-        return cls(folder, lock, log_lock)
+        session = cls(folder, lock, log_lock)
+        session.notes.extend(heard)
+        return session
 
 
 def _check_owner(info, participant, participant_folder, folder):
-    """Refuse to continue a session that is not ``participant``'s own: a participant folder copied or linked
-    under another ID (its log names the session's participant; its real path, the folder's)."""
-    real = Path(os.path.realpath(participant_folder))
-    if real.name != participant:
-        raise UserError(f"{participant_folder}: a link to {real}, the folder of participant {real.name!r}: "
-                        f"allowed is to resume {real.name!r} by its own ID")
+    """Refuse to continue a session that is not ``participant``'s own: a participant folder copied under another
+    ID (its log names the session's participant; a folder linked is refused before, by ``refuse_links``)."""
     if info["participant"] != participant:
         raise UserError(f"{folder}: holds a session of participant {info['participant']!r} (its log says so), not "
                         f"of {participant!r}: a participant folder copied or renamed is not resumed: allowed is "
                         f"to resume {info['participant']!r} in its own folder, or to start {participant!r} anew")
+
+
+def repair_recordings(folder):
+    """Make the headers of the session's recordings (``audio*.wav``) match their sizes (``io.wav_header``:
+    a kill between a write and its header's update); one line per file repaired."""
+    return [line for path in sorted(Path(folder).glob("audio*.wav")) if (line := repair_wav(path)) is not None]
 
 
 def lock_taken(participant_folder):

@@ -99,6 +99,13 @@ def main(args):
     participant = getattr(args, "participant_window", False) or screen_choice is not None or bool(shot)
     screen = choose_screen(screen_choice) if participant else None
     controller, console = build(args)
+    # Ctrl-C in the terminal, and SIGTERM (a logout, a service manager, ``kill``), close the console cleanly:
+    # the session aborted and logged, the engine stopped, its shared memory unlinked. Installed before any
+    # engine starts (SIGTERM's default left 3 segments and 3 semaphores to the resource tracker); the close
+    # is queued, so it runs inside the event loop even when the signal comes before it (Python sees signals
+    # between Qt events)
+    for number in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(number, lambda *_: QTimer.singleShot(0, console.shut_down))
     size = getattr(args, "size", None)
     if size is not None:
         console.set_size(*size)
@@ -121,12 +128,6 @@ def main(args):
         console.unattended = ScopeBenchmark(console, args.measure_scope)
     if getattr(args, "start", False) and not (getattr(args, "screenshot", None) or getattr(args, "measure_scope", None)):
         _start_when_possible(console, getattr(args, "seed", None))
-    # Ctrl-C in the terminal, and SIGTERM (a session manager, `kill`), close the console cleanly: the session
-    # aborted and logged, the engine stopped, its shared memory released (Python sees signals between Qt events;
-    # SIGTERM's default left "leaked shared_memory objects", issue 41, item 12)
-    # (queued: a signal before the event loop runs still closes it once it does)
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: QTimer.singleShot(0, console.shut_down))
     code = app.exec()
     console.shut_down()  # an unattended run may leave a session running: no one to ask
     return code

@@ -38,6 +38,13 @@ class ArchivingRunner(SessionRunner):
         self._cut = False
         self._source = None
 
+    def log(self, event):
+        """Log ``event``; a response only once the recording and the cues up to it are on disk (a kill
+        never leaves an answered step without its ``start`` row in audio_cues.csv)."""
+        if event.get("type") == "response" and self.recorder is not None:
+            self.recorder.sync()
+        return super().log(event)
+
     def _cue(self, event):
         t = self.trial
         self.recorder.cue(t.step, t.task, t.trial, event, at=self.chain.next_frame())

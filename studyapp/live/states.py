@@ -162,7 +162,7 @@ def end(c, how):
 def lose_engine(c):
     c.media.log_health()
     engine = c.host.engine
-    c.runner.log(records.engine_failed(list(engine.faults) if engine else []))
+    c.runner.log(records.engine_failed(engine.faults_since_clear() if engine else []))  # not the stops cleared
     c.message("the engine stopped (force is zero); the session is paused: press Resume to start "
               "a new engine and repeat the trial", level="error")
     return State.ENGINE_LOST

@@ -21,16 +21,24 @@ k = round(127 v) (``knob_step``), its value again v = k / 127
     Bowing()                     the bow on the string while v > 0
     HandTarget(low, high)        the hand's target position low + v (high - low) (m)
 
+Every action checks its fields when it is made (``check``): a ceiling of 0 or
+below, 0 decades, a NaN, an infinity or 1e308 would kill the worker at the next
+knob move (``knob_from_fmax``) or send F_max to the clamp. An action that came
+through a pipe (unpickled: never made here) is checked again by ``as_actions``
+where the worker installs it (issue 41, item 17).
+
 An action also has a compact spelling, the tuple ``(kind, *fields)`` with the
 kinds of ``KINDS`` (e.g. ``("fmax_log", 40.0, 2.0)``, ``("select", "KALLEV",
 1.0)``); ``as_action`` reads it.
 """
 
 import math
+import numbers
 from dataclasses import dataclass, fields
 
 from studyapp.errors import ParameterError
 from studyapp.model.fmax_knob import KNOB_MAX, LIVE_RANGE, fmax_from_knob, knob_from_fmax
+from studyapp.model.limits import FMAX_LIMIT, HAND_REACH, KNOB_DECADES
 
 VOLUME_DB = (-40.0, 0.0)  # the master volume's range: an attenuator, never above the chain's full level
 
@@ -48,12 +56,46 @@ def knob_value(step):
     return step / KNOB_MAX
 
 
+def number(what, value, low, high, allowed, above=False):
+    """``value`` as a float when it is a finite number in [low, high] (``above``: in (low, high]);
+    ``ParameterError`` naming ``what`` and what is ``allowed`` otherwise."""
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
+    if not ok or not (low < value if above else low <= value) or value > high:
+        raise ParameterError(f"{what} = {value!r}: allowed is {allowed}")
+    return float(value)
+
+
+def _fmax(what, value):
+    return number(what, value, 0.0, FMAX_LIMIT, f"an F_max from 0 to {FMAX_LIMIT:g} N")
+
+
+def hand_target(value):
+    """A hand target (m) checked: finite, at most ``HAND_REACH`` from the centre."""
+    return number("hand target", value, -HAND_REACH, HAND_REACH,
+                  f"a position from {-HAND_REACH:g} to {HAND_REACH:g} m")
+
+
+class _Checked:
+    def __post_init__(self):
+        self.check()
+
+    def check(self):
+        """Raise ``ParameterError`` for a field out of range; return the action."""
+        return self
+
+
 @dataclass(frozen=True)
-class FmaxKnob:
+class FmaxKnob(_Checked):
     """F_max on the logarithmic knob law over ``decades`` decades up to ``ceiling`` (N)."""
 
     ceiling: float
     decades: float
+
+    def check(self):
+        number("knob ceiling", self.ceiling, 0.0, FMAX_LIMIT, f"an F_max above 0, at most {FMAX_LIMIT:g} N",
+               above=True)
+        number("knob decades", self.decades, *KNOB_DECADES, f"{KNOB_DECADES[0]:g} to {KNOB_DECADES[1]:g} decades")
+        return self
 
     def fmax(self, step):
         """F_max (N) at knob step ``step`` (0..127): the one place the knob law is applied."""
@@ -65,11 +107,16 @@ class FmaxKnob:
 
 
 @dataclass(frozen=True)
-class FmaxLinear:
+class FmaxLinear(_Checked):
     """F_max from ``low`` (value 0) to ``high`` (value 1), N, linearly."""
 
     low: float
     high: float
+
+    def check(self):
+        if _fmax("knob low", self.low) == _fmax("knob high", self.high):
+            raise ParameterError(f"knob low = knob high = {self.low!r}: allowed is a range of F_max, two values")
+        return self
 
     def fmax(self, value):
         return self.low + value * (self.high - self.low)
@@ -103,18 +150,30 @@ class Volume:
 
 
 @dataclass(frozen=True)
-class Source:
+class Source(_Checked):
     """A pad: selects the velocity source ``name`` when pressed (an estimator or a pseudo-source)."""
 
     name: str
 
+    def check(self):
+        if not isinstance(self.name, str):
+            raise ParameterError(f"source {self.name!r}: allowed is a velocity source's name")
+        return self
+
 
 @dataclass(frozen=True)
-class Select:
+class Select(_Checked):
     """A rating knob: any movement selects ``condition``, at ``fmax`` (N) when one is given."""
 
     condition: str
     fmax: float | None = None
+
+    def check(self):
+        if not isinstance(self.condition, str):
+            raise ParameterError(f"rated condition {self.condition!r}: allowed is a velocity source's name")
+        if self.fmax is not None:
+            _fmax("rating F_max", self.fmax)
+        return self
 
 
 @dataclass(frozen=True)
@@ -123,11 +182,16 @@ class Bowing:
 
 
 @dataclass(frozen=True)
-class HandTarget:
+class HandTarget(_Checked):
     """The hand's target position (m) from ``low`` (value 0) to ``high`` (value 1)."""
 
     low: float
     high: float
+
+    def check(self):
+        hand_target(self.low)
+        hand_target(self.high)
+        return self
 
     def metres(self, value):
         return self.low + value * (self.high - self.low)
@@ -154,6 +218,17 @@ def as_action(action):
 
 
 def as_actions(mapping):
-    """``{control: action}`` with every action read by ``as_action``."""
-    return {control: as_action(action) for control, action in dict(mapping).items()}
+    """``{control: action}`` with every action read by ``as_action`` and checked (``check``: again for an
+    action that came through a pipe, which unpickling never checked); ``ParameterError`` for a bad one."""
+    try:
+        mapping = dict(mapping)
+    except (TypeError, ValueError):
+        raise ParameterError(f"control mapping {mapping!r}: allowed is {{control name: action}}") from None
+    checked = {}
+    for control, action in mapping.items():
+        if not isinstance(control, str):
+            raise ParameterError(f"control {control!r}: allowed is a control's name")
+        action = as_action(action)
+        checked[control] = action.check() if isinstance(action, _Checked) else action
+    return checked
 

@@ -12,6 +12,11 @@ the impulsive limit makes sense, so FMAX_LIMIT is the largest any simulation,
 protocol or logged event accepts; a study's own ceiling (protocol
 ``fmax_ceiling``) is at most SUSTAINED_FORCE.
 
+The hand's reach (``HAND_REACH``) and the F_max knob's span (``KNOB_DECADES``)
+bound what a command may ask (model/controls.py, engine/commands.py): a
+target or knob law outside them is refused where the command is made and
+again where the worker obeys it.
+
 The string's lowest rate (``RATE_PER_F0_MIN``): the waveguide sounds within 1 %
 of its pitch f0 only when the rate is at least 6 f0 (model/playable.py says
 why and what was measured); below, every command and a protocol's validation
@@ -31,6 +36,8 @@ IMPULSIVE_FORCE = 200.0  # N
 SUSTAINED_FORCE = 60.0  # N RMS
 FMAX_LIMIT = IMPULSIVE_FORCE  # N: nothing above the motors' impulsive limit makes sense
 RATE_PER_F0_MIN = 6.0  # the lowest rate / f0 at which the string sounds at f0 (model/playable.py)
+HAND_REACH = 0.1  # m: the farthest hand target from the centre a command accepts (9 times the end stop's TRAVEL)
+KNOB_DECADES = (0.1, 12.0)  # the decades an F_max knob may span (a protocol's adjustment ``decades``, a command's)
 
 GESTURES = ("strokes", "strokes-validation", "hold", "live", "playback")
 SESSION_GESTURES = tuple(g for g in GESTURES if g != "playback")

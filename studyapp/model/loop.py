@@ -60,6 +60,7 @@ from studyapp.model.control import (
     C_BOWING, C_BREAKAWAY, C_FORCE_SCALE, C_GAIN, C_PEAK, C_SCALE, C_SOURCE, C_USE_AUDIO, FAULT_DEVICE, FAULT_ESTIMATE,
     FAULT_FORCE, FAULT_SENSOR, FAULT_STRING, L_FAULT, L_FAULT_SAMPLE, N_CONTROL, N_LOOP_STATE, OUTPUTS,
 )
+from studyapp.model.controls import hand_target
 from studyapp.model.device import N_LIMIT_STATE, HapticDevice
 from studyapp.model.gestures import Hold, Live, Playback, Strokes
 from studyapp.model.limits import FMAX_LIMIT, GESTURES
@@ -249,9 +250,7 @@ class ClosedLoop:
         return bowing_reference.hiss_level(self.rate, self.string.f0, self.gesture_name, self.fmax)
 
     def set_hand_target(self, x_m):
-        x_m = float(x_m)
-        if not np.isfinite(x_m):
-            raise ParameterError(f"hand target = {x_m!r}: allowed is a finite position in metres")
+        x_m = hand_target(x_m)  # 1e308 latched a loop fault: refused like NaN (issue 41, item 17)
         if not isinstance(self._gesture, Live):
             self.set_gesture("live")
         self._gesture.set(x_m)

@@ -91,6 +91,10 @@ class FakeEngine:
 
     def clear_fault(self):
         self.send(cmd.ClearFault())
+        self._cleared = len(self.faults)
+
+    def faults_since_clear(self):
+        return self.faults[getattr(self, "_cleared", 0):]
 
     def controls(self):
         out, self._controls = self._controls, []

@@ -13,7 +13,9 @@ its frames came from it (``got``); the writer maps stream positions to file
 frames with them. A writer thread of the worker process turns
 the queue into a WAV file at the sink's rate (wav.py: 16-bit PCM mono). The file is written as it grows, its header made valid
 after every write, so a worker that is killed leaves a readable file up to its
-last write. If the writer falls ``QUEUE_SECONDS`` behind (a stalled disk),
+last write; a kill between a write and its header's update leaves a header
+that counts fewer frames than the file holds, which the session's resume
+repairs from the file's size and reports (io/wav_header.py). If the writer falls ``QUEUE_SECONDS`` behind (a stalled disk),
 blocks are dropped rather than waiting, counted in ``dropped`` and written as
 silence once the writer catches up, so the file's timeline stays the engine's.
 
@@ -142,6 +144,16 @@ class AudioRecorder:
         at = (self.stream or 0) if at is None else int(at)
         self._queue.put(("cue", at, {"step": step, "task": task, "trial": trial, "event": event}))
 
+    def sync(self, timeout=10.0):
+        """Wait until the writer has written everything queued so far, every pending cue's row included
+        (placed on the timeline as ``stop`` places them); False if it did not within ``timeout`` s.
+
+        Not for the real-time thread: a headless session calls it before it logs a response, so a kill
+        never leaves an answered step without its rows in ``audio_cues.csv`` (issue 41, item 15)."""
+        reached = threading.Event()
+        self._queue.put(("sync", reached))
+        return reached.wait(timeout)
+
     def stop(self):
         """Let the writer finish what is queued (and a trailing gap) and close the file; ``join`` waits for it."""
         self._queue.put(("end", self.frames))
@@ -171,10 +183,13 @@ class AudioRecorder:
                     items.append(self._queue.get_nowait())
                 except queue.Empty:
                     break
-            chunks, rows, done = [], [], False
+            chunks, rows, done, synced = [], [], False, []
             for item in items:
                 if item is None:
                     done = self._stopped = True
+                elif item[0] == "sync":
+                    rows += self._resolve(None)
+                    synced.append(item[1])
                 elif item[0] == "audio":
                     _, frame, start, got, underflow, samples = item
                     chunks.append(bytes(2 * (frame - written)) + pcm16(samples))  # dropped frames: silence
@@ -198,6 +213,8 @@ class AudioRecorder:
                 wav.writeframes(b"".join(chunks))
             for row in rows:
                 self._append_cue(row)
+            for reached in synced:
+                reached.set()
             if done:
                 return
 
@@ -251,6 +268,8 @@ class AudioRecorder:
         while not self._stopped and (item := self._queue.get()) is not None:
             if item[0] == "audio":
                 self._taken += item[-1].shape[0]
+            elif item[0] == "sync":
+                item[1].set()  # nothing more will be written: no one waits for it
 
 
 class Recordings:

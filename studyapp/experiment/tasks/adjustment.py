@@ -55,7 +55,7 @@ from studyapp.experiment.task_type import Measure
 from studyapp.experiment.tasks.confirm_pad import ConfirmPadTrial, check_knob_value, read_confirm_pad
 from studyapp.experiment.tasks.phases import PhaseFields, read_phases
 from studyapp.model.controls import KNOB_MAX, FmaxKnob
-from studyapp.model.limits import FMAX_LIMIT
+from studyapp.model.limits import FMAX_LIMIT, KNOB_DECADES
 
 HEARD_TOLERANCE = 1e-9  # relative: the same knob position gives the same F_max, float for float
 
@@ -143,7 +143,7 @@ class Adjustment:
             conditions=table.conditions("conditions", bounds.estimators, 1, len(bounds.estimators)),
             trials=table.integer("trials", 1, 100),
             ceiling=table.number("ceiling", FMAX_AUDIBLE, FMAX_LIMIT, AUDIBLE),
-            decades=table.number("decades", 0.1, 12.0, "decades", default=3.0),
+            decades=table.number("decades", *KNOB_DECADES, "decades", default=3.0),
             knob=table.integer("knob", 0, bounds.knobs - 1, default=0),
             confirm_pad=pad,
             instructions=instructions,
