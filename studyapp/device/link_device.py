@@ -18,17 +18,27 @@ What can go wrong, and what is done (``health`` counts it, cumulative):
 
     corrupt   a frame that does not check (frames.FrameReader): never applied
     lost      device frames missing by their sequence numbers (mod 256)
-    missing   device samples never received (the sample counter jumped): the loop skips them
+    missing   device samples never received (frames lost on the way): the loop skips them
     late      forces sent for a sample the host already knew had passed (the device drops them)
     faults    FAULT frames from the device (WATCHDOG, LINK_CORRUPT, INTERNAL latch; CLAMP, SUSTAINED, LATE count)
+    trips     the device's WATCHDOG faults (its force cut because the host's forces came too late)
 
-A link that closes or errors, or is silent longer than ``SILENCE`` while the
-host waits for a frame, or a latching FAULT from the device, is a device
-fault: ``fault`` is set (the loop latches it at the end of the block: force 0
-from then on), DISARM(2) is sent if the link still takes it, and the rest of
-the block is filled with zero sensors and zero force without waiting. It
-stays latched until ``rearm()`` (the experimenter's act), which reopens the
-link if it has to, shakes hands again and arms.
+The device's u32 sample counter is followed by serial-number arithmetic
+(sample_counter.py): the host counts unwrapped, so a run across the wrap is
+like any other. A device fault is latched when the device reports one (a
+latching FAULT), or when the host detects one: the link closes or errors, no
+valid frame for ``SILENCE`` while the host waits for one (corrupt frames are
+no sign of life), a counter that goes back, jumps further than the device's
+clock can run, or a frame of another count than START's packet
+(sample_counter.py), or a sensor value that is not finite or physically
+impossible (sensor_check.py). Either way ``fault`` is set (its text says
+which: "the device reported ..." or "host-detected: ..."; the loop latches it
+at the end of the block: force 0 from then on), DISARM(2) then STOP are sent
+if the link still takes them, and from then on each block reads what the
+device sends (its FAULT and STATE frames; samples dropped) without waiting,
+its forces zero. It stays latched until ``rearm()``, which reopens the link if
+it has to (a new handshake) or else STARTs the stream again, and arms. A
+disarmed device is sent 0 N, never the loop's force.
 
 ``info`` is a plain dict (the console, session.json and recordings read it;
 names documented in docs/engine.md): name, serial, protocol, firmware, rate,
@@ -46,6 +56,8 @@ from studyapp.device import messages as msg
 from studyapp.device.errors import ProtocolError
 from studyapp.device.frames import FrameReader, encode
 from studyapp.device.link_open import open_link
+from studyapp.device.sample_counter import MASK, CounterFault, SampleCounter
+from studyapp.device.sensor_check import check as check_sensors
 from studyapp.errors import ParameterError
 from studyapp.model.device import DeviceLimits, HapticDevice
 
@@ -55,7 +67,8 @@ DISARM_HOST, DISARM_EMERGENCY, DISARM_FAULT = msg.HOST_REQUEST, msg.EMERGENCY_ST
 DEFAULT_LATENCY = 5  # samples the host answers ahead (1 ms at 5 kHz)
 DEFAULT_PACKET = 1  # samples per sensor frame
 DEFAULT_RAMP_MS = 200  # the force ramps up from 0 over this after each ARM
-HEALTH = ("frames", "samples", "corrupt", "lost", "missing", "late", "faults", "clamped")
+HEALTH = ("frames", "samples", "corrupt", "lost", "missing", "late", "faults", "clamped", "trips")
+DRAIN_READS = 64  # reads at most per block while faulted: what the device sent is taken, never waited for
 
 
 class LinkDevice(HapticDevice):
@@ -91,6 +104,7 @@ class LinkDevice(HapticDevice):
         self.fault_time = None  # time.monotonic() when ``fault`` was set
         self.last_data = None  # time.monotonic() when bytes last came from the device while streaming
         self.device_faults = []  # (code, sample, detail) of every FAULT frame, oldest first
+        self.fault_code = None  # the device's FAULT code of a latched device-reported fault; None if host-detected
         self.link_lost = False  # the link itself failed (closed, errored): a re-arm reopens it
         self.armed = False
         self.link = None
@@ -104,8 +118,10 @@ class LinkDevice(HapticDevice):
             self._reader = FrameReader()
             self._seq_out = 0
             self._seq_in = None
-            self._pending = []  # decoded SENSORS samples not yet run: (sample, x, a, v)
-            self._newest = -1  # the newest device sample seen
+            self._pending = []  # decoded SENSORS samples not yet run: (sample unwrapped, x, a, v)
+            self._counter = SampleCounter(self.rate, self.packet)
+            self._newest = -1  # the newest device sample seen, unwrapped (sample_counter.py)
+            self._stopped = False  # STOP sent after a fault: a re-arm STARTs again
             self._forces = []  # forces of the current run of samples, not yet sent
             self._first = None  # the device sample of _forces[0]
             self._read_at = 0.0
@@ -120,6 +136,7 @@ class LinkDevice(HapticDevice):
             self._check_loop(handshake.loop_of(self.device_info, self.spec))
             self.round_trip = handshake.probe(self._send, self._receive_one, self.spec, self.pings)
             self._pending.clear()
+            self._counter = SampleCounter(self.rate, self.packet)
             self._newest = -1
             self.health = health
             self._start()
@@ -145,6 +162,7 @@ class LinkDevice(HapticDevice):
 
     def _start(self):
         self._send(msg.Start(packet=self.packet, latency=self.latency))
+        self._counter.started()
 
     def _parse(self, payload):
         return msg.parse(payload, self._channels)
@@ -186,14 +204,17 @@ class LinkDevice(HapticDevice):
             self._take(self.link.read())
 
     def _take(self, data):
-        """Decode the bytes read: SENSORS samples go to ``_pending``, other messages to ``_queue`` or act."""
+        """Decode the bytes read: SENSORS samples go to ``_pending``, other messages to ``_queue`` or act.
+        Returns how many valid frames there were (corrupt ones are no sign of a live device)."""
         corrupt = self._reader.corrupt
+        valid = 0
         for payload in self._reader.feed(data):
             try:
                 seq, message = self._parse(payload)
             except ProtocolError:
                 self._reader.corrupt += 1
                 continue
+            valid += 1
             if self._seq_in is not None:
                 gap = (seq - self._seq_in - 1) & 0xFF
                 self.health["lost"] += gap
@@ -203,7 +224,10 @@ class LinkDevice(HapticDevice):
             elif isinstance(message, msg.Fault):
                 self.health["faults"] += 1
                 self.device_faults.append((message.code, message.sample, message.detail))
-                if message.code in LATCHING:
+                if message.code == msg.WATCHDOG and self.fault is None:
+                    self.health["trips"] += 1
+                if message.code in LATCHING and self.fault is None:
+                    self.fault_code = message.code
                     self._device_fault(f"the device reported {msg.FAULT_NAMES.get(message.code, message.code)} "
                                        f"at its sample {message.sample}")
             elif isinstance(message, msg.State):
@@ -211,22 +235,37 @@ class LinkDevice(HapticDevice):
             elif not self._streaming:
                 self._queue.append(message)
         self.health["corrupt"] += self._reader.corrupt - corrupt
+        return valid
+
+    def _follow(self, frame, count, name):
+        """The frame's first sample, unwrapped, after the counter's checks (sample_counter.py); None on a fault."""
+        try:
+            first, missing = self._counter.take(frame.sample, count, name)
+        except CounterFault as exc:
+            self._host_fault(str(exc))
+            return None
+        self.health["missing"] += missing
+        self._newest = self._counter.newest
+        return first
 
     def _sensors(self, frame):
+        if self.fault is not None:
+            return  # a faulted stream's samples are read (the device's queue must not back up), never run
         h = self.health
         h["frames"] += 1
         if frame.flags & msg.FLAG_CLAMPED:
             h["clamped"] += 1
-        expected = self._newest + 1
-        if self._newest >= 0 and frame.sample > expected:
-            h["missing"] += frame.sample - expected
-        if frame.sample < expected:
-            return  # a repeat of samples already run: never applied twice
         count = len(frame.values)
-        self._newest = frame.sample + count - 1
+        first = self._follow(frame, count, "SENSORS")
+        if first is None:
+            return
         x, a, v = self.scales.convert(frame.values)
+        bad = check_sensors(frame.sample, x, a, v)
+        if bad is not None:
+            self._host_fault(bad)
+            return
         for i in range(count):
-            self._pending.append((frame.sample + i, x[i], a[i], v[i]))
+            self._pending.append((first + i, x[i], a[i], v[i]))
 
     # streaming ----------------------------------------------------------------
     def _next_sample(self):
@@ -243,15 +282,17 @@ class LinkDevice(HapticDevice):
                 return None
             if data:
                 self._read_at = time.perf_counter()
-                self.last_data = time.monotonic()
-                self._take(data)
+                if self._take(data):
+                    self.last_data = time.monotonic()
+                    end = self.last_data + self.silence  # a valid frame came: the device is alive
                 if self._pending:
                     return self._pending.pop(0)
-                end = time.monotonic() + self.silence  # bytes came: the link is alive
-                continue
+                if self.fault is not None:
+                    return None
             left = end - time.monotonic()
             if left <= 0:
-                self._device_fault(f"the link was silent for more than {1e3 * self.silence:g} ms")
+                self._host_fault(f"no valid frame from the device for more than {1e3 * self.silence:g} ms "
+                                 f"(the link silent, or only corrupt frames)")
                 return None
             self.link.wait(left)
         return None
@@ -263,10 +304,11 @@ class LinkDevice(HapticDevice):
         tag = self._first + self.latency
         if tag <= self._newest_known():
             self.health["late"] += 1
+        forces = self._forces if self.armed else [0.0] * len(self._forces)  # a disarmed device is sent 0 N
         try:
-            for start in range(0, len(self._forces), msg.MAX_FORCES):
-                chunk = self._forces[start:start + msg.MAX_FORCES]
-                self._send(msg.Force(sample=(tag + start) & 0xFFFFFFFF, forces=tuple(chunk)))  # u32, wraps
+            for start in range(0, len(forces), msg.MAX_FORCES):
+                chunk = forces[start:start + msg.MAX_FORCES]
+                self._send(msg.Force(sample=(tag + start) & MASK, forces=tuple(chunk)))  # u32, wraps
         except OSError as exc:
             self._link_failed(exc)
         if self.timing:
@@ -280,6 +322,9 @@ class LinkDevice(HapticDevice):
     def exchange(self, control, n, out, est_out):
         """The next ``n`` device samples through the loop's controller; zeros without waiting once faulted."""
         h = self.health
+        if self.fault is not None:
+            self._drain()
+            return  # zero sensors and force, at once: the loop has latched ``fault``
         for k in range(n):
             got = self._next_sample() if self.fault is None else None
             if got is None:
@@ -321,11 +366,36 @@ class LinkDevice(HapticDevice):
         self.link_lost = True
         self._device_fault(f"the link failed ({_why(exc)})")
 
+    def _host_fault(self, text):
+        """A fault the host detected itself (not the device's FAULT frame)."""
+        self._device_fault(f"host-detected: {text}")
+
     def _device_fault(self, text):
+        """Latch ``text``; DISARM(2), then STOP so that the device's stream does not pile up in the link."""
         if self.fault is None:
             self.fault = text
             self.fault_time = time.monotonic()
+            self._forces = []
+            self._pending.clear()
             self.disarm(DISARM_FAULT)
+            if self.link is not None and not self.link_lost:
+                self._guarded(msg.Stop(), quiet=True)
+                self._stopped = True
+
+    def _drain(self):
+        """While faulted: take what the device sent (its FAULT and STATE frames; samples are dropped), without
+        waiting, so that a device whose writes block never stalls on the host."""
+        for _ in range(DRAIN_READS):
+            if self.link is None or self.link_lost or not self.link.wait(0.0):
+                return
+            try:
+                data = self.link.read()
+            except (OSError, EOFError):
+                self.link_lost = True
+                return
+            if not data:
+                return
+            self._take(data)
 
     def rearm(self, ramp_ms=None):
         """The experimenter's reset after a device fault: reopen the link if it failed (and shake hands again),
@@ -337,9 +407,21 @@ class LinkDevice(HapticDevice):
             self.close()
             self._open()
             self.link_lost = False
+            self._stopped = False
         self.fault = None
+        self.fault_code = None
         self.resync()
+        if self._stopped:  # STOPped at the fault: the stream starts again
+            self._stopped = False
+            self._restarted()
+            try:
+                self._start()
+            except OSError as exc:
+                self._link_failed(exc)
         self.arm(ramp_ms)
+
+    def _restarted(self):
+        """The stream is about to START again on the open link (after a fault's STOP)."""
 
     def resync(self):
         """Drop every frame waiting on the link (the host was busy, not answering): the next sample is fresh."""
