@@ -191,7 +191,7 @@ def test_after_a_fault_the_host_keeps_reading_and_sends_no_force(fake):
 def test_a_disarmed_device_is_sent_zero_force(fake):
     device = _armed(fake)
     _stream(fake, device, [0, 1])
-    assert any(f != 0.0 for f in fake.forces().values())
+    assert _wait(lambda: len(fake.forces()) == 2) and all(f != 0.0 for f in fake.forces().values())
     device.disarm(messages.EMERGENCY_STOP)
     _stream(fake, device, [2, 3, 4])
     assert _wait(lambda: {2 + 2, 3 + 2, 4 + 2} <= set(fake.forces()))
