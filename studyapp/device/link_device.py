@@ -22,6 +22,7 @@ What can go wrong, and what is done (``health`` counts it, cumulative):
     late      forces sent for a sample the host already knew had passed (the device drops them)
     faults    FAULT frames from the device (WATCHDOG, LINK_CORRUPT, INTERNAL latch; CLAMP, SUSTAINED, LATE count)
     trips     the device's WATCHDOG faults (its force cut because the host's forces came too late)
+    silences  the host's silence faults (no valid frame for ``silence`` s)
 
 The device's u32 sample counter is followed by serial-number arithmetic
 (sample_counter.py): the host counts unwrapped, so a run across the wrap is
@@ -67,7 +68,7 @@ DISARM_HOST, DISARM_EMERGENCY, DISARM_FAULT = msg.HOST_REQUEST, msg.EMERGENCY_ST
 DEFAULT_LATENCY = 5  # samples the host answers ahead (1 ms at 5 kHz)
 DEFAULT_PACKET = 1  # samples per sensor frame
 DEFAULT_RAMP_MS = 200  # the force ramps up from 0 over this after each ARM
-HEALTH = ("frames", "samples", "corrupt", "lost", "missing", "late", "faults", "clamped", "trips")
+HEALTH = ("frames", "samples", "corrupt", "lost", "missing", "late", "faults", "clamped", "trips", "silences")
 DRAIN_READS = 64  # reads at most per block while faulted: what the device sent is taken, never waited for
 
 
@@ -105,6 +106,7 @@ class LinkDevice(HapticDevice):
         self.last_data = None  # time.monotonic() when bytes last came from the device while streaming
         self.device_faults = []  # (code, sample, detail) of every FAULT frame, oldest first
         self.fault_code = None  # the device's FAULT code of a latched device-reported fault; None if host-detected
+        self.fault_timing = False  # the latched fault is one of timing (the device's WATCHDOG, the host's silence)
         self.link_lost = False  # the link itself failed (closed, errored): a re-arm reopens it
         self.armed = False
         self.link = None
@@ -122,6 +124,7 @@ class LinkDevice(HapticDevice):
             self._counter = SampleCounter(self.rate, self.packet)
             self._newest = -1  # the newest device sample seen, unwrapped (sample_counter.py)
             self._stopped = False  # STOP sent after a fault: a re-arm STARTs again
+            self._skip_partial = False  # bytes were dropped undecoded: the next frame starts after a 0x00
             self._forces = []  # forces of the current run of samples, not yet sent
             self._first = None  # the device sample of _forces[0]
             self._read_at = 0.0
@@ -161,8 +164,16 @@ class LinkDevice(HapticDevice):
                                  "cannot drive it (studyapp/device/loop_link.py does); refused")
 
     def _start(self):
-        self._send(msg.Start(packet=self.packet, latency=self.latency))
-        self._counter.started()
+        """START waits for the host's first use (``_begin``): the device streams from the moment the host reads,
+        so nothing piles up in the link while the engine is still being built (a backlog read later costs more
+        time than it spans, and the pty drops what does not fit: issue 41's trips at the start)."""
+        self._start_pending = True
+
+    def _begin(self):
+        if self._start_pending and self.link is not None:
+            self._start_pending = False
+            self._guarded(msg.Start(packet=self.packet, latency=self.latency))
+            self._counter.started()
 
     def _parse(self, payload):
         return msg.parse(payload, self._channels)
@@ -206,6 +217,11 @@ class LinkDevice(HapticDevice):
     def _take(self, data):
         """Decode the bytes read: SENSORS samples go to ``_pending``, other messages to ``_queue`` or act.
         Returns how many valid frames there were (corrupt ones are no sign of a live device)."""
+        if self._skip_partial:
+            end = data.find(b"\x00")
+            if end < 0:
+                return 0
+            data, self._skip_partial = data[end + 1:], False
         corrupt = self._reader.corrupt
         valid = 0
         for payload in self._reader.feed(data):
@@ -228,6 +244,7 @@ class LinkDevice(HapticDevice):
                     self.health["trips"] += 1
                 if message.code in LATCHING and self.fault is None:
                     self.fault_code = message.code
+                    self.fault_timing = message.code == msg.WATCHDOG
                     self._device_fault(f"the device reported {msg.FAULT_NAMES.get(message.code, message.code)} "
                                        f"at its sample {message.sample}")
             elif isinstance(message, msg.State):
@@ -291,6 +308,8 @@ class LinkDevice(HapticDevice):
                     return None
             left = end - time.monotonic()
             if left <= 0:
+                self.health["silences"] += 1
+                self.fault_timing = True
                 self._host_fault(f"no valid frame from the device for more than {1e3 * self.silence:g} ms "
                                  f"(the link silent, or only corrupt frames)")
                 return None
@@ -321,6 +340,7 @@ class LinkDevice(HapticDevice):
 
     def exchange(self, control, n, out, est_out):
         """The next ``n`` device samples through the loop's controller; zeros without waiting once faulted."""
+        self._begin()
         h = self.health
         if self.fault is not None:
             self._drain()
@@ -344,6 +364,7 @@ class LinkDevice(HapticDevice):
     # arming and faults --------------------------------------------------------
     def arm(self, ramp_ms=None):
         """Allow force, ramping up from 0 over ``ramp_ms`` (default the driver's)."""
+        self._begin()
         if self.fault is None:
             ramp = self.ramp_ms if ramp_ms is None else int(ramp_ms)
             self._guarded(msg.Arm(ramp_ms=max(ramp, self.device_info.ramp_ms_min)))
@@ -410,22 +431,34 @@ class LinkDevice(HapticDevice):
             self._stopped = False
         self.fault = None
         self.fault_code = None
+        self.fault_timing = False
         self.resync()
-        if self._stopped:  # STOPped at the fault: the stream starts again
+        if self._stopped:  # STOPped at the fault: the stream starts again (``arm`` sends START)
             self._stopped = False
             self._restarted()
-            try:
-                self._start()
-            except OSError as exc:
-                self._link_failed(exc)
+            self._start()
         self.arm(ramp_ms)
 
     def _restarted(self):
         """The stream is about to START again on the open link (after a fault's STOP)."""
 
     def resync(self):
-        """Drop every frame waiting on the link (the host was busy, not answering): the next sample is fresh."""
-        self._read_waiting()
+        """Drop every byte waiting on the link undecoded (the host was busy, not answering: decoding the backlog
+        frame by frame would take longer than the time it spans): the next sample is fresh."""
+        self._begin()
+        for _ in range(DRAIN_READS * 16):
+            if self.fault is not None or not self.link.wait(0.0):
+                break
+            try:
+                data = self.link.read()
+            except (OSError, EOFError) as exc:
+                self._link_failed(exc)
+                break
+            if not data:
+                break
+            self._reader = FrameReader()
+            self._skip_partial = not data.endswith(b"\x00")
+            self._counter.started()  # samples dropped on purpose: the next frame may be any distance ahead
         self._pending.clear()
         self._forces = []
         self._first = None

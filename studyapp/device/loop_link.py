@@ -55,7 +55,6 @@ import numpy as np
 
 from studyapp.device import handshake
 from studyapp.device import loop_messages as lm
-from studyapp.device import messages as msg
 from studyapp.device import shadow
 from studyapp.device.link_device import LinkDevice
 from studyapp.device.loop_image import image_crc
@@ -130,21 +129,6 @@ class LoopLink(LinkDevice):
         self.health.update({key: self.health.get(key, 0) for key in EXTRA_HEALTH})
         self.silence = max(self.silence, self.loop_info.keepalive_ms / 1000.0)
         self._alive_period = self.loop_info.keepalive_ms / 4000.0  # s: the protocol's longest gap between ALIVEs
-
-    def _start(self):
-        """START waits for the host's first use (``_begin``): the device streams from the moment the host reads,
-        so nothing piles up while the loop is still being built (a pty that fills drops telemetry: a gap)."""
-        self._start_pending = True
-
-    def _begin(self):
-        if self._start_pending and self.link is not None:
-            self._start_pending = False
-            self._guarded(msg.Start(packet=self.packet, latency=self.lead))
-            self._counter.started()
-
-    def arm(self, ramp_ms=None):
-        self._begin()
-        super().arm(ramp_ms)
 
     def _check_loop(self, loop):
         if loop.loop != lm.DEVICE_LOOP:
@@ -243,6 +227,8 @@ class LoopLink(LinkDevice):
                     return False
             left = end - time.monotonic()
             if left <= 0:
+                self.health["silences"] += 1
+                self.fault_timing = True
                 self._host_fault(f"no valid frame from the device for more than {1e3 * self.silence:g} ms "
                                  f"(the link silent, or only corrupt frames)")
                 return False

@@ -49,6 +49,8 @@ def test_handshake_info_and_start(fake):
     assert info["rate"] == 5000.0 and info["latency_samples"] == 3 and info["packet"] == 2
     assert info["channels"] == ["position", "acceleration", "velocity"] and info["calibration"] == "device"
     assert info["round_trip_ms"]["median"] > 0 and info["round_trip_ms"]["p99"] >= info["round_trip_ms"]["median"]
+    assert not fake.started.is_set()  # START waits for the host's first use: nothing piles up before it
+    device.resync()
     assert _wait(fake.started.is_set)
     start = [m for m in fake.received if isinstance(m, messages.Start)]
     assert start == [messages.Start(packet=2, latency=3)]
