@@ -49,13 +49,13 @@ channels, calibration, limits, latency_samples, packet, round_trip_ms
 
 import time
 
-import numpy as np
-
 from studyapp.device import handshake
 from studyapp.device import loop_messages as lm
 from studyapp.device import messages as msg
 from studyapp.device.errors import ProtocolError
 from studyapp.device.frames import FrameReader, encode
+from studyapp.device.link_arming import DISARM_EMERGENCY, DISARM_FAULT, DISARM_HOST, Arming  # noqa: F401 (re-exported)
+from studyapp.device.link_arming import why as _why
 from studyapp.device.link_open import open_link
 from studyapp.device.sample_counter import MASK, CounterFault, SampleCounter
 from studyapp.device.sensor_check import check as check_sensors
@@ -64,15 +64,13 @@ from studyapp.model.device import DeviceLimits, HapticDevice
 
 SILENCE = 0.020  # s without a device frame, while waiting for one, that makes a device fault
 LATCHING = (msg.WATCHDOG, msg.LINK_CORRUPT, msg.INTERNAL)
-DISARM_HOST, DISARM_EMERGENCY, DISARM_FAULT = msg.HOST_REQUEST, msg.EMERGENCY_STOP, msg.HOST_FAULT
 DEFAULT_LATENCY = 5  # samples the host answers ahead (1 ms at 5 kHz)
 DEFAULT_PACKET = 1  # samples per sensor frame
 DEFAULT_RAMP_MS = 200  # the force ramps up from 0 over this after each ARM
 HEALTH = ("frames", "samples", "corrupt", "lost", "missing", "late", "faults", "clamped", "trips", "silences")
-DRAIN_READS = 64  # reads at most per block while faulted: what the device sent is taken, never waited for
 
 
-class LinkDevice(HapticDevice):
+class LinkDevice(Arming, HapticDevice):
     """The device on the link ``spec`` (path or URL), streaming at ``rate`` Hz once opened.
 
     ``latency``: samples ahead the host answers (FORCE tagged sensor sample + latency);
@@ -360,150 +358,3 @@ class LinkDevice(HapticDevice):
             if not self._pending or len(self._forces) >= self.packet:
                 self._flush()
         self._flush()
-
-    # arming and faults --------------------------------------------------------
-    def arm(self, ramp_ms=None):
-        """Allow force, ramping up from 0 over ``ramp_ms`` (default the driver's)."""
-        self._begin()
-        if self.fault is None:
-            ramp = self.ramp_ms if ramp_ms is None else int(ramp_ms)
-            self._guarded(msg.Arm(ramp_ms=max(ramp, self.device_info.ramp_ms_min)))
-            self.armed = self.fault is None
-
-    def disarm(self, reason=DISARM_HOST):
-        """Force 0 at once on the device, latched there until ``arm``."""
-        self.armed = False
-        if self.link is not None:
-            self._guarded(msg.Disarm(reason=int(reason)), quiet=True)
-
-    def _guarded(self, message, quiet=False):
-        try:
-            self._send(message)
-        except OSError as exc:
-            if not quiet:
-                self._link_failed(exc)
-
-    def _link_failed(self, exc):
-        self.link_lost = True
-        self._device_fault(f"the link failed ({_why(exc)})")
-
-    def _host_fault(self, text):
-        """A fault the host detected itself (not the device's FAULT frame)."""
-        self._device_fault(f"host-detected: {text}")
-
-    def _device_fault(self, text):
-        """Latch ``text``; DISARM(2), then STOP so that the device's stream does not pile up in the link."""
-        if self.fault is None:
-            self.fault = text
-            self.fault_time = time.monotonic()
-            self._forces = []
-            self._pending.clear()
-            self.disarm(DISARM_FAULT)
-            if self.link is not None and not self.link_lost:
-                self._guarded(msg.Stop(), quiet=True)
-                self._stopped = True
-
-    def _drain(self):
-        """While faulted: take what the device sent (its FAULT and STATE frames; samples are dropped), without
-        waiting, so that a device whose writes block never stalls on the host."""
-        for _ in range(DRAIN_READS):
-            if self.link is None or self.link_lost or not self.link.wait(0.0):
-                return
-            try:
-                data = self.link.read()
-            except (OSError, EOFError):
-                self.link_lost = True
-                return
-            if not data:
-                return
-            self._take(data)
-
-    def rearm(self, ramp_ms=None):
-        """The experimenter's reset after a device fault: reopen the link if it failed (and shake hands again),
-        drop the frames that piled up, arm.
-
-        ``ParameterError`` (one line) when the device is still not there; the fault stays latched then.
-        """
-        if self.fault is not None and self.link_lost:
-            self.close()
-            self._open()
-            self.link_lost = False
-            self._stopped = False
-        self.fault = None
-        self.fault_code = None
-        self.fault_timing = False
-        self.resync()
-        if self._stopped:  # STOPped at the fault: the stream starts again (``arm`` sends START)
-            self._stopped = False
-            self._restarted()
-            self._start()
-        self.arm(ramp_ms)
-
-    def _restarted(self):
-        """The stream is about to START again on the open link (after a fault's STOP)."""
-
-    def resync(self):
-        """Drop every byte waiting on the link undecoded (the host was busy, not answering: decoding the backlog
-        frame by frame would take longer than the time it spans): the next sample is fresh."""
-        self._begin()
-        for _ in range(DRAIN_READS * 16):
-            if self.fault is not None or not self.link.wait(0.0):
-                break
-            try:
-                data = self.link.read()
-            except (OSError, EOFError) as exc:
-                self._link_failed(exc)
-                break
-            if not data:
-                break
-            self._reader = FrameReader()
-            self._skip_partial = not data.endswith(b"\x00")
-            self._counter.started()  # samples dropped on purpose: the next frame may be any distance ahead
-        self._pending.clear()
-        self._forces = []
-        self._first = None
-
-    def _read_waiting(self):
-        """Take every byte already waiting on the link, without waiting."""
-        while self.fault is None and self.link.wait(0.0):
-            try:
-                data = self.link.read()
-            except (OSError, EOFError) as exc:
-                self._link_failed(exc)
-                break
-            if not data:
-                break
-            self._take(data)
-
-    def stop_stream(self, timeout=0.2):
-        """STOP the stream and wait for the device's STATE (its own counters: late, lost, corrupt); None if none came."""
-        self.device_state = None
-        self._guarded(msg.Stop(), quiet=True)
-        end = time.monotonic() + timeout
-        while self.device_state is None and self.fault is None and (left := end - time.monotonic()) > 0:
-            if self.link.wait(left):
-                try:
-                    self._take(self.link.read())
-                except (OSError, EOFError) as exc:
-                    self._link_failed(exc)
-        self._streaming = False
-        return self.device_state
-
-    def close(self):
-        """STOP the stream (force 0) and close the link."""
-        if self.link is None:
-            return
-        try:
-            self._send(msg.Disarm(reason=DISARM_HOST))
-            self._send(msg.Stop())
-        except OSError:
-            pass
-        self.link.close()
-        self.link = None
-        self.armed = False
-
-
-def _why(exc):
-    text = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
-    return text.splitlines()[0]
-

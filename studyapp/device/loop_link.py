@@ -350,7 +350,8 @@ class LoopLink(LinkDevice):
                 row = [float(v) for v in table[start + bad]]
                 force, bridge = (float(v) for v in self._shadow_values)
                 self._host_fault(
-                    f"the device's loop differs from the host's shadow at its sample {int(row[shadow.R_SAMPLE]) & MASK}: "
+                    f"the device's loop differs from the host's shadow at its sample "
+                    f"{int(row[shadow.R_SAMPLE]) & MASK}: "
                     f"force {row[shadow.R_LOOP_FORCE]!r} N (shadow {force!r}), bridge {row[shadow.R_BRIDGE]!r} "
                     f"(shadow {bridge!r})")
                 return

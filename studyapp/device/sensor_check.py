@@ -20,6 +20,6 @@ def check(sample, x, a, v):
         bound = BOUNDS[name]
         for i, value in enumerate(values):
             if not (math.isfinite(value) and -bound <= value <= bound):
-                return (f"the device's {name} at its sample {(sample + i) & 0xFFFFFFFF} is {value!r}: allowed is a finite "
-                        f"number within +-{bound:g} (SI)")
+                return (f"the device's {name} at its sample {(sample + i) & 0xFFFFFFFF} is {value!r}: allowed is a "
+                        f"finite number within +-{bound:g} (SI)")
     return None
