@@ -35,7 +35,10 @@ def one_run(index, seconds, first_sample, extra):
         return {"run": index, "error": (proc.stderr.strip().splitlines() or ["no output"])[-1]}
     result = json.loads(proc.stdout)
     device = result["device"]
-    health = device["health"] or {}
+    if not device or not device.get("health"):
+        return {"run": index, "error": "no device health in live's summary (the engine's end was not reported)",
+                "faults": len(result.get("faults", []))}
+    health = device["health"]
     trips, rearms, slowest = health.get("trips", 0), device.get("rearms", 0), device.get("rearm_max_s")
     ok = device["fault"] is None and rearms >= trips and (slowest is None or slowest <= REARM_WITHIN)
     return {"run": index, "trips": trips, "silences": health.get("silences", 0), "rearms": rearms,
