@@ -284,7 +284,7 @@ class LinkDevice(Arming, HapticDevice):
 
     # streaming ----------------------------------------------------------------
     def _next_sample(self):
-        """The next device sample (sample, x, a, v), waiting up to ``SILENCE`` per frame; None on a device fault."""
+        """The next device sample (sample, x, a, v), waiting up to ``silence`` for one; None on a device fault."""
         if self._pending:
             return self._pending.pop(0)
         self._flush()
@@ -299,8 +299,8 @@ class LinkDevice(Arming, HapticDevice):
                 self._read_at = time.perf_counter()
                 if self._take(data):
                     self.last_data = time.monotonic()
-                    end = self.last_data + self.silence  # a valid frame came: the device is alive
-                if self._pending:
+                if self._pending:  # only samples end the wait: corrupt frames, or a stream of other frames, are
+                    # no sign of a live stream (a device sending STATE or PONG forever must not wedge the host)
                     return self._pending.pop(0)
                 if self.fault is not None:
                     return None
@@ -308,8 +308,8 @@ class LinkDevice(Arming, HapticDevice):
             if left <= 0:
                 self.health["silences"] += 1
                 self.fault_timing = True
-                self._host_fault(f"no valid frame from the device for more than {1e3 * self.silence:g} ms "
-                                 f"(the link silent, or only corrupt frames)")
+                self._host_fault(f"no sample from the device for more than {1e3 * self.silence:g} ms "
+                                 f"(the link silent, or only corrupt or other frames)")
                 return None
             self.link.wait(left)
         return None

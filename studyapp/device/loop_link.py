@@ -219,8 +219,7 @@ class LoopLink(LinkDevice):
             if data:
                 if self._take(data):
                     self.last_data = time.monotonic()
-                    end = self.last_data + self.silence  # a valid frame came: the device is alive
-                if self._rows:
+                if self._rows:  # only rows end the wait (as LinkDevice._next_sample)
                     self._alive()
                     return True
                 if self.fault is not None:
@@ -229,8 +228,8 @@ class LoopLink(LinkDevice):
             if left <= 0:
                 self.health["silences"] += 1
                 self.fault_timing = True
-                self._host_fault(f"no valid frame from the device for more than {1e3 * self.silence:g} ms "
-                                 f"(the link silent, or only corrupt frames)")
+                self._host_fault(f"no sample from the device for more than {1e3 * self.silence:g} ms "
+                                 f"(the link silent, or only corrupt or other frames)")
                 return False
             self.link.wait(min(left, self._alive_period))
         return False

@@ -141,10 +141,32 @@ def test_a_run_of_corrupt_frames_is_silence(fake):
     device.exchange(Recorder(), 10, None, None)
     took = time.monotonic() - started
     thread.join(1.0)
-    _host_detected(device, "no valid frame")
+    _host_detected(device, "no sample from the device")
     assert took < 0.15  # within the silence bound (0.05 s) and a loaded machine's margin, not the flood's end
     assert device.health["corrupt"] > 10
     assert _disarmed_then_stopped(fake)
+    device.close()
+
+
+def test_a_stream_of_frames_without_samples_is_silence(fake):
+    device = _armed(fake)
+    _stream(fake, device, [0])
+    stop = time.monotonic() + 0.2
+    started = time.monotonic()
+
+    def flood():
+        while time.monotonic() < stop:
+            fake.send(messages.State(armed=1, streaming=1, faults=0, late=0, lost=0, corrupt=0))  # valid, no samples
+            time.sleep(0.0005)
+
+    import threading
+    thread = threading.Thread(target=flood, daemon=True)
+    thread.start()
+    device.exchange(Recorder(), 10, None, None)
+    took = time.monotonic() - started
+    thread.join(1.0)
+    _host_detected(device, "no sample from the device")
+    assert took < 0.15
     device.close()
 
 
