@@ -46,7 +46,7 @@ def _live(path, seconds, *options):
     proc = subprocess.run([sys.executable, "-m", "studyapp", "live", "--device", str(path), "--audio", "null",
                            "--midi", "none", "--seconds", str(seconds), "--json", *options],
                           capture_output=True, text=True, timeout=600, env=env, cwd=REPO)
-    assert proc.returncode in (0, 1), proc.stderr
+    assert proc.returncode in (0, 1) and proc.stdout.strip(), proc.stderr[-3000:]
     return json.loads(proc.stdout), proc.stderr
 
 
