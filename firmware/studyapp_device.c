@@ -317,6 +317,15 @@ void sd_counters(const sd_device *d, uint32_t out[8]) {
     out[7] = d->missing;
 }
 
+void sd_set_counter(sd_device *d, uint32_t sample) {
+    d->now = sample;
+    d->seen = sample;
+    d->arm_sample = sample;
+    d->start_sample = sample;
+    d->deadline = sample;
+    d->last_feed = sample;
+}
+
 int sd_init(sd_device *d, const uint8_t *info, uint32_t len, double rms_alpha) {
     const uint8_t *b = info + 2;
     uint32_t at, c, wd, size, version, end, keepalive = 0;

@@ -116,6 +116,9 @@ uint16_t sd_crc16(const uint8_t *data, uint32_t n, uint16_t crc);
 uint32_t sd_sizeof(void);
 /* now, armed, streaming, fault, late, lost, corrupt, missing */
 void sd_counters(const sd_device *d, uint32_t out[8]);
+/* the sample counter from here (after sd_init, before START): a firmware's counter may start anywhere and
+   wraps after 2^32 samples; every comparison of two counters is by their signed 32-bit difference */
+void sd_set_counter(sd_device *d, uint32_t sample);
 /* version 2, lock-step: 1 while a streaming device loop has run up to ALIVE's seen + START's latency */
 int sd_needs_alive(const sd_device *d);
 /* between the core's files (studyapp_device.c, _link.c, _loop.c), not for a firmware: */

@@ -3,7 +3,7 @@
     studyapp device-emulator --link PATH [--rate HZ] [--seed N] [--gesture strokes|hold]
         [--latency S] [--jitter S] [--loss P] [--corrupt P] [--disconnect-after S] [--lockstep]
         [--format f64|counts] [--core auto|c|python] [--watchdog-ms MS]
-        [--loop host|device] [--keepalive-ms MS]
+        [--loop host|device] [--keepalive-ms MS] [--first-sample N]
 
 Makes PATH a link to the device end of a new pty (as socat does) and prints
 ``ready: PATH`` once it exists; runs until SIGTERM / Ctrl-C (or
@@ -11,7 +11,9 @@ Makes PATH a link to the device end of a new pty (as socat does) and prints
 studyapp/device/emulator.py says what it simulates; docs/device-protocol.md
 what it speaks. ``--loop device`` runs the loop on the device (protocol version 2,
 in C: not with ``--core python``), its watchdog on the host's keep-alive
-(``--keepalive-ms``, default 200) instead of ``--watchdog-ms``. A bad option:
+(``--keepalive-ms``, default 200) instead of ``--watchdog-ms``. ``--first-sample``
+starts the device's u32 sample counter there (4294962296 = 2^32 - 5000: the
+counter wraps 1 s into the stream at 5 kHz). A bad option:
 one line, exit 2, no link made.
 """
 
@@ -48,6 +50,9 @@ def register(sub):
                    help="who runs the loop: the host (protocol 1, default) or the device (protocol 2, the C loop)")
     p.add_argument("--keepalive-ms", metavar="MS", type=int, default=None,
                    help="a device loop's watchdog on the host's keep-alive, 1..65535 ms (default 200)")
+    p.add_argument("--first-sample", metavar="N", type=int, default=0,
+                   help="the device's u32 sample counter starts at N, 0..4294967295 (default 0; near 2^32 it wraps "
+                        "while streaming)")
     p.set_defaults(func=run)
 
 
@@ -90,11 +95,14 @@ def config_from(args):
     need(not (args.lockstep and faults),
          f"--lockstep with --{faults[0] if faults else ''}: lock-step waits for every force, so it takes no "
          "link faults (allowed: --disconnect-after)")
+    need(0 <= args.first_sample <= 0xFFFFFFFF,
+         f"--first-sample {args.first_sample}: allowed is a whole number from 0 to 4294967295 (a u32 counter)")
     check_path(args.link)
     return EmulatorConfig(link=args.link, rate=int(args.rate), seed=args.seed, gesture=args.gesture,
                           latency=args.latency, jitter=args.jitter, loss=args.loss, corrupt=args.corrupt,
                           disconnect_after=args.disconnect_after, lockstep=args.lockstep, format=args.format,
-                          core=args.core, watchdog_ms=watchdog_ms, loop=args.loop, keepalive_ms=keepalive_ms)
+                          core=args.core, watchdog_ms=watchdog_ms, loop=args.loop, keepalive_ms=keepalive_ms,
+                          first_sample=args.first_sample)
 
 
 def run(args):

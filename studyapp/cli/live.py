@@ -108,7 +108,8 @@ def _check_device(args):
 def _device(info, summary):
     if info is None:
         return None
-    return {**info, "health": summary.get("device_health"), "fault": summary.get("device_fault")}
+    return {**info, "health": summary.get("device_health"), "fault": summary.get("device_fault"),
+            "rearms": summary.get("device_rearms", 0), "rearm_max_s": summary.get("device_rearm_max_s")}
 
 
 def run(args):
@@ -138,6 +139,7 @@ def run(args):
         rate=args.rate, estimators=_estimators(args.estimators, args.source), source=args.source,
         fmax=args.fmax, gesture=args.gesture, seed=args.seed, block=args.block, audio=args.audio,
         midi=args.midi, device=args.device, device_calibration=args.calibration,
+        device_rearm=True,  # a watchdog trip is re-armed at once, counted and told (a session leaves it to Resume)
     )
     link_options = (args.device_latency, args.device_packet, args.device_silence, args.calibration)
     if args.device is None and link_options != (None,) * 4:
@@ -209,4 +211,11 @@ def run(args):
         say(f"live: done: {result['achieved_rate']:.0f} Hz achieved, {result['deadline_misses']} deadline misses, "
             f"{result['audio_underruns']} underruns, {len(result['faults'])} faults, "
             f"{result['events_dropped']} events dropped")
+    device = result["device"]
+    if device is not None and device["health"] is not None:
+        say(f"live: device: {device['health']['trips']} watchdog trips, {device['health']['silences']} silences, "
+            f"{device['rearms']} re-armed"
+            + (f" (the slowest {1e3 * device['rearm_max_s']:.0f} ms after the trip was read)"
+               if device["rearm_max_s"] is not None else "")
+            + (f"; latched: {device['fault']}" if device["fault"] else ""))
     return 1 if engine.tripped else 0

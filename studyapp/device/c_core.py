@@ -96,6 +96,7 @@ def _load(path):
     lib.sd_tx.argtypes = [ptr, ptr, u32]
     lib.sd_tx.restype = u32
     lib.sd_counters.argtypes = [ptr, ctypes.POINTER(u32 * 8)]
+    lib.sd_set_counter.argtypes = [ptr, u32]
     lib.sd_crc16.argtypes = [buf, u32, ctypes.c_uint16]
     lib.sd_crc16.restype = ctypes.c_uint16
     return lib
@@ -151,6 +152,10 @@ class CCore:
             if not n:
                 return b"".join(chunks)
             chunks.append(self._out.raw[:n])
+
+    def set_counter(self, sample):
+        """The sample counter from ``sample`` (u32) on: before START (the emulator's --first-sample)."""
+        self._lib.sd_set_counter(self._state, sample & 0xFFFFFFFF)
 
     def counters(self):
         self._lib.sd_counters(self._state, ctypes.byref(self._counters))

@@ -117,6 +117,11 @@ class DeviceSide:
         self.last_report = {}
         self.reports = []
 
+    def set_counter(self, sample):
+        """The counter from ``sample`` on (before START): a device's counter may start anywhere (C: sd_set_counter)."""
+        sample &= MASK
+        self.now = self.arm_sample = self.start_sample = self.deadline = self.last_feed = sample
+
     # host messages, arriving before the actuation of sample ``now``
 
     def _feed(self, until):

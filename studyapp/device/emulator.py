@@ -36,7 +36,8 @@ late and the loop equals the model's at no latency, sample for sample.
 The link's faults (link_faults.py, seeded): ``latency`` and ``jitter`` delay
 what the device receives; ``loss`` and ``corrupt`` drop frames or flip a bit
 of them, both ways; ``disconnect_after`` closes the link after that many
-seconds (of the device's clock; of wall time in lock-step).
+seconds (of the device's clock; of wall time in lock-step). ``first_sample``
+starts the device's u32 sample counter there (the wrap past 2^32 in a test's seconds).
 
 SIGTERM, SIGINT and SIGHUP end it: the link is removed on every exit. At the
 end one line on stdout: ``stats: {json}`` (samples, the core's counters, the
@@ -89,6 +90,7 @@ class EmulatorConfig:
     watchdog_ms: int = 1
     loop: str = "host"
     keepalive_ms: int = KEEPALIVE_MS
+    first_sample: int = 0  # where the device's u32 sample counter starts (near 2^32: it wraps while streaming)
 
 
 def device_info(config, loop=None):
@@ -152,6 +154,7 @@ class Emulator:
         else:
             self.info = device_info(config)
             self.core, self.core_name = make_core(config.core, self.info)
+        self.core.set_counter(config.first_sample)
         warm = SimulatedDevice(config.rate)  # loads the compiled per-sample path before the link is ready
         warm.read_sensors()
         warm.write_force(0.0)

@@ -140,6 +140,10 @@ class Firmware:
         """Armed or streaming: the emulator paces such samples closely."""
         return self.side.streaming or self.side.armed
 
+    def set_counter(self, sample):
+        """The sample counter from ``sample`` (u32) on: before START (the emulator's --first-sample)."""
+        self.side.set_counter(sample)
+
     def counters(self):
         s = self.side
         return {"now": s.now, "armed": int(s.armed), "streaming": int(s.streaming), "fault": s.fault,

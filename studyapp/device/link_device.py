@@ -18,17 +18,28 @@ What can go wrong, and what is done (``health`` counts it, cumulative):
 
     corrupt   a frame that does not check (frames.FrameReader): never applied
     lost      device frames missing by their sequence numbers (mod 256)
-    missing   device samples never received (the sample counter jumped): the loop skips them
+    missing   device samples never received (frames lost on the way): the loop skips them
     late      forces sent for a sample the host already knew had passed (the device drops them)
     faults    FAULT frames from the device (WATCHDOG, LINK_CORRUPT, INTERNAL latch; CLAMP, SUSTAINED, LATE count)
+    trips     the device's WATCHDOG faults (its force cut because the host's forces came too late)
+    silences  the host's silence faults (no valid frame for ``silence`` s)
 
-A link that closes or errors, or is silent longer than ``SILENCE`` while the
-host waits for a frame, or a latching FAULT from the device, is a device
-fault: ``fault`` is set (the loop latches it at the end of the block: force 0
-from then on), DISARM(2) is sent if the link still takes it, and the rest of
-the block is filled with zero sensors and zero force without waiting. It
-stays latched until ``rearm()`` (the experimenter's act), which reopens the
-link if it has to, shakes hands again and arms.
+The device's u32 sample counter is followed by serial-number arithmetic
+(sample_counter.py): the host counts unwrapped, so a run across the wrap is
+like any other. A device fault is latched when the device reports one (a
+latching FAULT), or when the host detects one: the link closes or errors, no
+valid frame for ``SILENCE`` while the host waits for one (corrupt frames are
+no sign of life), a counter that goes back, jumps further than the device's
+clock can run, or a frame of another count than START's packet
+(sample_counter.py), or a sensor value that is not finite or physically
+impossible (sensor_check.py). Either way ``fault`` is set (its text says
+which: "the device reported ..." or "host-detected: ..."; the loop latches it
+at the end of the block: force 0 from then on), DISARM(2) then STOP are sent
+if the link still takes them, and from then on each block reads what the
+device sends (its FAULT and STATE frames; samples dropped) without waiting,
+its forces zero. It stays latched until ``rearm()``, which reopens the link if
+it has to (a new handshake) or else STARTs the stream again, and arms. A
+disarmed device is sent 0 N, never the loop's force.
 
 ``info`` is a plain dict (the console, session.json and recordings read it;
 names documented in docs/engine.md): name, serial, protocol, firmware, rate,
@@ -38,27 +49,28 @@ channels, calibration, limits, latency_samples, packet, round_trip_ms
 
 import time
 
-import numpy as np
-
 from studyapp.device import handshake
 from studyapp.device import loop_messages as lm
 from studyapp.device import messages as msg
 from studyapp.device.errors import ProtocolError
 from studyapp.device.frames import FrameReader, encode
+from studyapp.device.link_arming import DISARM_EMERGENCY, DISARM_FAULT, DISARM_HOST, Arming  # noqa: F401 (re-exported)
+from studyapp.device.link_arming import why as _why
 from studyapp.device.link_open import open_link
+from studyapp.device.sample_counter import MASK, CounterFault, SampleCounter
+from studyapp.device.sensor_check import check as check_sensors
 from studyapp.errors import ParameterError
 from studyapp.model.device import DeviceLimits, HapticDevice
 
 SILENCE = 0.020  # s without a device frame, while waiting for one, that makes a device fault
 LATCHING = (msg.WATCHDOG, msg.LINK_CORRUPT, msg.INTERNAL)
-DISARM_HOST, DISARM_EMERGENCY, DISARM_FAULT = msg.HOST_REQUEST, msg.EMERGENCY_STOP, msg.HOST_FAULT
 DEFAULT_LATENCY = 5  # samples the host answers ahead (1 ms at 5 kHz)
 DEFAULT_PACKET = 1  # samples per sensor frame
 DEFAULT_RAMP_MS = 200  # the force ramps up from 0 over this after each ARM
-HEALTH = ("frames", "samples", "corrupt", "lost", "missing", "late", "faults", "clamped")
+HEALTH = ("frames", "samples", "corrupt", "lost", "missing", "late", "faults", "clamped", "trips", "silences")
 
 
-class LinkDevice(HapticDevice):
+class LinkDevice(Arming, HapticDevice):
     """The device on the link ``spec`` (path or URL), streaming at ``rate`` Hz once opened.
 
     ``latency``: samples ahead the host answers (FORCE tagged sensor sample + latency);
@@ -91,6 +103,8 @@ class LinkDevice(HapticDevice):
         self.fault_time = None  # time.monotonic() when ``fault`` was set
         self.last_data = None  # time.monotonic() when bytes last came from the device while streaming
         self.device_faults = []  # (code, sample, detail) of every FAULT frame, oldest first
+        self.fault_code = None  # the device's FAULT code of a latched device-reported fault; None if host-detected
+        self.fault_timing = False  # the latched fault is one of timing (the device's WATCHDOG, the host's silence)
         self.link_lost = False  # the link itself failed (closed, errored): a re-arm reopens it
         self.armed = False
         self.link = None
@@ -104,8 +118,11 @@ class LinkDevice(HapticDevice):
             self._reader = FrameReader()
             self._seq_out = 0
             self._seq_in = None
-            self._pending = []  # decoded SENSORS samples not yet run: (sample, x, a, v)
-            self._newest = -1  # the newest device sample seen
+            self._pending = []  # decoded SENSORS samples not yet run: (sample unwrapped, x, a, v)
+            self._counter = SampleCounter(self.rate, self.packet)
+            self._newest = -1  # the newest device sample seen, unwrapped (sample_counter.py)
+            self._stopped = False  # STOP sent after a fault: a re-arm STARTs again
+            self._skip_partial = False  # bytes were dropped undecoded: the next frame starts after a 0x00
             self._forces = []  # forces of the current run of samples, not yet sent
             self._first = None  # the device sample of _forces[0]
             self._read_at = 0.0
@@ -120,6 +137,7 @@ class LinkDevice(HapticDevice):
             self._check_loop(handshake.loop_of(self.device_info, self.spec))
             self.round_trip = handshake.probe(self._send, self._receive_one, self.spec, self.pings)
             self._pending.clear()
+            self._counter = SampleCounter(self.rate, self.packet)
             self._newest = -1
             self.health = health
             self._start()
@@ -144,7 +162,16 @@ class LinkDevice(HapticDevice):
                                  "cannot drive it (studyapp/device/loop_link.py does); refused")
 
     def _start(self):
-        self._send(msg.Start(packet=self.packet, latency=self.latency))
+        """START waits for the host's first use (``_begin``): the device streams from the moment the host reads,
+        so nothing piles up in the link while the engine is still being built (a backlog read later costs more
+        time than it spans, and the pty drops what does not fit: issue 41's trips at the start)."""
+        self._start_pending = True
+
+    def _begin(self):
+        if self._start_pending and self.link is not None:
+            self._start_pending = False
+            self._guarded(msg.Start(packet=self.packet, latency=self.latency))
+            self._counter.started()
 
     def _parse(self, payload):
         return msg.parse(payload, self._channels)
@@ -186,8 +213,15 @@ class LinkDevice(HapticDevice):
             self._take(self.link.read())
 
     def _take(self, data):
-        """Decode the bytes read: SENSORS samples go to ``_pending``, other messages to ``_queue`` or act."""
+        """Decode the bytes read: SENSORS samples go to ``_pending``, other messages to ``_queue`` or act.
+        Returns how many valid frames there were (corrupt ones are no sign of a live device)."""
+        if self._skip_partial:
+            end = data.find(b"\x00")
+            if end < 0:
+                return 0
+            data, self._skip_partial = data[end + 1:], False
         corrupt = self._reader.corrupt
+        valid = 0
         for payload in self._reader.feed(data):
             try:
                 seq, message = self._parse(payload)
@@ -196,6 +230,7 @@ class LinkDevice(HapticDevice):
                 if payload[0] == msg.INFO and not self._streaming:  # the handshake refuses it by its field
                     self._queue.append(handshake.BadFrame(str(exc), True))
                 continue
+            valid += 1
             if self._seq_in is not None:
                 gap = (seq - self._seq_in - 1) & 0xFF
                 self.health["lost"] += gap
@@ -205,7 +240,11 @@ class LinkDevice(HapticDevice):
             elif isinstance(message, msg.Fault):
                 self.health["faults"] += 1
                 self.device_faults.append((message.code, message.sample, message.detail))
-                if message.code in LATCHING:
+                if message.code == msg.WATCHDOG and self.fault is None:
+                    self.health["trips"] += 1
+                if message.code in LATCHING and self.fault is None:
+                    self.fault_code = message.code
+                    self.fault_timing = message.code == msg.WATCHDOG
                     self._device_fault(f"the device reported {msg.FAULT_NAMES.get(message.code, message.code)} "
                                        f"at its sample {message.sample}")
             elif isinstance(message, msg.State):
@@ -213,26 +252,41 @@ class LinkDevice(HapticDevice):
             elif not self._streaming:
                 self._queue.append(message)
         self.health["corrupt"] += self._reader.corrupt - corrupt
+        return valid
+
+    def _follow(self, frame, count, name):
+        """The frame's first sample, unwrapped, after the counter's checks (sample_counter.py); None on a fault."""
+        try:
+            first, missing = self._counter.take(frame.sample, count, name)
+        except CounterFault as exc:
+            self._host_fault(str(exc))
+            return None
+        self.health["missing"] += missing
+        self._newest = self._counter.newest
+        return first
 
     def _sensors(self, frame):
+        if self.fault is not None:
+            return  # a faulted stream's samples are read (the device's queue must not back up), never run
         h = self.health
         h["frames"] += 1
         if frame.flags & msg.FLAG_CLAMPED:
             h["clamped"] += 1
-        expected = self._newest + 1
-        if self._newest >= 0 and frame.sample > expected:
-            h["missing"] += frame.sample - expected
-        if frame.sample < expected:
-            return  # a repeat of samples already run: never applied twice
         count = len(frame.values)
-        self._newest = frame.sample + count - 1
+        first = self._follow(frame, count, "SENSORS")
+        if first is None:
+            return
         x, a, v = self.scales.convert(frame.values)
+        bad = check_sensors(frame.sample, x, a, v)
+        if bad is not None:
+            self._host_fault(bad)
+            return
         for i in range(count):
-            self._pending.append((frame.sample + i, x[i], a[i], v[i]))
+            self._pending.append((first + i, x[i], a[i], v[i]))
 
     # streaming ----------------------------------------------------------------
     def _next_sample(self):
-        """The next device sample (sample, x, a, v), waiting up to ``SILENCE`` per frame; None on a device fault."""
+        """The next device sample (sample, x, a, v), waiting up to ``silence`` for one; None on a device fault."""
         if self._pending:
             return self._pending.pop(0)
         self._flush()
@@ -245,15 +299,19 @@ class LinkDevice(HapticDevice):
                 return None
             if data:
                 self._read_at = time.perf_counter()
-                self.last_data = time.monotonic()
-                self._take(data)
-                if self._pending:
+                if self._take(data):
+                    self.last_data = time.monotonic()
+                if self._pending:  # only samples end the wait: corrupt frames, or a stream of other frames, are
+                    # no sign of a live stream (a device sending STATE or PONG forever must not wedge the host)
                     return self._pending.pop(0)
-                end = time.monotonic() + self.silence  # bytes came: the link is alive
-                continue
+                if self.fault is not None:
+                    return None
             left = end - time.monotonic()
             if left <= 0:
-                self._device_fault(f"the link was silent for more than {1e3 * self.silence:g} ms")
+                self.health["silences"] += 1
+                self.fault_timing = True
+                self._host_fault(f"no sample from the device for more than {1e3 * self.silence:g} ms "
+                                 f"(the link silent, or only corrupt or other frames)")
                 return None
             self.link.wait(left)
         return None
@@ -265,10 +323,11 @@ class LinkDevice(HapticDevice):
         tag = self._first + self.latency
         if tag <= self._newest_known():
             self.health["late"] += 1
+        forces = self._forces if self.armed else [0.0] * len(self._forces)  # a disarmed device is sent 0 N
         try:
-            for start in range(0, len(self._forces), msg.MAX_FORCES):
-                chunk = self._forces[start:start + msg.MAX_FORCES]
-                self._send(msg.Force(sample=(tag + start) & 0xFFFFFFFF, forces=tuple(chunk)))  # u32, wraps
+            for start in range(0, len(forces), msg.MAX_FORCES):
+                chunk = forces[start:start + msg.MAX_FORCES]
+                self._send(msg.Force(sample=(tag + start) & MASK, forces=tuple(chunk)))  # u32, wraps
         except OSError as exc:
             self._link_failed(exc)
         if self.timing:
@@ -281,7 +340,11 @@ class LinkDevice(HapticDevice):
 
     def exchange(self, control, n, out, est_out):
         """The next ``n`` device samples through the loop's controller; zeros without waiting once faulted."""
+        self._begin()
         h = self.health
+        if self.fault is not None:
+            self._drain()
+            return  # zero sensors and force, at once: the loop has latched ``fault``
         for k in range(n):
             got = self._next_sample() if self.fault is None else None
             if got is None:
@@ -297,107 +360,3 @@ class LinkDevice(HapticDevice):
             if not self._pending or len(self._forces) >= self.packet:
                 self._flush()
         self._flush()
-
-    # arming and faults --------------------------------------------------------
-    def arm(self, ramp_ms=None):
-        """Allow force, ramping up from 0 over ``ramp_ms`` (default the driver's)."""
-        if self.fault is None:
-            ramp = self.ramp_ms if ramp_ms is None else int(ramp_ms)
-            self._guarded(msg.Arm(ramp_ms=max(ramp, self.device_info.ramp_ms_min)))
-            self.armed = self.fault is None
-
-    def disarm(self, reason=DISARM_HOST):
-        """Force 0 at once on the device, latched there until ``arm``."""
-        self.armed = False
-        if self.link is not None:
-            self._guarded(msg.Disarm(reason=int(reason)), quiet=True)
-
-    def _guarded(self, message, quiet=False):
-        try:
-            self._send(message)
-        except OSError as exc:
-            if not quiet:
-                self._link_failed(exc)
-
-    def _link_failed(self, exc):
-        self.link_lost = True
-        self._device_fault(f"the link failed ({_why(exc)})")
-
-    def _device_fault(self, text):
-        if self.fault is None:
-            self.fault = text
-            self.fault_time = time.monotonic()
-            self.disarm(DISARM_FAULT)
-
-    def rearm(self, ramp_ms=None):
-        """The experimenter's reset after a device fault: reopen the link if it failed (and shake hands again),
-        drop the frames that piled up, arm.
-
-        ``ParameterError`` (one line) when the device is still not there; the fault stays latched then.
-        """
-        reopen = self.fault is not None and self.link_lost
-        for _ in range(2):
-            if reopen:
-                self.close()
-                self._open()
-                self.link_lost = False
-            self.fault = None
-            self.resync()
-            self.arm(ramp_ms)
-            # a link found gone only now (a device restarted while a silence fault held it): reopen it at once,
-            # or this Resume would fail and only the next one work (issue 41, item 8)
-            reopen = self.fault is not None and self.link_lost
-            if not reopen:
-                break
-
-    def resync(self):
-        """Drop every frame waiting on the link (the host was busy, not answering): the next sample is fresh."""
-        self._read_waiting()
-        self._pending.clear()
-        self._forces = []
-        self._first = None
-
-    def _read_waiting(self):
-        """Take every byte already waiting on the link, without waiting."""
-        while self.fault is None and self.link.wait(0.0):
-            try:
-                data = self.link.read()
-            except (OSError, EOFError) as exc:
-                self._link_failed(exc)
-                break
-            if not data:
-                break
-            self._take(data)
-
-    def stop_stream(self, timeout=0.2):
-        """STOP the stream and wait for the device's STATE (its own counters: late, lost, corrupt); None if none came."""
-        self.device_state = None
-        self._guarded(msg.Stop(), quiet=True)
-        end = time.monotonic() + timeout
-        while self.device_state is None and self.fault is None and (left := end - time.monotonic()) > 0:
-            if self.link.wait(left):
-                try:
-                    self._take(self.link.read())
-                except (OSError, EOFError) as exc:
-                    self._link_failed(exc)
-        self._streaming = False
-        return self.device_state
-
-    def close(self):
-        """STOP the stream (force 0) and close the link."""
-        if self.link is None:
-            return
-        try:
-            self._send(msg.Disarm(reason=DISARM_HOST))
-            self._send(msg.Stop())
-        except OSError:
-            pass
-        self.link.close()
-        self.link = None
-        self.armed = False
-
-
-def _why(exc):
-    text = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
-    return text.splitlines()[0]
-

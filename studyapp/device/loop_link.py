@@ -55,10 +55,11 @@ import numpy as np
 
 from studyapp.device import handshake
 from studyapp.device import loop_messages as lm
-from studyapp.device import messages as msg
 from studyapp.device import shadow
 from studyapp.device.link_device import LinkDevice
 from studyapp.device.loop_image import image_crc
+from studyapp.device.sample_counter import MASK
+from studyapp.device.sensor_check import check as check_sensors
 from studyapp.errors import ParameterError
 from studyapp.model.control import C_BOWING, C_FORCE_SCALE, C_GAIN, C_SOURCE
 
@@ -129,20 +130,6 @@ class LoopLink(LinkDevice):
         self.silence = max(self.silence, self.loop_info.keepalive_ms / 1000.0)
         self._alive_period = self.loop_info.keepalive_ms / 4000.0  # s: the protocol's longest gap between ALIVEs
 
-    def _start(self):
-        """START waits for the host's first use (``_begin``): the device streams from the moment the host reads,
-        so nothing piles up while the loop is still being built (a pty that fills drops telemetry: a gap)."""
-        self._start_pending = True
-
-    def _begin(self):
-        if self._start_pending and self.link is not None:
-            self._start_pending = False
-            self._guarded(msg.Start(packet=self.packet, latency=self.lead))
-
-    def arm(self, ramp_ms=None):
-        self._begin()
-        super().arm(ramp_ms)
-
     def _check_loop(self, loop):
         if loop.loop != lm.DEVICE_LOOP:
             raise ParameterError(f"device at {self.spec}: it does not run the loop (INFO.loop = {loop.loop}); "
@@ -160,23 +147,29 @@ class LoopLink(LinkDevice):
         return lm.parse(payload, self._channels)
 
     def _sensors(self, frame):
-        """A TELEMETRY frame: its rows to ``_rows`` (a repeat dropped, a gap counted)."""
+        """A TELEMETRY frame: its rows to ``_rows`` (samples unwrapped; a gap counted; a counter or a sensor an
+        honest device cannot send is a fault, as in ``LinkDevice``)."""
+        if self.fault is not None:
+            return
         h = self.health
         h["frames"] += 1
         flags = frame.flags
         if flags & lm.FLAG_CLAMPED:
             h["clamped"] += 1
-        expected = self._newest + 1
-        if self._newest >= 0 and frame.sample > expected:
-            h["missing"] += frame.sample - expected
-            h["gaps"] += 1
-            self._unsynced_from = min(self._unsynced_from, expected)  # rows before the gap still compare
-        if frame.sample < expected:
-            return
         count = len(frame.rows)
-        self._newest = frame.sample + count - 1
+        newest = self._newest
+        first = self._follow(frame, count, "TELEMETRY")
+        if first is None:
+            return
+        if newest >= 0 and first > newest + 1:
+            h["gaps"] += 1
+            self._unsynced_from = min(self._unsynced_from, newest + 1)  # rows before the gap still compare
         width = len(self._channels)
         x, a, v = self.scales.convert([r[:width] for r in frame.rows])
+        bad = check_sensors(frame.sample, x, a, v)
+        if bad is not None:
+            self._host_fault(bad)
+            return
         # a packet's flags are the device's state at its end: a force gap is counted only inside a run of
         # steady packets (an ARM or a DISARM within a packet is no gap)
         now_steady = bool(flags & lm.FLAG_ARMED) and not flags & (lm.FLAG_RAMPING | lm.FLAG_FAULT)
@@ -185,7 +178,7 @@ class LoopLink(LinkDevice):
             loop_force, applied, bridge, cid = r[width:]
             if steady and applied == 0.0 and loop_force != 0.0:
                 h["force_gaps"] += 1
-            self._rows.append((frame.sample + i, x[i], a[i], v[i], loop_force, applied, bridge, cid))
+            self._rows.append((first + i, x[i], a[i], v[i], loop_force, applied, bridge, cid))
 
     def _service(self):
         """While catching up on waiting rows (after a stall), still read the link and send ALIVE every ms: the
@@ -224,16 +217,19 @@ class LoopLink(LinkDevice):
                 self._link_failed(exc)
                 return False
             if data:
-                self.last_data = time.monotonic()
-                self._take(data)
-                if self._rows:
+                if self._take(data):
+                    self.last_data = time.monotonic()
+                if self._rows:  # only rows end the wait (as LinkDevice._next_sample)
                     self._alive()
                     return True
-                end = time.monotonic() + self.silence
-                continue
+                if self.fault is not None:
+                    return False
             left = end - time.monotonic()
             if left <= 0:
-                self._device_fault(f"the link was silent for more than {1e3 * self.silence:g} ms")
+                self.health["silences"] += 1
+                self.fault_timing = True
+                self._host_fault(f"no sample from the device for more than {1e3 * self.silence:g} ms "
+                                 f"(the link silent, or only corrupt or other frames)")
                 return False
             self.link.wait(min(left, self._alive_period))
         return False
@@ -266,7 +262,7 @@ class LoopLink(LinkDevice):
         included), superseded at once.
         """
         if cid not in self._sent:
-            self._device_fault(f"the device's sample {sample} runs CONTROL {cid}, which this host never sent")
+            self._host_fault(f"the device's sample {sample & MASK} runs CONTROL {cid}, which this host never sent")
             return False
         now = time.perf_counter()
         for i in list(self._sent):
@@ -291,7 +287,7 @@ class LoopLink(LinkDevice):
         self._image_checked = True
         crc = image_crc(int(self.rate), arrays)
         if crc != self.loop_info.image:
-            self._device_fault(f"its loop's parameters are not the host's (image CRC {self.loop_info.image:08x}, "
+            self._host_fault(f"its loop's parameters are not the host's (image CRC {self.loop_info.image:08x}, "
                                f"the host's {crc:08x}); refused")
 
     # the loop's block ---------------------------------------------------------
@@ -315,6 +311,9 @@ class LoopLink(LinkDevice):
             ctl[:] = wanted
 
     def _run(self, control, n, out, est_out, ctl):
+        if self.fault is not None:
+            self._drain()
+            return
         rows = []
         while len(rows) < n and self.fault is None:
             row = self._next_row()
@@ -349,12 +348,23 @@ class LoopLink(LinkDevice):
             if bad >= 0:
                 row = [float(v) for v in table[start + bad]]
                 force, bridge = (float(v) for v in self._shadow_values)
-                self._device_fault(
-                    f"the device's loop differs from the host's shadow at its sample {int(row[shadow.R_SAMPLE])}: "
+                self._host_fault(
+                    f"the device's loop differs from the host's shadow at its sample "
+                    f"{int(row[shadow.R_SAMPLE]) & MASK}: "
                     f"force {row[shadow.R_LOOP_FORCE]!r} N (shadow {force!r}), bridge {row[shadow.R_BRIDGE]!r} "
                     f"(shadow {bridge!r})")
                 return
             start = end
+
+    def _restarted(self):
+        """The stream STARTs again after a fault's STOP: the device's loop starts as built (sl_reset) with its
+        CONTROL queue empty, so the shadow, which kept its state, is no longer compared (as after a reopen)."""
+        self._rows.clear()
+        self._sent.clear()
+        self._last_setting = None
+        self._effect, self._effect_id = IDLE, 0
+        self._steady = False
+        self._unsynced_from = -1
 
     def resync(self):
         """Rows waiting are kept (the shadow must run every row the device ran); only the link's bytes are read."""

@@ -53,6 +53,7 @@ class EngineConfig:
     device_calibration: str | None = None  # a TOML file of calibrations keyed by serial number (calibration_file.py)
     device_ramp_ms: int = DEFAULT_RAMP_MS  # ms over which a link device's force ramps up from 0 after each ARM
     device_silence: float = SILENCE  # s without a frame from a link device that make it a device fault
+    device_rearm: bool = False  # re-arm a link device at once after its watchdog trips (live); else the experimenter
     # s without a heartbeat before the force guard calls the worker hung: HANG_TIMEOUT, more on a busy machine
     hang_timeout: float = field(default_factory=lambda: hang_timeout_for(load_per_core(), HANG_TIMEOUT))
     # s without the force guard's heartbeat before the worker switches its own force off: the guard's

@@ -11,11 +11,19 @@ decide:
   ramps up from 0 (the device restarts its ramp), and the trial's health is
   reported;
 - ``force_enable`` cleared (the emergency stop: DISARM(1); the guard or the
-  parent's watchdog: DISARM(2)) before the block runs;
+  parent's watchdog: DISARM(2)), or a fault latched by the engine's safety
+  (the runaway guard, a clamp found violated: DISARM(2)), before the block
+  runs: the device's force is cut at once, and it is sent 0 N while disarmed;
 - the experimenter clears the fault (``ClearFault``): a device fault (the link
   closed, failed or fell silent; the device's own WATCHDOG) is re-armed
   (``rearm``: the link reopened and the handshake redone if need be) and the
-  loop's device fault cleared; else ARM again.
+  loop's device fault cleared; else ARM again;
+- ``rearm_after_trip`` (``EngineConfig.device_rearm``: ``studyapp live``):
+  a fault of timing (the device's WATCHDOG trip: its force cut because the
+  host's forces came late; the host's silence: no valid frame in time, on a
+  link still open) is re-armed at once, counted (``rearms``; the delays from
+  the host latching the fault to the ARM in ``rearm_delays``) and told to the
+  parent; every other device fault stays latched for the experimenter.
 
 Events (engine/events.py) for the console and the session records:
 ``DeviceInfo(info)`` once the device is armed (and after each re-arm), and
@@ -24,7 +32,10 @@ ended (``health`` the counts over that trial, ``totals`` since the link opened).
 The status block carries the running counts (``device_*`` numbers).
 """
 
+import time
+
 from studyapp.device.link_device import DISARM_EMERGENCY, DISARM_FAULT
+from studyapp.device.messages import WATCHDOG
 from studyapp.engine import events as ev
 from studyapp.errors import UserError
 
@@ -42,6 +53,8 @@ class DeviceLink:
         self.trial = 0
         self._trial_start = dict(device.health)
         self._disarmed_for = None  # the force_enable reason the device was disarmed for
+        self.rearms = 0  # watchdog trips re-armed (rearm_after_trip)
+        self.rearm_delays = []  # s from the host reading each trip to its ARM
 
     @staticmethod
     def of(device, events, notice):
@@ -59,11 +72,17 @@ class DeviceLink:
         self._trial_start = dict(self.device.health)
         self.events.put(ev.DeviceInfo(self.info))
 
-    def before_block(self, enabled, reason):
-        """The force guard's word for this block: disarm the device the moment it is cleared."""
-        if not enabled and self._disarmed_for is None:
+    def before_block(self, enabled, reason, latched=None):
+        """The force guard's word for this block, and the safety's latched fault (``latched``, its text or None):
+        disarm the device the moment either cuts the force."""
+        if self._disarmed_for is not None:
+            return
+        if not enabled:
             self._disarmed_for = reason
             self.device.disarm(DISARM_EMERGENCY if reason == "operator" else DISARM_FAULT)
+        elif latched is not None:
+            self._disarmed_for = "fault"
+            self.device.disarm(DISARM_FAULT)
 
     def trial_started(self, trial):
         """A trial (re)starts: the last one's health, and the force ramps up from 0 again."""
@@ -97,11 +116,29 @@ class DeviceLink:
             return False
         return True
 
+    def rearm_after_trip(self, loop):
+        """Re-arm the device after its watchdog tripped (``studyapp live``); True if it was re-armed."""
+        device = self.device
+        if device.fault is None or not device.fault_timing or device.link_lost:
+            return False
+        what = ("its watchdog tripped (the host's forces came late)" if device.fault_code == WATCHDOG
+                else "the host heard nothing from it in time")
+        read_at = device.fault_time
+        if not self.clear(loop):
+            return False
+        self.rearms += 1
+        self.rearm_delays.append(time.monotonic() - read_at)
+        self.notice(f"device: {what}; re-armed after {1e3 * self.rearm_delays[-1]:.1f} ms (re-arm {self.rearms})",
+                    "warning")
+        return True
+
     def status(self):
         return {key: self.device.health[name] for key, name in STATUS.items()}
 
     def summary(self):
-        return {"device": self.info, "device_health": dict(self.device.health), "device_fault": self.device.fault}
+        return {"device": self.info, "device_health": dict(self.device.health), "device_fault": self.device.fault,
+                "device_rearms": self.rearms,
+                "device_rearm_max_s": max(self.rearm_delays) if self.rearm_delays else None}
 
     def close(self):
         self.report()

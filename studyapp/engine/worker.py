@@ -117,6 +117,9 @@ def main(config, ring_spec, status_name, commands, events_name):
         os._exit(0)
 
 
+SUMMARY_FAULTS = 20  # the first faults in the summary (its event has a size limit; live re-arms trip after trip)
+
+
 class Worker(ControlRouting):
     cut = False  # the model's sound jumps at the next block (the sink fades across it)
 
@@ -284,7 +287,7 @@ class Worker(ControlRouting):
         enabled, why = self.guard.force()
         self.safety.before_block(enabled, why=why)
         if self.link is not None:
-            self.link.before_block(enabled, self.status.force_off_reason)
+            self.link.before_block(enabled, self.status.force_off_reason, self.safety.latched)
         bowing = self.loop.bowing
         out = self.loop.run(self.block)
         if self.sink.render:
@@ -344,6 +347,9 @@ class Worker(ControlRouting):
             for text in new_faults:
                 self.fault(text)
             self._faults_seen += len(new_faults)
+            if self.link is not None and self.config.device_rearm and self.link.rearm_after_trip(self.loop):
+                self.safety.clear()  # live: a watchdog trip is re-armed at once (engine/device_link.py)
+                self.status.set(fault="")
             status.set(
                 heartbeat=finished, blocks=self.k, samples=self.k * self.block, load=pacing.loads[-1],
                 audio_underruns=self.sink.underruns, audio_xruns=self.sink.xruns, audio_limited=self.sink.limited,
@@ -375,7 +381,8 @@ class Worker(ControlRouting):
             "rate": self.loop.rate, "blocks": self.k, "samples": self.k * self.block,
             "seconds": t["seconds"], "achieved_rate": t["achieved_rate"], "deadline_misses": int(s.get("deadline_misses")),
             "audio_underruns": self.sink.underruns, "audio_xruns": self.sink.xruns,
-            "audio_limited": self.sink.limited, "audio_frames": self.sink.frames_played, "faults": list(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
+            "audio_limited": self.sink.limited, "audio_frames": self.sink.frames_played, "faults": list(self.safety.faults[:SUMMARY_FAULTS]),
+            "faults_total": len(self.safety.faults), "midi_messages": int(s.get("midi_messages")),
             "midi_overflows": self.midi.overflows if self.midi else 0,
             "command_latency_max": float(s.get("command_latency_max")),
             "load_mean": t["load_mean"], "load_p99": t["load_p99"], "load_max": t["load_max"], "realtime": self.realtime,

@@ -332,5 +332,5 @@ class ClosedLoop:
             FAULT_FORCE: "the device force",
         }
         if code == FAULT_DEVICE:
-            return f"the device reported a fault at t = {t:.4f} s ({self.device.fault}); force held at 0"
+            return f"device fault at t = {t:.4f} s ({self.device.fault}); force held at 0"
         return f"non-finite value from {what[code]} at t = {t:.4f} s; force held at 0"

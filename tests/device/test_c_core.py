@@ -34,7 +34,7 @@ def wire(draw):
     if kind == "force":  # tagged from the device's sample counter when it is sent: mostly ahead, some late
         offset = draw(st.integers(-3, 30))
         values = tuple(draw(st.lists(forces, min_size=1, max_size=12)))
-        return lambda now: frames.encode(messages.Force(max(0, now + offset), values).pack(seq))
+        return lambda now: frames.encode(messages.Force(_tag(now, offset), values).pack(seq))
     if kind == "payload":
         body = draw(st.binary(max_size=24))
         return frames.encode(bytes((draw(st.integers(0x80, 0x8A)), seq)) + body)
@@ -45,6 +45,11 @@ def wire(draw):
         bit = draw(st.integers(0, len(data) * 8 - 1))
         data[bit // 8] ^= 1 << (bit % 8)
     return bytes(data)
+
+
+def _tag(now, offset):
+    """``offset`` samples from the device's ``now``: mod 2^32 near the wrap (issue 41), else at least 0."""
+    return (now + offset) & 0xFFFFFFFF if now >= 2**31 else max(0, now + offset)
 
 
 session = st.just([lambda now: frames.encode(messages.Start(2, 4).pack(0)),
@@ -58,8 +63,10 @@ def bits(f):
     return struct.pack("<d", f)
 
 
-def run_both(info, program, counts):
+def run_both(info, program, counts, first=0):
     py, c = Firmware(info), c_core.CCore(info)
+    py.set_counter(first)
+    c.set_counter(first)
     k = 0
     for frames_in, cut, n in program:
         data = b"".join(f(py.now) if callable(f) else f for f in frames_in)
@@ -88,6 +95,34 @@ def test_c_core_equals_python_core(program):
 @settings(max_examples=40, deadline=None)
 def test_c_core_equals_python_core_counts(program):
     run_both(emulator.device_info(emulator.EmulatorConfig(link="-", format="counts", rate=1000)), program, counts=True)
+
+
+@given(steps)
+@settings(max_examples=60, deadline=None)
+def test_c_core_equals_python_core_across_the_counter_wrap(program):
+    """From 40 samples before 2^32 (sd_set_counter, the emulator's --first-sample): the programs cross the wrap."""
+    run_both(emulator.device_info(emulator.EmulatorConfig(link="-")), program, counts=False, first=2**32 - 40)
+
+
+def test_the_cores_stream_and_answer_forces_across_the_wrap():
+    """Armed streaming over the wrap: forces tagged mod 2^32 act on both sides of it, the watchdog stays fed."""
+    info = emulator.device_info(emulator.EmulatorConfig(link="-"))
+    first = 2**32 - 100
+    program = [([frames.encode(messages.Start(4, 8).pack(0)), frames.encode(messages.Arm(0).pack(1))], 0, 0)]
+    for block in range(60):
+        tag = (first + block * 4 + 8) & 0xFFFFFFFF
+        program.append(([frames.encode(messages.Force(tag, (1.0, 2.0, 3.0, 4.0)).pack((block + 2) & 255))], 0, 4))
+    run_both(info, program, counts=False, first=first)
+    py = Firmware(info)
+    py.set_counter(first)
+    for frames_in, _, n in program:
+        py.rx(b"".join(frames_in))
+        for _ in range(n):
+            py.sample((0.0, 0.0, 0.0))
+            py.actuate()
+    counters = py.counters()
+    assert counters["now"] == (first + 240) & 0xFFFFFFFF and counters["fault"] == 0 and counters["armed"] == 1
+    assert counters["late"] == 0 and counters["missing"] == 0
 
 
 def test_long_streaming_run_with_clamps_and_watchdog():

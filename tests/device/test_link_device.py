@@ -49,6 +49,8 @@ def test_handshake_info_and_start(fake):
     assert info["rate"] == 5000.0 and info["latency_samples"] == 3 and info["packet"] == 2
     assert info["channels"] == ["position", "acceleration", "velocity"] and info["calibration"] == "device"
     assert info["round_trip_ms"]["median"] > 0 and info["round_trip_ms"]["p99"] >= info["round_trip_ms"]["median"]
+    assert not fake.started.is_set()  # START waits for the host's first use: nothing piles up before it
+    device.resync()
     assert _wait(fake.started.is_set)
     start = [m for m in fake.received if isinstance(m, messages.Start)]
     assert start == [messages.Start(packet=2, latency=3)]
@@ -89,6 +91,7 @@ def _rows(samples):
 
 def test_exchange_answers_each_sample_latency_ahead(fake):
     device = _open(fake, latency=4, packet=2)
+    device.arm(0)
     control = Recorder()
     fake.sensors(100, _rows([100, 101]))
     fake.sensors(102, _rows([102, 103]))
@@ -140,9 +143,10 @@ def test_a_silent_link_is_a_device_fault_after_the_bound(fake):
     waited = time.monotonic() - started
     assert SILENCE <= waited < SILENCE + 0.01
     assert "silent" in device.fault
-    assert isinstance(fake.received[-1], messages.Disarm) or _wait(
-        lambda: isinstance(fake.received[-1], messages.Disarm))
-    assert fake.received[-1].reason == messages.HOST_FAULT
+    assert device.fault.startswith("host-detected: ")
+    # DISARM(2), then STOP: the device's stream must not pile up in the link (issue 41)
+    assert _wait(lambda: [type(m) for m in fake.received[-2:]] == [messages.Disarm, messages.Stop])
+    assert fake.received[-2].reason == messages.HOST_FAULT
     device.close()
 
 

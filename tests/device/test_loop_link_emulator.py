@@ -72,7 +72,7 @@ def test_a_device_loop_of_other_estimator_parameters_is_refused(emulator):
     device = LoopLink(emulator(), RATE, silence=SILENCE_S)
     loop = _loop(device, params={"LEVANT": {"c": 123.0}})
     forces = loop.run(50)["force"]
-    assert device.fault.startswith("its loop's parameters are not the host's (image CRC")
+    assert device.fault.startswith("host-detected: its loop's parameters are not the host's (image CRC")
     assert "refused" in device.fault and not np.any(forces)
     device.close()
 
