@@ -29,7 +29,7 @@ class Zero:
         return 0.0
 
 
-def _stream(tmp_path, latency, seconds, *emulator):
+def _stream(tmp_path, latency, seconds, *emulator, faults=()):
     path = tmp_path / f"device-{latency}"
     with EmulatorProcess(path, "--seed", "1", "--watchdog-ms", "100", *emulator) as emu:
         device = LinkDevice(path, RATE, latency=latency, packet=PACKET, ramp_ms=0, silence=5.0, pings=2)
@@ -39,7 +39,7 @@ def _stream(tmp_path, latency, seconds, *emulator):
         health, fault = dict(device.health), device.fault
         device.close()
         stats = emu.stop()
-    assert fault is None
+    assert fault is None or any(word in fault for word in faults), fault
     print(f"\npacket {PACKET}, latency {latency} {' '.join(emulator) or 'clocked'}: {health['samples']} samples, "
           f"host late {health['late']}, device late {stats['late']}, dropped ahead {stats['corrupt']}")
     return health, stats
@@ -64,7 +64,8 @@ def test_at_latency_1024_no_force_is_dropped_above_it_some_are(tmp_path, uncheck
     assert handshake.MAX_LATENCY == 1024
     _, stats = _stream(tmp_path, 1024, 2.0)
     assert stats["corrupt"] == 0 and stats["samples"] > 1024 + RATE
-    _, stats = _stream(tmp_path, 1040, 2.0)
+    # every force dropped starves the device's watchdog (100 ms) when the host keeps up: the drop is the point
+    _, stats = _stream(tmp_path, 1040, 2.0, faults=("WATCHDOG",))
     assert stats["corrupt"] > 0
 
 
