@@ -113,14 +113,8 @@ class Arming:
         frame by frame would take longer than the time it spans): the next sample is fresh."""
         self._begin()
         for _ in range(DRAIN_READS * 16):
-            if self.fault is not None or not self.link.wait(0.0):
-                break
-            try:
-                data = self.link.read()
-            except (OSError, EOFError) as exc:
-                self._link_failed(exc)
-                break
-            if not data:
+            data = self._read_chunk()
+            if data is None:
                 break
             self._reader = FrameReader()
             self._skip_partial = not data.endswith(b"\x00")
@@ -131,15 +125,19 @@ class Arming:
 
     def _read_waiting(self):
         """Take every byte already waiting on the link, without waiting."""
-        while self.fault is None and self.link.wait(0.0):
-            try:
-                data = self.link.read()
-            except (OSError, EOFError) as exc:
-                self._link_failed(exc)
-                break
-            if not data:
-                break
+        while (data := self._read_chunk()) is not None:
             self._take(data)
+
+    def _read_chunk(self):
+        """One read of the bytes waiting on the link; None when none wait, the link failed or a fault holds."""
+        if self.fault is not None or not self.link.wait(0.0):
+            return None
+        try:
+            data = self.link.read()
+        except (OSError, EOFError) as exc:
+            self._link_failed(exc)
+            return None
+        return data or None
 
     def stop_stream(self, timeout=0.2):
         """STOP the stream and wait for the device's STATE (its own counters: late, lost, corrupt); None if none

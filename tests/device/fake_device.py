@@ -24,6 +24,17 @@ INFO = messages.Info(protocol_version=1, firmware_major=0, firmware_minor=1, rat
                      sustained_window_s=1.0, watchdog_ms=2, ramp_ms_min=0)
 
 
+class Recorder:
+    """A stand-in for the loop's controller: records the sensors it is given, answers force = 10 * x."""
+
+    def __init__(self):
+        self.seen = []
+
+    def sample(self, k, sensors, truth, out, est_out):
+        self.seen.append(tuple(sensors))
+        return 10.0 * sensors[0]
+
+
 class FakeDevice:
     def __init__(self, info=INFO, hello=True, reply=None, boot=0.0, noise=b""):
         self.info = info

@@ -9,18 +9,7 @@ import pytest
 from studyapp.device import messages
 from studyapp.device.link_device import SILENCE, LinkDevice
 from studyapp.errors import ParameterError
-from tests.device.fake_device import INFO, FakeDevice
-
-
-class Recorder:
-    """A stand-in for the loop's controller: records the sensors it is given, answers force = 10 * x."""
-
-    def __init__(self):
-        self.seen = []
-
-    def sample(self, k, sensors, truth, out, est_out):
-        self.seen.append(tuple(sensors))
-        return 10.0 * sensors[0]
+from tests.device.fake_device import INFO, FakeDevice, Recorder
 
 
 @pytest.fixture

@@ -15,18 +15,7 @@ import pytest
 from studyapp.device import messages
 from studyapp.device.link_device import LinkDevice
 from studyapp.model.loop import ClosedLoop, LoopConfig
-from tests.device.fake_device import FakeDevice
-
-
-class Recorder:
-    """The loop's controller stand-in: force = 10 * x (nonzero for the rows below)."""
-
-    def __init__(self):
-        self.seen = []
-
-    def sample(self, k, sensors, truth, out, est_out):
-        self.seen.append(tuple(sensors))
-        return 10.0 * sensors[0]
+from tests.device.fake_device import FakeDevice, Recorder
 
 
 @pytest.fixture
