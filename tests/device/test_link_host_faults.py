@@ -7,6 +7,7 @@ then STOP sent, the link still read afterwards, and no force but 0 N to a disarm
 
 import math
 import os
+import threading
 import time
 
 import numpy as np
@@ -99,6 +100,20 @@ def test_a_counter_that_jumps_at_random_is_a_fault_within_a_few_frames(fake, see
     device.close()
 
 
+def _flood(send, every, seconds=0.2):
+    """``send`` every ``every`` s for ``seconds``, on a thread (started; join it)."""
+    stop = time.monotonic() + seconds
+
+    def flood():
+        while time.monotonic() < stop:
+            send()
+            time.sleep(every)
+
+    thread = threading.Thread(target=flood, daemon=True)
+    thread.start()
+    return thread
+
+
 def test_a_frame_of_another_count_than_starts_packet_is_a_named_fault(fake):
     device = _armed(fake, packet=2)
     _stream(fake, device, [0], packet=2)
@@ -116,17 +131,8 @@ def test_a_run_of_corrupt_frames_is_silence(fake):
     _stream(fake, device, [0])
     good = fake.sender.frame(messages.Sensors(sample=1, flags=0, values=(_row(1),)))
     bad = good[:5] + bytes([good[5] ^ 0x40]) + good[6:]
-    stop = time.monotonic() + 0.2
     started = time.monotonic()
-
-    def flood():
-        while time.monotonic() < stop:
-            fake.raw(bad)  # only corrupt frames, every 0.2 ms
-            time.sleep(0.0002)
-
-    import threading
-    thread = threading.Thread(target=flood, daemon=True)
-    thread.start()
+    thread = _flood(lambda: fake.raw(bad), 0.0002)  # only corrupt frames, every 0.2 ms
     device.exchange(Recorder(), 10, None, None)
     took = time.monotonic() - started
     thread.join(1.0)
@@ -140,17 +146,10 @@ def test_a_run_of_corrupt_frames_is_silence(fake):
 def test_a_stream_of_frames_without_samples_is_silence(fake):
     device = _armed(fake)
     _stream(fake, device, [0])
-    stop = time.monotonic() + 0.2
     started = time.monotonic()
-
-    def flood():
-        while time.monotonic() < stop:
-            fake.send(messages.State(armed=1, streaming=1, faults=0, late=0, lost=0, corrupt=0))  # valid, no samples
-            time.sleep(0.0005)
-
-    import threading
-    thread = threading.Thread(target=flood, daemon=True)
-    thread.start()
+    # valid frames, no samples
+    thread = _flood(lambda: fake.send(messages.State(armed=1, streaming=1, faults=0, late=0, lost=0, corrupt=0)),
+                    0.0005)
     device.exchange(Recorder(), 10, None, None)
     took = time.monotonic() - started
     thread.join(1.0)
