@@ -177,6 +177,9 @@ def test_after_a_fault_the_host_keeps_reading_and_sends_no_force(fake):
     device = _armed(fake)
     _stream(fake, device, [10, 11, 5])  # back: a fault
     assert device.fault is not None
+    # the forces sent before the fault reach the fake ahead of the fault's DISARM and STOP (they arrive
+    # asynchronously): count them once those have come
+    assert _disarmed_then_stopped(fake)
     forces_before = len([m for m in fake.received if isinstance(m, messages.Force)])
     # the device streams on (its STOP in flight): 2,000 frames, far more than the pty holds (about 4 kB), written
     # without blocking as the link takes them; the host's blocks, faulted, must keep taking them
