@@ -192,7 +192,12 @@ class LoopLink(LinkDevice):
     def _alive(self, force=False):
         """ALIVE(seen) when the host has read further since the last one (at most every ms unless ``force``),
         and at least every keepalive_ms / 4 even when it has not (a device that paused and then runs its
-        samples fast, as an emulator catching up, must still hear from the host within its watchdog)."""
+        samples fast, as an emulator catching up, must still hear from the host within its watchdog). None before
+        the first TELEMETRY since START: until then the host has no sample of this run to name, and a seen from
+        before it (0 on a new host, the last run's on a restart) would hold a lock-step device behind its own
+        START for good (START fed its watchdog and set its seen)."""
+        if self._counter.fresh:
+            return
         seen = self._newest + 1
         now = time.perf_counter()
         due = now - self._alive_at >= self._alive_period

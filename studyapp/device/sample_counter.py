@@ -55,6 +55,11 @@ class SampleCounter:
         self.newest = -1  # the newest device sample read, unwrapped; -1 before the first frame ever
         self._fresh = True  # no frame read since START yet
 
+    @property
+    def fresh(self):
+        """No frame read since START: the device's counter is not known yet."""
+        return self._fresh
+
     def started(self):
         """START was sent: the next frame may be any distance ahead."""
         self._fresh = True

@@ -8,7 +8,9 @@ applied at their tagged samples in the order received (docs/device-protocol.md,
 further than ALIVE's ``seen`` + START's latency, so the host's CONTROLs are
 never late. ``skew = {sample: ulps}`` moves that sample's loop_force by ``ulps``
 units in the last place (a device whose loop differs); ``drop = {frame index}``
-loses whole TELEMETRY frames (a gap).
+loses whole TELEMETRY frames (a gap); ``first_sample`` is where its counter
+stands when the host opens it (a device that ran for an earlier host). ALIVE
+sets ``seen`` and START sets it to the device's sample, as the C core does.
 """
 
 import os
@@ -50,7 +52,7 @@ def info_for(config, base, image=None):
 
 
 class FakeLoopDevice:
-    def __init__(self, config, base, sensors, skew=None, drop=(), image=None):
+    def __init__(self, config, base, sensors, skew=None, drop=(), image=None, first_sample=0):
         self.info = info_for(config, base, image)
         self.loop = ClosedLoop(config, device=Handle(config.rate, base), judge=False)
         self.sensors = sensors  # (n, 3): x, a, v per sample
@@ -63,8 +65,8 @@ class FakeLoopDevice:
         self.received = []
         self.rows = []  # every row made: (sample, loop force, applied, bridge, control id)
         self.packet = self.latency = None
-        self.seen = 0
-        self.sample = 0
+        self.seen = self.sample = first_sample  # sensors[j] is the row of device sample j
+        self.alives = []  # every ALIVE's seen, in order
         self.frames_made = 0
         self.queue = []  # CONTROLs received, not yet in effect
         self.control_id = 0
@@ -109,9 +111,10 @@ class FakeLoopDevice:
         elif isinstance(message, messages.Ping):
             self.send(messages.Pong(nonce=message.nonce, sample=self.sample))
         elif isinstance(message, messages.Start):
-            self.packet, self.latency = message.packet, message.latency
+            self.packet, self.latency, self.seen = message.packet, message.latency, self.sample
         elif isinstance(message, lm.Alive):
-            self.seen = max(self.seen, message.seen)
+            self.seen = message.seen
+            self.alives.append(message.seen)
         elif isinstance(message, lm.Control):
             self.queue.append(message)
 

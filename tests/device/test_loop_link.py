@@ -187,3 +187,15 @@ def test_the_driver_is_picked_from_info(device_loop):
         device.close()
     finally:
         v1.close()
+
+
+# the CI failure of stop 45: a second host on a device whose counter had run on sent ALIVE(seen=0) before its first
+# TELEMETRY, which held the lock-step device behind its own START for good (silence 1 run in 3)
+def test_no_alive_names_a_sample_before_the_first_telemetry_of_the_run(device_loop):
+    fake = device_loop(sensors=np.concatenate([np.zeros((3000, 3)), _sensors()]), first_sample=3000)
+    link, loop = _open(fake)
+    link.arm(0)
+    _run(loop, 10)
+    assert link.fault is None and loop.fault is None
+    assert fake.alives and min(fake.alives) > 3000, fake.alives[:5]
+    link.close()
