@@ -16,7 +16,7 @@ from studyapp.engine.event_ring import SLOTS
 from studyapp.engine.midi_flood import KNOBS, SENDER
 from studyapp.model.fmax_knob import LIVE_RANGE, fmax_from_knob
 
-pytestmark = pytest.mark.jack
+pytestmark = [pytest.mark.jack, pytest.mark.alone]  # a real-time guarantee: a loaded machine delays the reader
 
 RATE = 5000.0
 FLOOD_RATE = 10_000.0  # control changes per second, the flood
