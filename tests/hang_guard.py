@@ -40,7 +40,12 @@ def pytest_terminal_summary(terminalreporter, config):
     if hasattr(config, "workerinput"):
         return
     for path in sorted(glob.glob(os.path.join(tempfile.gettempdir(), "hung-*.txt"))):
-        if os.path.getmtime(path) >= STARTED:
-            with open(path) as stacks:
-                terminalreporter.write_sep("=", f"a hung test's stacks ({path})")
-                terminalreporter.write(stacks.read())
+        if os.path.getmtime(path) < STARTED:
+            continue
+        with open(path) as stacks:
+            text = stacks.read()
+        # only a file faulthandler wrote stacks into: the header alone is a test still running in another
+        # pytest on the same machine
+        if "\n" in text.rstrip("\n"):
+            terminalreporter.write_sep("=", f"a hung test's stacks ({path})")
+            terminalreporter.write(text)
