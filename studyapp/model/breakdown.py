@@ -148,7 +148,8 @@ def _broken(loop, gesture, duration, fmax, seed):
     level, hiss, pitch = _bowing_measures(block, loop.rate)
     ref_level, ref_hiss, _ = _true_bowing(float(loop.rate), float(loop.string.f0), gesture, float(fmax), total,
                                           int(seed))
-    return (level > stability.RISE * ref_level or stability.over(hiss, ref_hiss, stability.RISE)
+    floors = (stability.band_floor(loop.rate), stability.hiss_floor(loop.rate))
+    return (stability.bowing_over(level, ref_level, hiss, ref_hiss, stability.RISE, floors)
             or not abs(pitch / loop.string.f0 - 1.0) <= stability.PITCH_TOLERANCE)
 
 
