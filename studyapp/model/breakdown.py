@@ -12,8 +12,10 @@ One trial, ``is_broken(source, f)``: the closed loop (loop.py) runs for
   (2.5 kHz up to min(16 kHz, 0.45 x rate), none at 5 kHz), RMS over
   [SETTLE, duration], is more than stability.RISE (6 dB) above TRUE's in the
   same band on the same gesture at the same F_max and seed (TRUE's runs are
-  cached), or if the string's pitch (the largest spectral peak of the string's
-  velocity at the bow above 100 Hz, over the same span) is more than
+  cached) and above the band's perception floor (stability.band_floor,
+  stability.hiss_floor: what a person could feel or hear), or if the
+  string's pitch (the largest spectral peak of the string's velocity at the
+  bow above 100 Hz, over the same span) is more than
   stability.PITCH_TOLERANCE off f0. docs/model.md justifies it.
 - Holding (``hold``): broken if the loop faults or the stability monitor's hold
   criterion flags breakdown once its SETTLE = 0.25 s window has filled

@@ -69,12 +69,26 @@ scale > 0) False means not broken, whatever the band holds: a pointer's jerky
 bowing fills the band at F_max 0 (its target jumps at each mouse event, tens
 of times a second) and was called "broken" there (issue 31).
 
+Perception floors (issue 42). A band counts only above the least level a
+person could perceive in it, whatever TRUE's level there:
+
+    broken  =  (band > RISE * reference  and  band > band_floor(rate))
+               or  (upper band > RISE * upper reference  and  upper band > hiss_floor(rate))
+
+band_floor: the lower of the grasp's vibrotactile threshold and the hearing
+threshold through the contact microphone; hiss_floor: the hearing one only
+(perception_floors.py has the tables, their sources and the conversions).
+They lie 40-80 dB below TRUE's levels in this world, so they decide only
+where a reference vanishes. ``bowing_over`` is the one decision the monitor
+and a breakdown trial both make.
+
 Hysteresis. A verdict changes only when the evidence is clear, so a level
 hovering at the threshold does not flip it back and forth within a trial:
 broken is entered at the thresholds above and left only below lower ones,
 
     bowing:   enter  band > RISE x reference,          leave  band < RELEASE x reference,  RELEASE = sqrt(2) (3 dB)
-              (and the same for the upper band: broken while either band is above RELEASE x its reference)
+              (and the same for the upper band: broken while either band is above RELEASE x its reference;
+              the floors hold for leaving as for entering)
     holding:  enter  level > VIBRATION_MIN, cv < CV_MAX,  leave  level < VIBRATION_MIN or cv > CV_RELEASE = 0.25
 
 A breakdown's onset is judged exactly as before (``studyapp breakdown`` and
