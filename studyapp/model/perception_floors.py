@@ -23,7 +23,10 @@ Am. 84:1680, the four-channel model) put that minimum at about -20 dB re 1 um
 peak, 0.1 um (PACINIAN_MIN_UM). A handle is grasped, not touched by a probe:
 Brisben, Hsiao & Johnson (1999, J. Neurophysiol. 81:1548) found thresholds
 through a grasped cylinder 18.5 dB lower at 300 Hz (GRASP_DB) than through a
-probe, some subjects below 0.01 um. The floor takes the grasped minimum,
+1 mm probe vibrating perpendicular to the skin, some subjects below 0.01 um.
+Taken off the large contactor's minimum (whose threshold is already below a
+1 mm probe's) the correction errs low, as a floor should; the result sits
+among Brisben's lowest subjects. The floor takes that grasped minimum,
 
     d_min = 0.1 um x 10^(-18.5 / 20) = 0.0119 um peak,
 
@@ -59,9 +62,10 @@ below, 20 Hz-12.5 kHz). So
     heard(f)    = 10^((T(f) - FULL_SCALE_SPL_DB) / 20) / (STIMULUS_GAIN x GAIN x 2 pi f x |H60(f)|)
     heard(band) = min over THRESHOLD's frequencies f in the band of heard(f)
 
-(the band's most sensitive frequency, as for touch). Above 12.5 kHz, ISO
-389-7:2005 gives thresholds that rise steeply (tens of dB by 16 kHz), faster
-than 2 pi f, so the minimum lies within the table for every band.
+(the band's most sensitive frequency, as for touch). From 12.5 to 16 kHz the
+threshold rises by a further 16-28 dB (ISO 389-5:2006's earphone thresholds,
+ER-2A and HDA 200), far more than 2 pi f's 2 dB there, so the minimum lies
+within the table for every band.
 
 The listening level. The app sets no absolute level: the headphone level check
 plays a tone as loud as the bowed string's typical RMS (stimulus_level.py,
