@@ -6,6 +6,7 @@ because its upper band held 0.005 mm/s against TRUE's 0.002.
 """
 
 import math
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -14,10 +15,13 @@ from hypothesis import given, settings, strategies as st
 from scipy import signal
 
 from studyapp.estimators.at_rate import table1
+from studyapp.experiment import level_check
+from studyapp.experiment.protocol import load_protocol
 from studyapp.model import breakdown, contact_mic, perception_floors as pf, stability
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.stimulus_level import STIMULUS_GAIN
 
+ROOT = Path(__file__).resolve().parents[2]
 RATES = (1000.0, 5000.0, 6000.0, 22050.0, 48000.0, 96000.0)
 # ISO 226:2003 Table 1, T_f (dB SPL), typed from the standard
 ISO_226 = {20: 78.5, 31.5: 59.5, 50: 44.0, 100: 26.5, 250: 11.4, 400: 6.2, 1000: 2.4, 2000: -1.3, 2500: -4.2,
@@ -121,3 +125,10 @@ def test_levants_hiss_at_48_khz_is_far_above_its_heard_floor():
     hiss = stability.hiss_level(block["velocity_true"], rate, int(0.25 * rate))
     assert 2e-6 < hiss < 2e-5
     assert 20 * math.log10(hiss / stability.hiss_floor(rate)) > 40.0
+
+
+def test_the_listening_anchor_is_the_level_checks_tone():
+    """The floors' one copied figure, sinclair2014's level check tone, against the model that computes it."""
+    rms, fmax, task = level_check.stimulus_rms_dbfs(load_protocol(ROOT / "protocols" / "sinclair2014.toml"))
+    assert (fmax, task) == (1.0, "rating")
+    assert pf.TONE_RMS_DBFS == pytest.approx(rms, abs=0.3)
