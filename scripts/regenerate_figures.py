@@ -116,6 +116,8 @@ GENERATORS_AFTER_BREAKDOWN = (
               {"breakdown_strokes_lowpass.png": "docs/breakdown_strokes_lowpass.png"}),
     Generator("string-pitch", "docs/model.md (Pitch / f0 at 1 and 5 kHz)",
               ((PY, "scripts/string_pitch.py", "--rates", "1000", "5000"),)),
+    Generator("hiss-heard", "docs/model.md (Perception floors: the upper band on the handle and in the sound)",
+              ((PY, "scripts/hiss_heard.py", "--fmax", "0.05,0.1,0.2,0.5,1,2,3"),)),
     Generator("link-delay", "docs/devices.md (the link's delay tables), link_delay.png, link_delay_table.csv",
               ((PY, "scripts/link_delay_table.py", "--seeds", "5", "--rows", "latency,packet", "--out", "{out}"),),
               {"link_delay_table.csv": "docs/link_delay_table.csv", "link_delay.png": "docs/link_delay.png"}),

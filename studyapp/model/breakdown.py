@@ -12,8 +12,10 @@ One trial, ``is_broken(source, f)``: the closed loop (loop.py) runs for
   (2.5 kHz up to min(16 kHz, 0.45 x rate), none at 5 kHz), RMS over
   [SETTLE, duration], is more than stability.RISE (6 dB) above TRUE's in the
   same band on the same gesture at the same F_max and seed (TRUE's runs are
-  cached), or if the string's pitch (the largest spectral peak of the string's
-  velocity at the bow above 100 Hz, over the same span) is more than
+  cached) and above the band's perception floor (stability.band_floor,
+  stability.hiss_floor: what a person could feel or hear), or if the
+  string's pitch (the largest spectral peak of the string's velocity at the
+  bow above 100 Hz, over the same span) is more than
   stability.PITCH_TOLERANCE off f0. docs/model.md justifies it.
 - Holding (``hold``): broken if the loop faults or the stability monitor's hold
   criterion flags breakdown once its SETTLE = 0.25 s window has filled
@@ -148,7 +150,8 @@ def _broken(loop, gesture, duration, fmax, seed):
     level, hiss, pitch = _bowing_measures(block, loop.rate)
     ref_level, ref_hiss, _ = _true_bowing(float(loop.rate), float(loop.string.f0), gesture, float(fmax), total,
                                           int(seed))
-    return (level > stability.RISE * ref_level or stability.over(hiss, ref_hiss, stability.RISE)
+    floors = (stability.band_floor(loop.rate), stability.hiss_floor(loop.rate))
+    return (stability.bowing_over(level, ref_level, hiss, ref_hiss, stability.RISE, floors)
             or not abs(pitch / loop.string.f0 - 1.0) <= stability.PITCH_TOLERANCE)
 
 

@@ -69,12 +69,26 @@ scale > 0) False means not broken, whatever the band holds: a pointer's jerky
 bowing fills the band at F_max 0 (its target jumps at each mouse event, tens
 of times a second) and was called "broken" there (issue 31).
 
+Perception floors (issue 42). A band counts only above the least level a
+person could perceive in it, whatever TRUE's level there:
+
+    broken  =  (band > RISE * reference  and  band > band_floor(rate))
+               or  (upper band > RISE * upper reference  and  upper band > hiss_floor(rate))
+
+band_floor: the lower of the grasp's vibrotactile threshold and the hearing
+threshold through the contact microphone; hiss_floor: the hearing one only
+(perception_floors.py has the tables, their sources and the conversions).
+They lie 40-80 dB below TRUE's levels in this world, so they decide only
+where a reference vanishes. ``bowing_over`` is the one decision the monitor
+and a breakdown trial both make.
+
 Hysteresis. A verdict changes only when the evidence is clear, so a level
 hovering at the threshold does not flip it back and forth within a trial:
 broken is entered at the thresholds above and left only below lower ones,
 
     bowing:   enter  band > RISE x reference,          leave  band < RELEASE x reference,  RELEASE = sqrt(2) (3 dB)
-              (and the same for the upper band: broken while either band is above RELEASE x its reference)
+              (and the same for the upper band: broken while either band is above RELEASE x its reference;
+              the floors hold for leaving as for entering)
     holding:  enter  level > VIBRATION_MIN, cv < CV_MAX,  leave  level < VIBRATION_MIN or cv > CV_RELEASE = 0.25
 
 A breakdown's onset is judged exactly as before (``studyapp breakdown`` and
@@ -89,7 +103,7 @@ from numba import njit
 
 from studyapp.estimators.biquad import filter_from_rest, section_from_sos
 from studyapp.estimators.butterworth import sos_row, sos_rows
-from studyapp.model import calibration
+from studyapp.model import calibration, perception_floors
 from studyapp.model.sensors import section_at
 
 BAND = (50.0, 400.0)  # Hz, the bowing verdict's band
@@ -161,9 +175,27 @@ def _rms(y):
     return float(np.sqrt(np.mean(y * y))) if y.size else 0.0
 
 
-def over(level, reference, factor):
-    """Whether a band's ``level`` is above ``factor`` x TRUE's ``reference`` (no reference, no upper band: False)."""
-    return reference is not None and level is not None and level > factor * reference
+def band_floor(rate):
+    """The bowing band's perception floor (m/s RMS) at ``rate``: felt or heard (perception_floors.py)."""
+    return perception_floors.floor((BAND[0], min(BAND[1], 0.45 * rate)))
+
+
+def hiss_floor(rate):
+    """The upper band's perception floor (m/s RMS) at ``rate``: heard only; None where the rate has no upper band."""
+    band = hiss_band(rate)
+    return None if band is None else perception_floors.floor(band, felt=False)
+
+
+def over(level, reference, factor, floor=0.0):
+    """Whether a band's ``level`` is above ``factor`` x TRUE's ``reference`` and above the band's perception
+    ``floor`` (no reference, no upper band: False)."""
+    return reference is not None and level is not None and level > factor * reference and level > floor
+
+
+def bowing_over(band, reference, hiss, hiss_reference, factor, floors):
+    """Whether either band is over ``factor`` x TRUE's level in it and over its floor; ``floors`` =
+    (band_floor(rate), hiss_floor(rate)). The monitor (``judge``) and a breakdown trial both decide with it."""
+    return over(band, reference, factor, floors[0]) or over(hiss, hiss_reference, factor, floors[1] or 0.0)
 
 
 @njit(cache=True, inline="always")
@@ -227,6 +259,7 @@ class StabilityMonitor:
         hiss = hiss_sos(rate)
         if hiss is not None:  # else its sections stay 0: the kernel's upper band then reads 0
             self._set_sections(MP_HISS, hiss)
+        self.floors = (band_floor(rate), hiss_floor(rate))
         self.state = np.zeros(N_STATE)
         self.reference = reference
         self.hiss_reference = None
@@ -265,8 +298,8 @@ class StabilityMonitor:
         else:
             reference = self.reference()
             hiss = None if self.hiss_reference is None else self.hiss_reference()
-            enter = self.band > RISE * reference or over(self.hiss, hiss, RISE)
-            stay = self.band >= RELEASE * reference or over(self.hiss, hiss, RELEASE)
+            enter = bowing_over(self.band, reference, self.hiss, hiss, RISE, self.floors)
+            stay = bowing_over(self.band, reference, self.hiss, hiss, RELEASE, self.floors)
             self.broken = bool(enter or (self.broken and stay))
         return self.broken
 
