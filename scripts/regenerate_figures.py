@@ -207,11 +207,11 @@ def check_pilot(gen, folder):
 
 def check_study(gen, folder):
     with open(folder / "results" / "findings.csv", newline="") as f:
-        new = list(csv.reader(f))[1:]
+        new = list(csv.DictReader(f))
     with open(ROOT / "docs" / "study" / "findings.csv", newline="") as f:
-        quoted = list(csv.reader(f))[1:]
-    return [f"finding {a[0]!r}: {a[-1]} against the quoted {b[-1]}" for a, b in zip(new, quoted)
-            if a[-1] != b[-1] and a[0] not in qf.FLIPPING_FINDINGS]
+        quoted = list(csv.DictReader(f))
+    return [f"finding {a['finding']!r}: {a['verdict']} against the quoted {b['verdict']}" for a, b in zip(new, quoted)
+            if a["verdict"] != b["verdict"] and a["finding"] not in qf.FLIPPING_FINDINGS]
 
 
 def check_of(gen):
