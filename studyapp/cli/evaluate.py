@@ -6,8 +6,10 @@ Fig. 5-style box plots (a: F_max 0-7.7 N, b: 2.2-12.1 N); and with
 ``--validation DIR`` the Sec. 7.3 comparison on an independent set. With
 ``--perceptual``, each estimator's ``audio_distance`` (the string's sound with
 it in the loop against TRUE's, paper Sec. 10; cli/perceptual_options.py); with
-``--compare-paper`` our Table 1 and findings beside the paper's
-(``evaluation/paper_comparison.py``).
+``--compare-paper`` our Table 1 and findings beside the paper's, each finding
+under the paper's Table 1 and under ``--params`` side by side
+(``evaluation/paper_comparison.py``). Without ``--params`` the estimators
+run with Table 1 made for the recordings' rate (``estimators/at_rate.py``).
 """
 
 from studyapp.cli import delay_option, output_paths, perceptual_options
@@ -39,7 +41,8 @@ def register(sub):
                         "(audio_distance, perceptual.png)")
     perceptual_options.add_options(p, "--perceptual")
     p.add_argument("--compare-paper", action="store_true",
-                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv to -o DIR; with "
+                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv (each finding under "
+                        "Table 1 and under --params side by side, and how many hold under each) to -o DIR; with "
                         "several --params files also their spread over the files: paper_comparison_seeds.csv, "
                         "metrics_seeds.csv and findings_seeds.csv")
     p.set_defaults(func=run)
