@@ -129,6 +129,11 @@ GENERATORS_AFTER_BREAKDOWN = (
               ((PY, "scripts/device_panel_screenshot.py", "{out}/console-device.png"),),
               {"console-device.png": "docs/console-device.png"}, {"QT_QPA_PLATFORM": "offscreen"}),
     STUDY,
+    Generator("lowpass-sweep", "docs/evaluation.md (Why LOWPASS lands near 528 Hz), docs/lowpass_sweep.png",
+              (("studyapp", "simulate-set", "-o", "{out}/data/train"),
+               (PY, "scripts/lowpass_sweep.py", "{out}/data/train", "--params", "docs/study/params.toml",
+                "-o", "{out}/lowpass_sweep.png")),
+              {"lowpass_sweep.png": "docs/lowpass_sweep.png"}),
     Generator("kalman-conventions", "docs/estimators-kalman.md (Table 1's Kalman filters under each q convention)",
               (("studyapp", "simulate-set", "-o", "{out}/sim"), (PY, "scripts/kalman_conventions.py", "{out}/sim"))),
     Generator("pilot", "docs/experiment.md (The simulated participant: the in-silico pilot), docs/study/pilot.csv",
@@ -209,11 +214,11 @@ def check_pilot(gen, folder):
 
 def check_study(gen, folder):
     with open(folder / "results" / "findings.csv", newline="") as f:
-        new = list(csv.reader(f))[1:]
+        new = list(csv.DictReader(f))
     with open(ROOT / "docs" / "study" / "findings.csv", newline="") as f:
-        quoted = list(csv.reader(f))[1:]
-    return [f"finding {a[0]!r}: {a[-1]} against the quoted {b[-1]}" for a, b in zip(new, quoted)
-            if a[-1] != b[-1] and a[0] not in qf.FLIPPING_FINDINGS]
+        quoted = list(csv.DictReader(f))
+    return [f"finding {a['finding']!r}: {a['verdict']} against the quoted {b['verdict']}" for a, b in zip(new, quoted)
+            if a["verdict"] != b["verdict"] and a["finding"] not in qf.FLIPPING_FINDINGS]
 
 
 def check_of(gen):

@@ -6,8 +6,10 @@ Fig. 5-style box plots (a: F_max 0-7.7 N, b: 2.2-12.1 N); and with
 ``--validation DIR`` the Sec. 7.3 comparison on an independent set. With
 ``--perceptual``, each estimator's ``audio_distance`` (the string's sound with
 it in the loop against TRUE's, paper Sec. 10; cli/perceptual_options.py); with
-``--compare-paper`` our Table 1 and findings beside the paper's
-(``evaluation/paper_comparison.py``).
+``--compare-paper`` our Table 1 and findings beside the paper's, each finding
+under the paper's Table 1 and under ``--params`` side by side
+(``evaluation/paper_comparison.py``). Without ``--params`` the estimators
+run with Table 1 made for the recordings' rate (``estimators/at_rate.py``).
 """
 
 from studyapp.cli import delay_option, output_paths, perceptual_options
@@ -39,7 +41,8 @@ def register(sub):
                         "(audio_distance, perceptual.png)")
     perceptual_options.add_options(p, "--perceptual")
     p.add_argument("--compare-paper", action="store_true",
-                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv to -o DIR; with "
+                   help="also write paper_comparison.csv (Table 1 beside ours) and findings.csv (each finding under "
+                        "Table 1 and under --params side by side, and how many hold under each) to -o DIR; with "
                         "several --params files also their spread over the files: paper_comparison_seeds.csv, "
                         "metrics_seeds.csv and findings_seeds.csv")
     p.set_defaults(func=run)
@@ -67,7 +70,7 @@ def run(args):
     args.params = params_files[0]
     takes = load_takes(expand_paths(args.recordings), args.reference)
     unavailable = {}
-    params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes), unavailable)
+    params, _ = parameter_sets(args.params, args.estimators, min(t.rate for t in takes), unavailable, for_rate=True)
     others = [parameter_sets(path, args.estimators, min(t.rate for t in takes)) for path in params_files[1:]]
     for name, reason in unavailable.items():
         print(f"studyapp evaluate: {name} skipped, {reason}", file=sys.stderr)
@@ -99,6 +102,12 @@ def run(args):
         validation = (summary, rows)
         document["validation"] = summary
     perceptual = None if cases is None else perceptual_options.add_to_evaluation(cases, result, document)
+    findings = None
+    if args.compare_paper:
+        findings = _findings_of_both_sets(args, takes, other, params, result, validation[0] if validation else None)
+        from studyapp.evaluation.paper_comparison import counts
+
+        document["findings"] = {**counts(findings), "rows": findings}
     over_seeds = None
     if args.compare_paper and others:
         over_seeds = _study_over_seeds(args, takes, other, dict(zip(names, [params] + [o[0] for o in others])),
@@ -115,7 +124,7 @@ def run(args):
     if args.compare_paper:
         from studyapp.evaluation import paper_comparison
 
-        paper_comparison.write(output, result, [t.position for t in takes], validation[0] if validation else None)
+        paper_comparison.write(output, result, findings)
         if over_seeds is not None:
             from studyapp.evaluation.tables import write_csv
 
@@ -128,6 +137,8 @@ def run(args):
         _print_table(result, validation)
         if perceptual is not None:
             perceptual_options.print_table(perceptual, result.names)
+        if findings is not None:
+            _print_findings(findings, args.params)
         if over_seeds is not None:
             print("findings over the parameter files (holds / fails on every one, else undecided):")
             for row in over_seeds["findings"]:
@@ -144,6 +155,57 @@ def run(args):
                     f" E apart {row['error_spread_pct']:.1f} %")
                 print(f"  {row['estimator']:<11} {cells}  spread {pct}{apart}")
     return 0
+
+
+def _findings_of_both_sets(args, takes, validation_takes, params, result, summary):
+    """findings.csv's rows: the evaluated set's findings and, with --params, Table 1's beside them (issue 42).
+
+    Table 1 is made for the recordings' rate, as ``evaluate`` without ``--params`` runs it, for the same
+    estimators, on the same recordings (and the same validation recordings).
+    """
+    import sys
+
+    from studyapp.errors import UserError
+    from studyapp.evaluation import paper_comparison
+    from studyapp.evaluation.dataset import Dataset
+    from studyapp.evaluation.parameter_sets import parameter_sets
+    from studyapp.evaluation.report import evaluate
+    from studyapp.evaluation.validation import compare
+
+    positions = [t.position for t in takes]
+    own = paper_comparison.finding_rows(result, positions, summary)
+    if args.params is None:
+        return paper_comparison.both_sets(own)
+    unavailable = {}
+    try:
+        table1, _ = parameter_sets(None, [",".join(params)], min(t.rate for t in takes), unavailable, for_rate=True)
+    except UserError as exc:  # Table 1 cannot exist at this rate for any of these estimators: the tuned set alone
+        print(f"studyapp evaluate: --compare-paper: no finding under Table 1, {exc}", file=sys.stderr)
+        return paper_comparison.both_sets([], own)
+    for name, reason in unavailable.items():
+        print(f"studyapp evaluate: {name} skipped under Table 1, {reason}", file=sys.stderr)
+    paper = evaluate(Dataset(takes, args.max_lag, delay_method=args.delay), table1)
+    paper_summary = None
+    if validation_takes is not None:
+        paper_summary, _ = compare(paper, evaluate(Dataset(validation_takes, args.max_lag,
+                                                           delay_method=args.delay), table1))
+    return paper_comparison.both_sets(paper_comparison.finding_rows(paper, positions, paper_summary), own)
+
+
+def _print_findings(rows, params_path):
+    from studyapp.evaluation.paper_comparison import counts as count
+
+    counts = count(rows)
+    table1 = (f"{counts['holds_table1']} of {counts['judged_table1']} hold with the paper's Table 1"
+              if counts["holds_table1"] is not None else "none judged with the paper's Table 1")
+    if counts["holds_tuned"] is None:
+        print(f"findings (findings.csv): {table1}; one parameter set (no --params): nothing tuned beside it")
+    else:
+        print(f"findings (findings.csv): {table1}, {counts['holds_tuned']} of {counts['judged_tuned']} "
+              f"with the tuned parameters ({params_path})")
+    for row in rows:
+        tuned = "" if row.get("verdict_tuned") is None else f"  tuned {row['verdict_tuned']:<16}"
+        print(f"  Table 1 {row.get('verdict_table1') or '-':<16}{tuned}  {row['finding']}")
 
 
 def _study_over_seeds(args, takes, validation_takes, sets, first, first_validation):

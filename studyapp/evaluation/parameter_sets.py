@@ -1,7 +1,10 @@
 """Which estimators to run, with which parameters: from PARAMS.toml, --estimators, or Table 1.
 
 Without a parameter file the paper's thirteen estimators run with their
-defaults (the paper's Table 1). With one, its estimators run with its values;
+defaults (the paper's Table 1); with ``for_rate`` Table 1 is made for the
+rate as breakdown and tradeoff make it (``estimators/at_rate.py``: counts in
+samples keep their duration; at Table 1's 5 kHz nothing changes): ``evaluate``
+runs it so, and sets it beside a tuned file with ``--compare-paper``. With one, its estimators run with its values;
 ``--estimators`` picks a subset (or adds estimators, with their defaults).
 Every value is checked against the estimator's spec here, so a bad file fails
 before any work with one line naming the file, table and parameter.
@@ -14,15 +17,17 @@ caller can report it and go on.
 """
 
 from studyapp.errors import ParameterError, UserError
+from studyapp.estimators.at_rate import table1
 from studyapp.estimators.registry import spec
 from studyapp.evaluation import params_file
 from studyapp.evaluation.dataset import estimator_names
 from studyapp.evaluation.space import PAPER_ESTIMATORS
 
 
-def parameter_sets(params_path=None, estimators=None, rate=None, unavailable=None):
+def parameter_sets(params_path=None, estimators=None, rate=None, unavailable=None, for_rate=False):
     """name -> parameters (validated at ``rate``), and the file's provenance (or {}).
 
+    ``for_rate``: without a file, Table 1 made for ``rate`` (``at_rate.table1``), not its values as printed.
     ``unavailable``: a dict to receive name -> reason for the estimators whose
     parameters cannot exist at ``rate`` (else those raise like any bad value).
     """
@@ -32,7 +37,7 @@ def parameter_sets(params_path=None, estimators=None, rate=None, unavailable=Non
     at = rate if rate is not None else 5000.0
     chosen = {}
     for name in names:
-        given = loaded.get(name, {})
+        given = table1(name, at) if for_rate and params_path is None else loaded.get(name, {})
         where = f"{params_path}: [{name}] " if params_path is not None else ""
         try:
             reason = None if unavailable is None else spec(name).not_available(at, given)
