@@ -33,8 +33,9 @@ round-trip gain of rho = 0.98 only: 20 f0 / (1 - beta) log10(0.98) = -127 dB/s
 at f0 440 Hz, slower than the whole string's own decay
 20 f0 log10(loss) = -196 dB/s, and a bowed string cannot do that: a bow held
 on it adds a loss, never removes one. Between strokes the participant heard
-it as a second pitch 11-16 dB below the note (docs/model.md, "The string
-between strokes"). So each segment keeps its share:
+it as a second pitch, 12 dB under the note at 2 N and, fed by the haptic
+loop, growing above it from 5 N (docs/model.md, "The string between
+strokes"). So each segment keeps its share:
 
     g_n = loss^(1 - beta)                      nut reflection (a gain: no phase, the pitch is unchanged)
     L(z) = loss^beta (1 - p) / (1 - p z^-1)    bridge reflection
