@@ -59,7 +59,7 @@ static void string_step(sl_loop *L, double v_bow, int bowing, double *u_out, dou
     double bridge_refl, nut_refl, v_h, vd, u = 0.0;
     s[SL_S_LOSS_Y] = y;
     bridge_refl = -y;
-    nut_refl = -read_line(L->nut, n, write, p[SL_P_DN]);
+    nut_refl = -p[SL_P_NUT_GAIN] * read_line(L->nut, n, write, p[SL_P_DN]);
     v_h = bridge_refl + nut_refl;
     vd = v_bow - v_h;
     if (bowing) u = friction(vd, p[SL_P_SLOPE], p[SL_P_OFFSET], p[SL_P_PEAK]);
@@ -196,7 +196,8 @@ static const int32_t LAYOUT[SL_N_LAYOUT] = {
     SL_L_FAULT, SL_L_FAULT_SAMPLE, SL_N_LOOP_STATE,
     SL_FAULT_SENSOR, SL_FAULT_ESTIMATE, SL_FAULT_STRING, SL_FAULT_FORCE,
     SL_SOURCE_LVT_SENSOR,
-    SL_P_DB, SL_P_DN, SL_P_LOSS_B0, SL_P_LOSS_A1, SL_P_SLOPE, SL_P_OFFSET, SL_P_PEAK, SL_N_STRING_PARAMS,
+    SL_P_DB, SL_P_DN, SL_P_LOSS_B0, SL_P_LOSS_A1, SL_P_SLOPE, SL_P_OFFSET, SL_P_PEAK, SL_P_NUT_GAIN,
+    SL_N_STRING_PARAMS,
     SL_S_WRITE, SL_S_LOSS_Y, SL_N_STRING_STATE,
     SL_LP_IMPULSIVE, SL_LP_SUSTAINED, SL_LP_RMS_ALPHA, SL_N_LIMIT_PARAMS,
     SL_LS_MS, SL_N_LIMIT_STATE,

@@ -55,7 +55,8 @@ enum { SL_FAULT_SENSOR = 1, SL_FAULT_ESTIMATE = 2, SL_FAULT_STRING = 3, SL_FAULT
 /* the LVT sensor as the source: studyapp/model/sources.py LVT_SENSOR_INDEX */
 #define SL_SOURCE_LVT_SENSOR (-2)
 /* string parameters and state: bowed_string.py P_*, S_* */
-enum { SL_P_DB, SL_P_DN, SL_P_LOSS_B0, SL_P_LOSS_A1, SL_P_SLOPE, SL_P_OFFSET, SL_P_PEAK, SL_N_STRING_PARAMS };
+enum { SL_P_DB, SL_P_DN, SL_P_LOSS_B0, SL_P_LOSS_A1, SL_P_SLOPE, SL_P_OFFSET, SL_P_PEAK, SL_P_NUT_GAIN,
+       SL_N_STRING_PARAMS };
 enum { SL_S_WRITE, SL_S_LOSS_Y, SL_N_STRING_STATE };
 /* motor limits: device.py LP_*, LS_* */
 enum { SL_LP_IMPULSIVE, SL_LP_SUSTAINED, SL_LP_RMS_ALPHA, SL_N_LIMIT_PARAMS };
@@ -117,7 +118,7 @@ void sl_reset(sl_loop *L);
 
 /* the layout constants above (in the order of studyapp_loop.c's table), for a binding to check against
  * its own: writes SL_N_LAYOUT int32s */
-#define SL_N_LAYOUT 36
+#define SL_N_LAYOUT 37
 void sl_layout(int32_t *out);
 
 #endif

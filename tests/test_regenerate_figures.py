@@ -129,6 +129,6 @@ def test_check_finds_the_docs_table_by_its_settings_not_its_spelling(tmp_path):
     (tmp_path / "x.md").write_text(spelled + "\n")
     gen = rf.Generator("breakdown-hold", "docs/breakdown.md", (("studyapp", "breakdown", "-o", "{out}/x.md"),))
     assert rf.check_breakdown(gen, tmp_path) == []
-    (tmp_path / "x.md").write_text(spelled.replace("| LVT | 5000 | hold | 5 | 5.81", "| LVT | 5000 | hold | 5 | 6.5")
-                                   .replace("5.81; 5.81; 5.81; 5.81; 5.81", "6.5; 5.81; 5.81; 5.81; 5.81") + "\n")
+    (tmp_path / "x.md").write_text(spelled.replace("| LVT | 5000 | hold | 5 | 6.72", "| LVT | 5000 | hold | 5 | 7.5")
+                                   .replace("6.72; 6.72; 6.72; 6.72; 6.72", "7.5; 6.72; 6.72; 6.72; 6.72") + "\n")
     assert [p.split(":")[0] for p in rf.check_breakdown(gen, tmp_path)] == ["LVT seed 0"]

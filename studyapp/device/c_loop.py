@@ -45,7 +45,7 @@ LAYOUT = (
     control.FAULT_SENSOR, control.FAULT_ESTIMATE, control.FAULT_STRING, control.FAULT_FORCE,
     LVT_SENSOR_INDEX,
     bowed_string.P_DB, bowed_string.P_DN, bowed_string.P_LOSS_B0, bowed_string.P_LOSS_A1, bowed_string.P_SLOPE,
-    bowed_string.P_OFFSET, bowed_string.P_PEAK, bowed_string.N_PARAMS,
+    bowed_string.P_OFFSET, bowed_string.P_PEAK, bowed_string.P_NUT_GAIN, bowed_string.N_PARAMS,
     bowed_string.S_WRITE, bowed_string.S_LOSS_Y, bowed_string.N_STATE,
     device.LP_IMPULSIVE, device.LP_SUSTAINED, device.LP_RMS_ALPHA, device.N_LIMIT_PARAMS,
     device.LS_MS, device.N_LIMIT_STATE,

@@ -3,16 +3,48 @@
 Two delay lines meet at the bow: the bridge side (a fraction ``beta`` of the
 loop) and the nut side (``1 - beta``). Each sample
 
-    v_h      = -L(bridge line out) - (nut line out)   incoming waves at the bow
+    v_h      = -L(bridge line out) - g_n (nut line out)   incoming waves at the bow
     v_delta  = v_bow - v_h
     u        = rho(v_delta) * v_delta, |u| <= max|rho v| (bow_table.py; 0 when the bow is lifted)
     nut line   <- -L(bridge line out) + u
-    bridge line <- -(nut line out) + u
+    bridge line <- -g_n (nut line out) + u
 
-with both ends inverting reflections and the string's losses lumped into the
-bridge reflection L. The string velocity at the bow is v_h + u; the wave
-arriving at the bridge drives the body filter (body.py) for the audio. The
-string-on-bow force is F = -G u (bow_table.py derives G from F_max, eqs. 2, 20).
+with both ends inverting reflections. The string velocity at the bow is
+v_h + u; the wave arriving at the bridge drives the body filter (body.py) for
+the audio. The string-on-bow force is F = -G u (bow_table.py derives G from
+F_max, eqs. 2, 20).
+
+The losses, shared by the two segments (issue 42, item 7). A string loses
+energy all along its length (internal friction, air), so a wave's DC gain
+over a path is loss^(path / round trip). STK lumps the whole round trip's
+``loss`` into the bridge filter L, which is exact only while the string is
+linear: filters commute through the delay lines, and "nut-side losses may be
+moved to the bridge side as an additional approximation step" (J. O. Smith,
+"Virtual acoustic musical instruments: review and update", J. New Music
+Research 33(3), 2004, Sec. "Bowed strings"; Serafin's bowed string keeps a
+filter on the nut side: S. Serafin, "The sound of friction", PhD thesis,
+Stanford 2004). The bow junction is not linear: while the bow sticks it
+reflects -rho = -0.98 of each incoming wave and passes 1 - rho = 0.02, so it
+splits the loop in two (McIntyre, Schumacher and Woodhouse, "On the
+oscillations of musical instruments", JASA 74(5), 1983, give each
+termination of the bowed string its own lossy reflection function). With all
+the loss at the bridge the nut segment then rings at f0 / (1 - beta) with a
+round-trip gain of rho = 0.98 only: 20 f0 / (1 - beta) log10(0.98) = -127 dB/s
+at f0 440 Hz, slower than the whole string's own decay
+20 f0 log10(loss) = -196 dB/s, and a bowed string cannot do that: a bow held
+on it adds a loss, never removes one. Between strokes the participant heard
+it as a second pitch, 12 dB under the note at 2 N and, fed by the haptic
+loop, growing above it from 5 N (docs/model.md, "The string between
+strokes"). So each segment keeps its share:
+
+    g_n = loss^(1 - beta)                      nut reflection (a gain: no phase, the pitch is unchanged)
+    L(z) = loss^beta (1 - p) / (1 - p z^-1)    bridge reflection
+
+The free string's round trip g_n L(z) is STK's loss (1 - p) / (1 - p z^-1)
+exactly (bit for bit it is not: the product is rounded in two places), and a
+pinned nut segment decays at 20 f0 / (1 - beta) log10(rho g_n)
+= -196 - 127 = -323 dB/s: the string's own loss plus the bow's.
+``nut_loss=False`` gives STK's lumped form (for the figures that compare).
 
 What is derived from the sample rate, and why:
 
@@ -43,8 +75,8 @@ from numba import njit
 from studyapp.model import bow_table, calibration
 
 # parameter vector layout
-P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET, P_PEAK = range(7)
-N_PARAMS = 7
+P_DB, P_DN, P_LOSS_B0, P_LOSS_A1, P_SLOPE, P_OFFSET, P_PEAK, P_NUT_GAIN = range(8)
+N_PARAMS = 8
 # state vector layout
 S_WRITE, S_LOSS_Y = range(2)
 N_STATE = 2
@@ -63,6 +95,7 @@ class StringDesign:
     offset: float = 0.0
     loss: float = 0.95  # STK stringFilter_ gain: the round trip's DC gain
     f_loss: float = 2100.0  # Hz, STK's loss corner at its design rate 22.05 kHz
+    nut_loss: bool = True  # the nut segment keeps its share loss^(1 - beta) (docstring); False: STK's lumped form
 
     def __post_init__(self):
         if not (0.0 < self.beta < 1.0):
@@ -94,7 +127,9 @@ class StringDesign:
         p = self.pole
         out = np.zeros(N_PARAMS)
         out[P_DB], out[P_DN] = db, dn
-        out[P_LOSS_B0] = self.loss * (1.0 - p)
+        nut_share = (1.0 - self.beta) if self.nut_loss else 0.0
+        out[P_LOSS_B0] = self.loss ** (1.0 - nut_share) * (1.0 - p)
+        out[P_NUT_GAIN] = self.loss ** nut_share
         out[P_LOSS_A1] = p
         out[P_SLOPE], out[P_OFFSET] = self.slope, self.offset
         out[P_PEAK] = self.peak_friction()
@@ -139,7 +174,7 @@ def step(p, s, bridge, nut, v_bow, bowing):
     y = p[P_LOSS_B0] * v_bridge + p[P_LOSS_A1] * s[S_LOSS_Y]
     s[S_LOSS_Y] = y
     bridge_refl = -y
-    nut_refl = -read_line(nut, write, p[P_DN])
+    nut_refl = -p[P_NUT_GAIN] * read_line(nut, write, p[P_DN])
     v_h = bridge_refl + nut_refl
     v_delta = v_bow - v_h
     u = 0.0

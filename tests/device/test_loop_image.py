@@ -28,7 +28,7 @@ def test_image_is_the_listed_parts(loop):
     string = StringDesign(5000.0, calibration.F0)
     expected = (struct.pack("<I", 5000) + bytes(int(k) for k in bank.kinds)
                 + struct.pack(f"<{bank.params.size}d", *bank.params.ravel())
-                + struct.pack("<7d", *string.params()) + struct.pack("<3d", *DeviceLimits().params(5000.0))
+                + struct.pack("<8d", *string.params()) + struct.pack("<3d", *DeviceLimits().params(5000.0))
                 + struct.pack("<3d", calibration.VELOCITY_SCALE, bow_table.peak_friction(string.slope, string.offset),
                               bow_table.breakaway(string.slope, string.offset)))
     assert image(5000, loop.control.arrays) == expected

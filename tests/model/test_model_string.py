@@ -5,7 +5,7 @@ import pytest
 from scipy import signal
 
 from studyapp.model import bow_table
-from studyapp.model.bowed_string import StringDesign
+from studyapp.model.bowed_string import P_LOSS_B0, P_NUT_GAIN, StringDesign
 from studyapp.model.calibration import F0
 
 from .conftest import bow
@@ -30,10 +30,13 @@ def test_pitch_other_strings(f0, fft_peak):
 def test_loss_filter_is_the_same_lowpass_at_every_rate(rate):
     d = StringDesign(rate, F0)
     assert 0.0 < d.pole < 1.0  # STK's pole 0.75 - 0.2 * 22050 / rate turns negative below 5.88 kHz
-    b0 = d.params()[2]
-    # DC gain is the loss; the one-pole's gain at 100 Hz is the analog prototype's within 1%
-    w, h = signal.freqz([b0], [1.0, -d.pole], worN=[0.0, 100.0], fs=rate)
+    p = d.params()
+    b0, g_nut = p[P_LOSS_B0], p[P_NUT_GAIN]
+    # the round trip (nut gain times the bridge filter) has DC gain loss; its gain at 100 Hz is the analog
+    # prototype's within 1%; the nut side keeps loss^(1 - beta) of it (bowed_string.py, issue 42)
+    w, h = signal.freqz([b0 * g_nut], [1.0, -d.pole], worN=[0.0, 100.0], fs=rate)
     assert abs(h[0]) == pytest.approx(d.loss, rel=1e-12)
+    assert g_nut == pytest.approx(d.loss ** (1.0 - d.beta), rel=1e-15)
     analog = d.loss / np.sqrt(1.0 + (100.0 / d.f_loss) ** 2)
     assert abs(h[1]) == pytest.approx(analog, rel=0.01)
     # the loop delay at f0 is exactly rate / f0 (lines plus the loss filter's phase delay),
