@@ -121,10 +121,11 @@ def order(medians):
     return " < ".join(f"{c} {v:.3g}" for c, v in ranked)
 
 
-def plot(rows, path):
+def plot(rows, path, seeds):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     import numpy as np
 
     frame = pd.DataFrame(rows)
@@ -152,13 +153,21 @@ def plot(rows, path):
             if sweep == "band":
                 axes[row, col].set_xscale("log")
         axes[0, col].set_yscale("log")
-        axes[0, col].set_ylabel("breakdown F_max median (N)")
+        axes[0, col].yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+        axes[0, col].yaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+        axes[0, col].set_ylabel(f"breakdown F_max, median of seeds {seeds} (N)")
         axes[1, col].set_ylabel("Spearman's rho against the paper's Fig. 7")
-        axes[1, col].set_xlabel(label + (f" (white drawn at {white_at:g})" if sweep == "band" else ""))
-        axes[1, col].set_ylim(-1.05, 1.05)
+        axes[1, col].set_xlabel(label)
+        if sweep == "band":
+            ticks = sorted({float(x) for x in part[x_name].replace(np.inf, white_at)})
+            axes[1, col].set_xticks(ticks, [("white" if t == white_at else f"{t:g}") for t in ticks])
+            axes[1, col].xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+        rhos = part[part["quantity"].str.endswith("rho")]["value"]
+        axes[1, col].set_ylim(min(-0.1, float(rhos.min()) - 0.05) if len(rhos) else -0.1, 1.0)
+        axes[1, col].axhline(0.0, color="grey", lw=0.5)
         axes[1, col].legend(fontsize=8)
     axes[0, 0].legend(fontsize=7, ncol=2)
-    fig.suptitle("The nine conditions against the LVDT (dotted: the documented sensor)")
+    fig.suptitle("The nine conditions against the LVDT (5 kHz, bowing; dotted: the documented sensor)")
     fig.tight_layout()
     fig.savefig(path, dpi=90)
 
@@ -217,7 +226,7 @@ def main(argv=None):
         writer = csv.DictWriter(f, FIELDS)
         writer.writeheader()
         writer.writerows(rows)
-    plot(rows, out / "lvdt_sensitivity.png")
+    plot(rows, out / "lvdt_sensitivity.png", seeds)
     command = "PYTHONPATH=. python scripts/lvdt_sensitivity.py " + shlex.join(argv if argv is not None else sys.argv[1:])
     print(f"Generated on {datetime.date.today().isoformat()} by `{command}`.\n")
     print(f"Breakdown (5 kHz, strokes, seeds {seeds}): rho of the medians against the paper's Fig. 7, and the order.\n")
