@@ -73,7 +73,7 @@ def parse_seeds(text, option):
 
 def environment(band, noise_um):
     return {sensors.BAND_VARIABLE: repr(band) if math.isfinite(band) else "inf",
-            sensors.NOISE_VARIABLE: repr(noise_um * 1e-6)}
+            sensors.NOISE_VARIABLE: f"{noise_um:g}e-6"}
 
 
 def breakdown_point(task):

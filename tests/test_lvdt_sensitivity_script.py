@@ -16,7 +16,7 @@ import lvdt_sensitivity as ls  # noqa: E402
 def test_the_two_sweeps_meet_once_at_the_documented_sensor():
     grid = ls.points([100.0, 250.0, math.inf], [5.0, 15.0])
     assert grid == [("band", 100.0, 15.0), ("band", 250.0, 15.0), ("band", math.inf, 15.0), ("noise", 250.0, 5.0)]
-    assert ls.environment(math.inf, 5.0) == {"STUDYAPP_LVDT_BAND": "inf", "STUDYAPP_LVDT_NOISE": "5e-06"}
+    assert ls.environment(math.inf, 5.0) == {"STUDYAPP_LVDT_BAND": "inf", "STUDYAPP_LVDT_NOISE": "5e-6"}
 
 
 @pytest.mark.parametrize("args, says", [(["--bands", "250,wide"], "--bands '250,wide': 'wide' is not allowed"),
