@@ -43,6 +43,9 @@ docs/model.md's sensor table gives every parameter with its source.
   to 500 Hz", modelled as a 2nd-order Butterworth low-pass at 500 Hz (maximally
   flat, -3 dB at 500 Hz: our reading of "flat up to 500 Hz"), plus 0.115 mm/s RMS
   Gaussian noise added after it (the paper measured the noise after A/D conversion).
+  Trans-Tek's note on LVT frequency response puts the band in the coils' L / R
+  with the load, a first-order pole whose corner the paper does not give; the
+  2nd order at 500 Hz is the stricter reading (more delay), kept.
 - Accelerometer (PCB 352C22, a piezoelectric ICP sensor): "frequency range up
   to 10 kHz" and "a constant RMS noise level of 0.22 m/s^2 ... when at rest".
   One sample is
