@@ -148,6 +148,11 @@ GENERATORS_AFTER_BREAKDOWN = (
     Generator("pilot", "docs/experiment.md (The simulated participant: the in-silico pilot), docs/study/pilot.csv",
               ((PY, "scripts/pilot.py", "--seeds", "1-6,7-12", "-o", "{out}/pilot"),),
               {"pilot/pilot.csv": "docs/study/pilot.csv"}),
+    Generator("lvdt-sensitivity", "docs/model.md (The sensors from their data sheets: breakdown and rho against the "
+              "LVDT's bandwidth and noise), lvdt_sensitivity.png, lvdt_sensitivity.csv",
+              ((PY, "scripts/lvdt_sensitivity.py", "-o", "{out}/lvdt"),),
+              {"lvdt/lvdt_sensitivity.png": "docs/lvdt_sensitivity.png",
+               "lvdt/lvdt_sensitivity.csv": "docs/lvdt_sensitivity.csv"}),
     Generator("blas-kernels", "docs/reproducibility.md (The same bits under every BLAS kernel)",
               ((PY, "scripts/blas_kernels.py"),)),
     Generator("sensitivity", "docs/reproducibility.md (Sensitivity to one rounding); scripts/quoted_figures.py's spreads",

@@ -22,10 +22,11 @@ The criterion's spread is calibrated, not measured on people: the paper reports
 only that the within-participant variance of Fig. 7 was "on average 61 percent
 lower" (Sec. 9.1), read as 1 - s_w^2 / (s_w^2 + s_b^2) of log F_max
 (studyapp.analysis.pilot). In knob positions (each 2/126 decade on
-sinclair2014's knob) the pilot's within-participant variance is s_w^2 = 5.3
-(the hand jitter's 1.5^2 and the staircase's landing; seeds 1-12, 2026-11-27),
+sinclair2014's knob) the pilot's within-participant variance is s_w^2 = 4.5
+(the hand jitter's 1.5^2 and the staircase's landing; seeds 1-12, 2026-11-29,
+with issue 42's LVDT; 5.3 with the white LVDT before it, which gave 2.9),
 and the criterion is all that differs between participants, so s_b^2 =
-criterion_spread^2 = 0.61 / 0.39 * 5.3 = 8.3: 2.9 positions (10 % of F_max).
+criterion_spread^2 = 0.61 / 0.39 * 4.5 = 7.1: 2.7 positions (9 % of F_max).
 The hand jitter is left as it was: with it each participant's ranking agrees
 with the global one at rho 0.95-1, as the paper's did (rho > 0.9).
 
@@ -48,7 +49,7 @@ from studyapp.experiment.tasks import task_type
 from studyapp.model.controls import KNOB_MAX
 
 
-CRITERION_SPREAD = 2.9  # knob positions, the personal criterion's standard deviation (calibrated, see above)
+CRITERION_SPREAD = 2.7  # knob positions, the personal criterion's standard deviation (calibrated, see above)
 
 
 class TrialRestarted(Exception):

@@ -1,12 +1,51 @@
-"""The device's sensors with the paper's measured figures (Sec. 4.2).
+"""The device's sensors, each modelled as the instrument it is from its data sheet and the paper (Sec. 4.2).
 
-- LVDT position: the true position plus Gaussian noise of 15 um RMS ("measured
-  ... when at rest"), quantised by a 16-bit converter over the 2.2 cm range
-  (LSB = 0.022 / 2^16 = 0.34 um) and limited to that range.
+docs/model.md's sensor table gives every parameter with its source.
+
+- LVDT position. An LVDT's secondaries carry the excitation (the carrier,
+  20 Hz - 20 kHz on the AD598) modulated by the core's position; the
+  conditioner demodulates it and low-passes the result, and the device's
+  16-bit converter samples that. One sample is
+
+      x_m = Q(LP(x + sigma_c w_c) + sigma_a w_a)
+
+  * LP, the conditioner's output low-pass: the AD598 sets its bandwidth with
+    three equal capacitors, C2 = C3 = C4 = 1e-4 F Hz / f_subsystem (its
+    design step 8; the example 250 Hz, 0.4 uF), so three poles: a 3rd-order
+    Butterworth at ``lvdt_band`` (the Butterworth alignment is our
+    assumption; the data sheet's Figs. 13-15 plot the response), designed by
+    the bilinear transform as a first-order section times a second-order one
+    of Q = 1 (the 3rd-order Butterworth's factors). The signal and the
+    conditioner's noise pass it together: the position is delayed (2 /
+    (2 pi f_b) at DC, 1.3 ms at 250 Hz) and its noise band-limited.
+    ``lvdt_band = inf``: no band limit (the former white model).
+  * sigma_c w_c, the conditioner's noise, white before LP, so coloured by it
+    at the output.
+  * sigma_a w_a, the converter's own white noise (``lvdt_adc_noise``, 1 LSB
+    RMS: our choice, the transition noise of a 16-bit converter; the
+    paper's board does not name its converter).
+  * Q, 16-bit quantisation over the 2.2 cm range (LSB = 0.022 / 2^16 =
+    0.34 um) and the range's limits.
+  * The carrier's ripple (at twice the carrier) is not modelled: with the
+    carrier at least ten times the bandwidth (the rule the data sheets'
+    examples follow), three poles pass at most (1 / 20)^3 = 1.25e-4 of a
+    full-wave demodulator's ripple (2/3 of its output), 0.9 um at the 11 mm
+    full scale: below 3 LSB and 6 % of the noise (it would alias to a fixed
+    tone where the carrier is above half the rate).
+
+  The paper gives the total: 15 um RMS "in the sampled analog signal when at
+  rest". sigma_c is set so that the total is that at any rate and any band:
+  sigma_c^2 G + sigma_a^2 + LSB^2 / 12 = lvdt_noise^2, G = sum h[k]^2 the
+  low-pass's power gain (``lvdt_power_gain``, summed over its impulse
+  response). The analog noise's variance does not depend on the rate that
+  samples it, so neither does the model's.
 - LVT tachometer (Trans-Tek Series 100, 0112-0000): "flat frequency response up
   to 500 Hz", modelled as a 2nd-order Butterworth low-pass at 500 Hz (maximally
   flat, -3 dB at 500 Hz: our reading of "flat up to 500 Hz"), plus 0.115 mm/s RMS
   Gaussian noise added after it (the paper measured the noise after A/D conversion).
+  Trans-Tek's note on LVT frequency response puts the band in the coils' L / R
+  with the load, a first-order pole whose corner the paper does not give; the
+  2nd order at 500 Hz is the stricter reading (more delay), kept.
 - Accelerometer (PCB 352C22, a piezoelectric ICP sensor): "frequency range up
   to 10 kHz" and "a constant RMS noise level of 0.22 m/s^2 ... when at rest".
   One sample is
@@ -26,7 +65,7 @@
     hold one. Designed by the bilinear transform (scipy's ``butter(1, f_c,
     "high")``); its frequency warping at 0.33 Hz is negligible at every rate.
   * LP, the band limit: a 2nd-order Butterworth low-pass at 10 kHz when that
-    is below 0.45 * rate, else none (the sensor's band covers the sampled one).
+    is below 0.49 * rate, else none (the sensor's band covers the sampled one).
   * n_lf, the low-frequency error the paper names without a figure (Sec. 5.6:
     "our accelerometer measurement does not adhere to its bias-free
     assumptions"; Sec. 7.1: R_a "perhaps reflecting problems due to
@@ -63,14 +102,22 @@
   n_lf starts at 0 and reaches its stationary level within 1 / (2 pi f_lf) =
   80 ms.
 
-Cut-offs above 0.45 * rate are lowered to 0.45 * rate (the estimators' own
+Cut-offs above 0.49 * rate are lowered to 0.49 * rate (the estimators' own
 rule, ``studyapp.estimators.spec.NYQUIST_FRACTION``), so every rate from 1 kHz works.
 
 The noises are drawn per block by the loop, each from its own seeded generator
-(the accelerometer's white and low-frequency parts from two); the compiled
-functions here only shape and add them.
+(the LVDT's conditioner and converter parts from two, the accelerometer's white
+and low-frequency parts from two); the compiled functions here only shape and add them.
+
+``from_environment`` reads the LVDT's band and noise from ``STUDYAPP_LVDT_BAND``
+(Hz, or ``inf``: no band limit) and ``STUDYAPP_LVDT_NOISE`` (m RMS at rest), as
+``STUDYAPP_NUDGE`` is read (nudge.py): so that a sweep (scripts/lvdt_sensitivity.py)
+can vary them under whole sessions (``studyapp run``); provenance records them.
 """
 
+import dataclasses
+import functools
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,6 +125,7 @@ from numba import njit
 
 from studyapp.estimators.biquad import butter_section, section_from_sos
 from studyapp.estimators.butterworth import sos_row
+from studyapp.errors import ParameterError
 from studyapp.estimators.spec import NYQUIST_FRACTION
 
 
@@ -85,7 +133,9 @@ from studyapp.estimators.spec import NYQUIST_FRACTION
 class SensorSpec:
     """The paper's sensor figures (SI units); see the module docstring for sources."""
 
-    lvdt_noise: float = 15e-6  # m RMS
+    lvdt_noise: float = 15e-6  # m RMS at rest, in total
+    lvdt_band: float = 250.0  # Hz, the conditioner's -3 dB bandwidth (math.inf: none)
+    lvdt_adc_noise: float = 0.022 / 2 ** 16  # m RMS, the converter's own white noise (1 LSB, assumed)
     lvdt_bits: int = 16
     lvdt_range: float = 0.022  # m, full scale
     lvt_band: float = 500.0  # Hz
@@ -102,6 +152,23 @@ class SensorSpec:
         return self.lvdt_range / 2.0 ** self.lvdt_bits
 
     @property
+    def lvdt_conditioner_variance(self):
+        """What the converter (noise and quantisation) leaves of the total variance at rest (m^2)."""
+        return self.lvdt_noise ** 2 - self.lvdt_adc_noise ** 2 - self.lvdt_lsb ** 2 / 12.0
+
+    def lvdt_sections(self, rate):
+        """The conditioner's low-pass as two 5-number sections (first order, then Q = 1), or two pass-throughs."""
+        if not np.isfinite(self.lvdt_band):
+            return PASS.copy(), PASS.copy()
+        f = min(self.lvdt_band, NYQUIST_FRACTION * rate)
+        return section_from_sos(sos_row(1, f, rate, "low")), lowpass_section(f, 1.0, rate)
+
+    def lvdt_drive(self, rate):
+        """sigma_c: the conditioner's noise before the low-pass that gives ``lvdt_noise`` in total at rest."""
+        first, second = self.lvdt_sections(rate)
+        return float(np.sqrt(self.lvdt_conditioner_variance / lvdt_power_gain(tuple(first), tuple(second))))
+
+    @property
     def acc_corner(self):
         """The AC coupling's -3 dB corner (Hz): a first-order high-pass, ``acc_low_tolerance`` low at the limit."""
         return self.acc_low_limit * float(np.sqrt(1.0 / (1.0 - self.acc_low_tolerance) ** 2 - 1.0))
@@ -116,7 +183,7 @@ class SensorSpec:
         return butter_section(min(self.lvt_band, NYQUIST_FRACTION * rate), rate)
 
     def acc_section(self, rate):
-        """The accelerometer's low-pass, or a pass-through section when its band exceeds 0.45 * rate."""
+        """The accelerometer's low-pass, or a pass-through section when its band exceeds 0.49 * rate."""
         if self.acc_band >= NYQUIST_FRACTION * rate:
             return np.array([1.0, 0.0, 0.0, 0.0, 0.0])
         return butter_section(self.acc_band, rate)
@@ -138,7 +205,8 @@ class SensorSpec:
     def params(self, rate):
         """Packed for the compiled loop: see the ``SP_*`` indices."""
         p = np.zeros(N_PARAMS)
-        p[SP_LVDT_NOISE] = self.lvdt_noise
+        p[SP_LVDT_DRIVE] = self.lvdt_drive(rate)
+        p[SP_LVDT_ADC] = self.lvdt_adc_noise
         p[SP_LVDT_LSB] = self.lvdt_lsb
         p[SP_LVDT_HALF] = self.lvdt_range / 2.0
         p[SP_LVT_NOISE] = self.lvt_noise
@@ -148,7 +216,75 @@ class SensorSpec:
         p[SP_LVT:SP_LVT + 5] = self.lvt_section(rate)
         p[SP_ACC:SP_ACC + 5] = self.acc_section(rate)
         p[SP_ACC_HP:SP_ACC_HP + 5] = self.acc_coupling_section(rate)
+        p[SP_LVDT_LP1:SP_LVDT_LP1 + 5], p[SP_LVDT_LP2:SP_LVDT_LP2 + 5] = self.lvdt_sections(rate)
         return p
+
+
+PASS = np.array([1.0, 0.0, 0.0, 0.0, 0.0])
+
+
+def lowpass_section(f, q, rate):
+    """A second-order low-pass of quality ``q`` at ``f`` Hz by the bilinear transform, prewarped at ``f``.
+
+    H(s) = w^2 / (s^2 + w s / q + w^2) with s = (w / K) (z - 1) / (z + 1), K = tan(pi f / rate):
+    b0 = b2 = K^2 / d, b1 = 2 b0, a1 = 2 (K^2 - 1) / d, a2 = (1 - K / q + K^2) / d,
+    d = 1 + K / q + K^2. With q = 1 and a first-order section at the same f it is
+    the 3rd-order Butterworth (its poles at -w and w exp(+-j 2 pi / 3)).
+    """
+    k = np.tan(np.pi * f / rate)
+    d = 1.0 + k / q + k * k
+    b0 = k * k / d
+    return np.array([b0, 2.0 * b0, b0, 2.0 * (k * k - 1.0) / d, (1.0 - k / q + k * k) / d])
+
+
+@functools.lru_cache(maxsize=256)
+def lvdt_power_gain(first, second, tail=1e-13):
+    """sum h[k]^2 of the two sections in series: their impulse response summed until its state is below ``tail``.
+
+    Plain float operations in a fixed order (no BLAS: the same bits on every machine, issue 39)."""
+    s = [0.0, 0.0, 0.0, 0.0]
+    total, x = 0.0, 1.0
+    for _ in range(10_000_000):
+        y = first[0] * x + s[0]
+        s[0] = first[1] * x - first[3] * y + s[1]
+        s[1] = first[2] * x - first[4] * y
+        z = second[0] * y + s[2]
+        s[2] = second[1] * y - second[3] * z + s[3]
+        s[3] = second[2] * y - second[4] * z
+        total += z * z
+        x = 0.0
+        if max(abs(s[0]), abs(s[1]), abs(s[2]), abs(s[3])) < tail:
+            return total
+    raise ValueError("the LVDT's low-pass does not settle")
+
+
+def _environment_number(name, default, low):
+    text = os.environ.get(name, "").strip()
+    if not text:
+        return default
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > low) or np.isnan(value):
+        raise ParameterError(f"environment variable {name}={text!r}: allowed is a number above {low:g}"
+                             + (" or inf" if name == BAND_VARIABLE else ""))
+    return value
+
+
+BAND_VARIABLE = "STUDYAPP_LVDT_BAND"
+NOISE_VARIABLE = "STUDYAPP_LVDT_NOISE"
+
+
+def from_environment():
+    """The sensors with the LVDT's band and noise from ``STUDYAPP_LVDT_BAND`` / ``STUDYAPP_LVDT_NOISE`` if set."""
+    spec = SensorSpec()
+    band = _environment_number(BAND_VARIABLE, spec.lvdt_band, 0.0)
+    noise = _environment_number(NOISE_VARIABLE, spec.lvdt_noise, 0.0)
+    if not np.isfinite(noise) or noise ** 2 <= spec.lvdt_adc_noise ** 2 + spec.lvdt_lsb ** 2 / 12.0:
+        raise ParameterError(f"environment variable {NOISE_VARIABLE}={noise!r}: allowed is a finite number of "
+                             f"metres above the converter's {np.sqrt(spec.lvdt_adc_noise ** 2 + spec.lvdt_lsb ** 2 / 12):.3g}")
+    return dataclasses.replace(spec, lvdt_band=band, lvdt_noise=noise)
 
 
 def lf_gain(rho, hp):
@@ -168,26 +304,34 @@ def lf_gain(rho, hp):
     return (c * c + 2.0 * c * p * p_ny + r * b0 * b0) / (1.0 - p * p)
 
 
-(SP_LVDT_NOISE, SP_LVDT_LSB, SP_LVDT_HALF, SP_LVT_NOISE, SP_ACC_NOISE, SP_ACC_LF_POLE,
+(SP_LVDT_DRIVE, SP_LVDT_LSB, SP_LVDT_HALF, SP_LVT_NOISE, SP_ACC_NOISE, SP_ACC_LF_POLE,
  SP_ACC_LF_DRIVE) = range(7)
 SP_LVT = 7
 SP_ACC = 12
 SP_ACC_HP = 17
-N_PARAMS = 22
-# state: LVT section (2), accelerometer low-pass (2), AC coupling (2), low-frequency noise (1)
+SP_LVDT_ADC = 22
+SP_LVDT_LP1 = 23
+SP_LVDT_LP2 = 28
+N_PARAMS = 33
+# state: LVT section (2), accelerometer low-pass (2), AC coupling (2), low-frequency noise (1), the LVDT's
+# low-pass (2 + 2)
 SS_LVT = 0
 SS_ACC = 2
 SS_ACC_HP = 4
 SS_ACC_LF = 6
-N_STATE = 7
+SS_LVDT_LP1 = 7
+SS_LVDT_LP2 = 9
+N_STATE = 11
 
 
 @njit(cache=True, inline="always")
-def lvdt(p, x_true, noise):
-    """One LVDT sample: ``noise`` is a standard normal draw."""
+def lvdt(p, s, x_true, noise, noise_adc):
+    """One LVDT sample: ``noise`` (the conditioner's) and ``noise_adc`` (the converter's) are standard normal draws."""
     lsb = p[SP_LVDT_LSB]
     half = p[SP_LVDT_HALF]
-    x = np.floor((x_true + p[SP_LVDT_NOISE] * noise) / lsb + 0.5) * lsb
+    demodulated = section_at(p, SP_LVDT_LP1, s, SS_LVDT_LP1, x_true + p[SP_LVDT_DRIVE] * noise)
+    demodulated = section_at(p, SP_LVDT_LP2, s, SS_LVDT_LP2, demodulated)
+    x = np.floor((demodulated + p[SP_LVDT_ADC] * noise_adc) / lsb + 0.5) * lsb
     if x > half - lsb:
         return half - lsb
     if x < -half:

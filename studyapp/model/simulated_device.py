@@ -48,8 +48,9 @@ one compiled function that calls the loop's compiled controller
 (control.sample) between the same two steps, releasing the GIL (``nogil``:
 in the live engine the audio device's callback thread needs it). Python runs
 only at block boundaries there: it draws the block's sensor noise from seeded
-generators (one per sensor, two for the accelerometer's white and
-low-frequency noise, two for the link's jitter and frame loss, so the stream
+generators (one per sensor, two for the LVDT's conditioner and converter
+noise and two for the accelerometer's white and low-frequency noise, two for
+the link's jitter and frame loss, so the stream
 does not depend on how the run is cut into blocks or samples), the link's
 per-packet delays, and the gesture's target. A gesture defined per
 block (``Live``, which ramps to its new target across the next block) ramps
@@ -109,9 +110,9 @@ def grip_force(dp, ds):
 
 
 @njit(cache=True, inline="always")
-def sense(use_acc, ds, snp, sns, noise_x, noise_v, noise_a, noise_lf):
+def sense(use_acc, ds, snp, sns, noise_x, noise_q, noise_v, noise_a, noise_lf):
     """The sensors on the state now: (x_m, a_m, v_m)."""
-    x_m = sensors.lvdt(snp, ds[DS_X], noise_x)
+    x_m = sensors.lvdt(snp, sns, ds[DS_X], noise_x, noise_q)
     v_m = sensors.lvt(snp, sns, ds[DS_V], noise_v)
     a_m = sensors.accelerometer(snp, sns, ds[DS_A], noise_a, noise_lf) if use_acc else 0.0
     return x_m, a_m, v_m
@@ -166,7 +167,7 @@ def actuate(dp, ds, hp, f, f_arm):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, noise_v, noise_a, noise_lf,
+def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, noise_q, noise_v, noise_a, noise_lf,
               link_s, delays, out, est_out):
     """``target.shape[0]`` samples of the device and the loop's controller ``c``: control.sample's sequence."""
     ctl, state, lp, ls, kinds, est_s, est_p, sp, ss, bridge, nut, body_p, body_s, mon_p, mon_s, mic_p, mic_s = c
@@ -178,7 +179,7 @@ def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, nois
         a = ds[DS_A]
         f_arm = hand_force(hp, ds, target[k], target_v[k], target_a[k])
         f_hand = grip_force(dp, ds)
-        x_m, a_m, v_m = sense(use_acc, ds, snp, sns, noise_x[k], noise_v[k], noise_a[k], noise_lf[k])
+        x_m, a_m, v_m = sense(use_acc, ds, snp, sns, noise_x[k], noise_q[k], noise_v[k], noise_a[k], noise_lf[k])
         control.check_sensors(state, k, x_m, a_m, v_m)
         # control.source_velocity and control.observe, written out: as inline calls they cost 15-20 ns
         # of a 48 kHz sample's 0.8 us (measured 2026-11-23); the per-sample test holds the two equal
@@ -199,8 +200,8 @@ def run_block(c, dp, ds, hp, snp, sns, target, target_v, target_a, noise_x, nois
 
 
 @njit(cache=True, error_model="numpy")
-def read_once(dp, ds, snp, sns, noise_x, noise_v, noise_a, noise_lf):
-    return sense(dp[DP_ACCELEROMETER] != 0.0, ds, snp, sns, noise_x, noise_v, noise_a, noise_lf)
+def read_once(dp, ds, snp, sns, noise_x, noise_q, noise_v, noise_a, noise_lf):
+    return sense(dp[DP_ACCELEROMETER] != 0.0, ds, snp, sns, noise_x, noise_q, noise_v, noise_a, noise_lf)
 
 
 @njit(cache=True, error_model="numpy")
@@ -221,7 +222,8 @@ def write_once(dp, ds, hp, f, f_arm, link_s, delay):
 class SimulatedDevice(HapticDevice):
     """The simulated device and the virtual hand holding it (calibration.py documents the constants).
 
-    ``seed`` seeds the sensors' noise and the link's draws; ``accelerometer=False`` leaves the accelerometer out
+    ``seed`` seeds the sensors' noise and the link's draws; ``sensor_spec`` (None: sensors.from_environment(), the
+    data sheets' figures unless STUDYAPP_LVDT_BAND / _NOISE say otherwise); ``accelerometer=False`` leaves the accelerometer out
     (it reads 0); ``link`` (a link.LinkSpec, default ideal) is the link between the host and the device;
     ``nudge``: the end-effector starts n rounding steps off rest (nudge.py; None: ``STUDYAPP_NUDGE``, default 0).
     """
@@ -234,7 +236,7 @@ class SimulatedDevice(HapticDevice):
         self.hand = hand_impedance or hand.HandImpedance(
             calibration.HAND_MASS, calibration.HAND_STIFFNESS, calibration.HAND_DAMPING, calibration.HAND_REACTION,
             calibration.GRIP_STIFFNESS, calibration.GRIP_DAMPING)
-        self.sensor_spec = sensor_spec or sensors.SensorSpec()
+        self.sensor_spec = sensor_spec or sensors.from_environment()
         self.accelerometer = bool(accelerometer)
         self._dp = np.zeros(N_PARAMS)
         self._dp[DP_T] = 1.0 / self.rate
@@ -254,11 +256,12 @@ class SimulatedDevice(HapticDevice):
         self._snp = self.sensor_spec.params(self.rate)
         self._sns = np.zeros(sensors.N_STATE)
         # the accelerometer's low-frequency noise is the 4th child, so the first three streams stay as they were;
-        # the link's two draws are the 5th and 6th (spawn(6)[:4] == spawn(4))
-        streams = np.random.SeedSequence(int(seed)).spawn(6)
+        # the link's two draws are the 5th and 6th, the LVDT converter's noise the 7th (spawn(7)[:4] == spawn(4))
+        streams = np.random.SeedSequence(int(seed)).spawn(7)
         self._rng_x, self._rng_v, self._rng_a, self._rng_lf = (np.random.default_rng(s) for s in streams[:4])
+        self._rng_q = np.random.default_rng(streams[6])
         self.link = link or IDEAL
-        self._link = Link(self.link, self.rate, streams[4:])
+        self._link = Link(self.link, self.rate, streams[4:6])
         self._sample = 0
         self._gesture = Hold()
         self._gesture_start = 0
@@ -286,15 +289,16 @@ class SimulatedDevice(HapticDevice):
 
     def _noise(self, n):
         nx = self._rng_x.standard_normal(n)
+        nq = self._rng_q.standard_normal(n)
         nv = self._rng_v.standard_normal(n)
         if self.accelerometer:
-            return nx, nv, self._rng_a.standard_normal(n), self._rng_lf.standard_normal(n)
-        return nx, nv, np.zeros(n), np.zeros(n)
+            return nx, nq, nv, self._rng_a.standard_normal(n), self._rng_lf.standard_normal(n)
+        return nx, nq, nv, np.zeros(n), np.zeros(n)
 
     def read_sensors(self):
         self._target = tuple(float(t[0]) for t in self._targets(1))
-        nx, nv, na, nl = (float(z[0]) for z in self._noise(1))
-        return read_once(self._dp, self._ds, self._snp, self._sns, nx, nv, na, nl)
+        nx, nq, nv, na, nl = (float(z[0]) for z in self._noise(1))
+        return read_once(self._dp, self._ds, self._snp, self._sns, nx, nq, nv, na, nl)
 
     def write_force(self, force):
         target = self._target if self._target is not None else tuple(float(t[0]) for t in self._targets(1))
@@ -306,7 +310,7 @@ class SimulatedDevice(HapticDevice):
 
     def exchange(self, control, n, out, est_out):
         target, target_v, target_a = self._targets(n)
-        nx, nv, na, nl = self._noise(n)
+        nx, nq, nv, na, nl = self._noise(n)
         run_block(control.arrays, self._dp, self._ds, self._hp, self._snp, self._sns, target, target_v, target_a,
-                  nx, nv, na, nl, self._link.state, self._link.delays(n), out, est_out)
+                  nx, nq, nv, na, nl, self._link.state, self._link.delays(n), out, est_out)
         self._sample += n

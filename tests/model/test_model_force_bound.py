@@ -17,7 +17,7 @@ import pytest
 
 from studyapp.errors import ParameterError
 from studyapp.estimators.registry import SPECS
-from studyapp.model import bow_table
+from studyapp.model import bow_table, sensors
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.sources import TRUE, is_pseudo
 
@@ -74,7 +74,11 @@ def test_the_friction_is_capped_at_its_peak_everywhere():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("rate", RATES, ids=lambda r: f"{r / 1000:g}kHz")
-def test_force_within_fmax_for_every_source_and_parameter_bound(rate):
+def test_force_within_fmax_for_every_source_and_parameter_bound(rate, monkeypatch):
+    # the noisiest LVDT the sweep of issue 42 allows, white (no conditioner band): the bound is the bow table's,
+    # whatever the sensor, and only a white LVDT still drives the noisy settings into the tail at 48 and 96 kHz
+    # (with the conditioner's 250 Hz low-pass none reached it there, 2026-11-29)
+    monkeypatch.setenv(sensors.BAND_VARIABLE, "inf")
     # the 16 sources: TRUE, the LVT (sensor and estimator read the same) and the 14 estimators
     cases = [(TRUE, {})] + [(name, params) for name in SPECS for params in settings(name, rate)]
     worst, reached = [], 0
