@@ -272,6 +272,8 @@ class Emulator:
             self.link.write(self.core.tx())
             while self.core.needs_force() and not self._stop:
                 self._block()
+            if self._stop:  # the host's last frames may still be unread: a device asked to stop does not move
+                return
             self._actuate()
 
     def _lockstep_device_loop(self):

@@ -58,3 +58,43 @@ def test_lockstep_equals_the_delayed_loop(tmp_path, latency, core):
     assert np.max(np.abs(got - expected)) == 0.0
     assert np.max(np.abs(expected[:, 0])) > 1e-3  # the strokes moved the handle
     assert stats["late"] == 0 and stats["missing"] == 0 and stats["corrupt"] == 0
+
+
+def test_a_lockstep_emulator_told_to_stop_while_waiting_for_a_force_actuates_nothing():
+    """The stop signal can land while the device waits for the force of sample j and the host's DISARM is still
+    unread in the link: moving over [j, j+1] then held the last force without its tag (``missing`` += 1 in the
+    stats of a run that lost nothing; CI at ddc97c2). A device asked to stop does not move."""
+    from studyapp.device.emulator import Emulator
+
+    class Core:
+        missing = 0
+
+        def streaming(self):
+            return True
+
+        def sample(self, row):
+            pass
+
+        def tx(self):
+            return b""
+
+        def needs_force(self):
+            return True
+
+    emulator = Emulator.__new__(Emulator)
+    emulator.config = type("Config", (), {"disconnect_after": None, "lockstep": True})()
+    emulator.device_loop = False
+    emulator.info = type("Info", (), {"channels": messages.SI_CHANNELS})()
+    emulator.device = type("Device", (), {"read_sensors": lambda self: (0.0, 0.0, 0.0)})()
+    emulator.link = type("Link", (), {"write": lambda self, data: None})()
+    emulator.core = Core()
+    emulator._stop = False
+    actuated = []
+
+    def block(timeout=0.05):
+        emulator._stop = True  # SIGTERM arrives while the device waits
+
+    emulator._block = block
+    emulator._actuate = lambda: actuated.append(1)
+    emulator._lockstep()
+    assert actuated == []
