@@ -240,6 +240,8 @@ class Emulator:
             if end is not None and k * period >= end:
                 return
             self._wait(t0 + k * period)
+            if self._stop:
+                return
             self._receive()
             self._sense_and_actuate()
             k += 1

@@ -60,7 +60,8 @@ def test_lockstep_equals_the_delayed_loop(tmp_path, latency, core):
     assert stats["late"] == 0 and stats["missing"] == 0 and stats["corrupt"] == 0
 
 
-def test_a_lockstep_emulator_told_to_stop_while_waiting_for_a_force_actuates_nothing():
+@pytest.mark.parametrize("mode", ["lockstep", "clocked"])
+def test_an_emulator_told_to_stop_while_waiting_actuates_nothing(mode):
     """The stop signal can land while the device waits for the force of sample j and the host's DISARM is still
     unread in the link: moving over [j, j+1] then held the last force without its tag (``missing`` += 1 in the
     stats of a run that lost nothing; CI at ddc97c2). A device asked to stop does not move."""
@@ -82,7 +83,7 @@ def test_a_lockstep_emulator_told_to_stop_while_waiting_for_a_force_actuates_not
             return True
 
     emulator = Emulator.__new__(Emulator)
-    emulator.config = type("Config", (), {"disconnect_after": None, "lockstep": True})()
+    emulator.config = type("Config", (), {"disconnect_after": None, "lockstep": True, "rate": 5000})()
     emulator.device_loop = False
     emulator.info = type("Info", (), {"channels": messages.SI_CHANNELS})()
     emulator.device = type("Device", (), {"read_sensors": lambda self: (0.0, 0.0, 0.0)})()
@@ -95,6 +96,8 @@ def test_a_lockstep_emulator_told_to_stop_while_waiting_for_a_force_actuates_not
         emulator._stop = True  # SIGTERM arrives while the device waits
 
     emulator._block = block
+    emulator._wait = lambda target: block()
     emulator._actuate = lambda: actuated.append(1)
-    emulator._lockstep()
+    emulator._sense_and_actuate = lambda: actuated.append(1)
+    emulator._lockstep() if mode == "lockstep" else emulator._clocked()
     assert actuated == []
