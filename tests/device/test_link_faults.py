@@ -211,3 +211,26 @@ def test_a_device_at_another_rate_is_refused(tmp_path):
         with pytest.raises(ParameterError) as err:
             LinkDevice(path, RATE)
     assert "rate 4000 Hz, the loop runs at 5000 Hz" in str(err.value)
+
+
+@pytest.mark.parametrize("try_", range(TRIES))
+def test_a_killed_host_leaves_a_device_loop_disarmed_by_its_keepalive_watchdog(tmp_path, try_):
+    """The loop on the device (protocol 2) runs on without the host; only the keep-alive watchdog stops it. A host
+    killed mid-run (SIGKILL: no DISARM, no STOP) leaves the device faulted WATCHDOG and disarmed within the
+    keep-alive and the ramp down, 100 ms + 1 ms here; the test waits three times that."""
+    path = tmp_path / "device"
+    emulator = EmulatorProcess(path, "--seed", try_, "--loop", "device", "--keepalive-ms", 100).start()
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    try:
+        host = subprocess.Popen([sys.executable, "-m", "tests.device.loop_host_worker", str(path)],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=REPO)
+        assert _line(host, 300) == "running", host.stderr.read() if host.poll() is not None else "no ready line"
+        time.sleep(0.2)
+        assert host.poll() is None  # no fault before the kill: the device was armed and bowing
+        host.kill()
+        host.communicate()
+        time.sleep(0.3)
+    finally:
+        stats = emulator.stop()
+    assert stats["loop"] == "device"
+    assert stats["fault"] == messages.WATCHDOG and stats["armed"] == 0
