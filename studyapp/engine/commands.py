@@ -8,7 +8,7 @@ worker applies commands at block boundaries, in order, through a handler table
 (``worker.Worker.HANDLERS``: one method per command type).
 
 Commands whose fields could stop the worker or latch a fault (``InstallActions``,
-``SetHandTarget``) check them when made, and the worker checks them again when
+``SetHandTarget``, ``SetFmax``, ``SetVolume``) check them when made, and the worker checks them again when
 it obeys them (a command from a pipe was never made here): a bad one is a
 warning, never a dead worker (issue 41, item 17).
 
@@ -23,13 +23,15 @@ knob reaches the same mapping as a ``Control`` command, so a knob takes one
 route whatever the hand turned.
 """
 
+import math
 import time
 from dataclasses import dataclass, field
 
+from studyapp.engine.signal_chain import volume_gain
 from studyapp.errors import ParameterError
 from studyapp.model.controls import (
     KNOB_MAX, LIVE_RANGE, Bowing, FmaxKnob, FmaxLinear, HandTarget, Select, Source, Volume, as_action, as_actions,
-    hand_target, knob_step,
+    hand_target, knob_step, number,
 )
 
 
@@ -45,7 +47,11 @@ class SetSource(Command):
 
 @dataclass(frozen=True)
 class SetFmax(Command):
-    newtons: float  # clamped to the safety ceiling
+    newtons: float  # clamped to the safety ceiling by the worker, which owns it; refused here below 0 or not finite
+
+    def __post_init__(self):
+        number("F_max", self.newtons, 0.0, math.inf, "a number of newtons from 0 up (the worker clamps it to its "
+               "ceiling)")
 
 
 @dataclass(frozen=True)
@@ -73,7 +79,10 @@ class ResetString(Command):
 
 @dataclass(frozen=True)
 class SetVolume(Command):
-    gain: float  # linear, 0..4
+    gain: float  # linear, 0..VOLUME_GAIN_MAX (signal_chain.py)
+
+    def __post_init__(self):
+        volume_gain(self.gain)
 
 
 @dataclass(frozen=True)

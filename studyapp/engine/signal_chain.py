@@ -60,7 +60,7 @@ import numpy as np
 
 from studyapp.engine.reference_tone import ReferenceTone
 from studyapp.engine.resampler import Resampler
-from studyapp.errors import ParameterError
+from studyapp.model.controls import number
 from studyapp.model.stimulus_level import KNEE_DBFS, STIMULUS_GAIN
 
 CEILING_DBFS = -12.0  # the documented peak: no output sample exceeds it
@@ -80,6 +80,14 @@ def soft_limit(x, ceiling=CEILING, knee_db=KNEE_DB):
     return x
 
 
+VOLUME_GAIN_MAX = 4.0  # linear; the console's volume law (model/controls.py VOLUME_DB) reaches 1.0
+
+
+def volume_gain(value):
+    """``value`` as a linear volume gain, 0..VOLUME_GAIN_MAX; ``ParameterError`` (errors.py) naming it otherwise."""
+    return number("volume", value, 0.0, VOLUME_GAIN_MAX, f"a linear gain from 0 to {VOLUME_GAIN_MAX:g}")
+
+
 class Gain:
     """Volume and mute, ramped linearly over one block on every change so changes never click.
 
@@ -96,9 +104,7 @@ class Gain:
         return 0.0 if self.muted else self.volume
 
     def set_volume(self, volume):
-        if not 0.0 <= volume <= 4.0:
-            raise ParameterError(f"volume: {volume} is outside 0..4")
-        self.volume = float(volume)
+        self.volume = volume_gain(volume)
 
     def apply(self, block):
         target = self.target

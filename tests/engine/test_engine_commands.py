@@ -10,6 +10,7 @@ from studyapp.engine.worker import Worker
 from studyapp.errors import EngineError, UserError
 from studyapp.model.fmax_knob import fmax_from_knob
 from tests.engine.fake_worker import fake_worker
+from tests.like import Like
 
 
 def test_every_command_type_has_exactly_one_handler():
@@ -21,6 +22,22 @@ def test_every_command_type_has_exactly_one_handler():
     with pytest.raises(dataclasses.FrozenInstanceError):
         made.newtons = 3.0
     assert made.sent > 0
+
+
+@pytest.mark.parametrize("make, value, words", [
+    (cmd.SetFmax, float("nan"), "F_max = nan"), (cmd.SetFmax, -0.5, "F_max = -0.5"),
+    (cmd.SetFmax, float("inf"), "F_max = inf"), (cmd.SetFmax, "2", "F_max = '2'"),
+    (cmd.SetVolume, 4.5, "volume = 4.5"), (cmd.SetVolume, -0.1, "volume = -0.1"),
+    (cmd.SetVolume, float("nan"), "volume = nan"), (cmd.SetVolume, None, "volume = None"),
+])
+def test_f_max_and_volume_are_checked_where_they_are_made(make, value, words):
+    """A command made here with a value the worker would refuse is refused at once, naming the value and what is
+    allowed (issue 41 item 17's rule, now for SetFmax and SetVolume too); the worker still checks what a pipe
+    brings (unpickling makes no check), and a value above the ceiling is the worker's to clamp."""
+    with pytest.raises(UserError) as err:
+        make(value)
+    assert str(err.value).startswith(words) and "allowed is" in str(err.value)
+    assert cmd.SetFmax(1e3).newtons == 1e3 and cmd.SetVolume(0).gain == 0
 
 
 @pytest.fixture
@@ -40,7 +57,7 @@ def test_a_control_takes_the_installed_mapping_and_reports_its_trial(worker):
     applied = worker.events[-1]
     assert isinstance(applied, ev.Applied) and (applied.control, applied.trial, applied.block) == ("knob1", 3, 7)
     assert applied.latency > 0 and applied.origin == "screen"
-    assert applied.commands == (cmd.SetFmax(pytest.approx(fmax_from_knob(30, 40.0, 2.0)), sent=1.0),)
+    assert applied.commands == (Like(cmd.SetFmax, newtons=pytest.approx(fmax_from_knob(30, 40.0, 2.0)), sent=1.0),)
     worker.apply(cmd.Control("knob2", 0.0, sent=1.0))
     assert (worker.loop.source, worker.loop.fmax) == ("KALLEV", 1.0)
     worker.apply(cmd.Control("knob1", 30 / 127, sent=1.0))
