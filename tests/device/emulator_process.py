@@ -61,6 +61,7 @@ class Host:
         self.sender = Sender()
         self.receiver = host_receiver()
         self.inbox = []
+        self.after_wait = []  # what a wait read after the message it waited for: the next poll returns it
 
     def close(self):
         os.close(self.fd)
@@ -86,17 +87,37 @@ class Host:
                 return []
             got = self.receiver.feed(data)
             self.inbox += got
-            return got
-        return []
+            return self._with_after_wait(got)
+        return self._with_after_wait([])
+
+    def clear(self):
+        self.inbox.clear()
+        self.after_wait = []
+
+    def _with_after_wait(self, got):
+        got, self.after_wait = self.after_wait + got, []
+        return got
+
+    def next(self, timeout=10.0):
+        """What arrives next (``poll``), waiting at most ``timeout`` s for something: a lock-step device that has
+        stopped sending is a failed test, not a hung one."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            got = self.poll(min(0.5, max(0.0, end - time.monotonic())))
+            if got:
+                return got
+        raise AssertionError(f"nothing from the device within {timeout} s")
 
     def wait(self, kind, timeout=5.0, where=lambda m: True):
         end = time.monotonic() + timeout
         while True:
             for i, m in enumerate(self.inbox):
                 if isinstance(m, kind) and where(m):
+                    self.after_wait = self.inbox[i + 1:]
                     del self.inbox[:i + 1]
                     return m
             self.inbox.clear()
+            self.after_wait = []
             left = end - time.monotonic()
             if left <= 0:
                 raise AssertionError(f"no {kind.__name__} within {timeout} s")

@@ -19,6 +19,7 @@ class LoopHost:
         self.reader = frames.FrameReader()
         self.channels = None
         self.inbox = []
+        self.after_wait = []  # what a wait read after the message it waited for: the next poll returns it
         self.corrupt = 0
 
     def close(self):
@@ -34,6 +35,10 @@ class LoopHost:
                 continue
 
     def poll(self, timeout=0.0):
+        got, self.after_wait = self.after_wait, []
+        return got + self._read(timeout)
+
+    def _read(self, timeout):
         if not select.select([self.fd], [], [], timeout)[0]:
             return []
         try:
@@ -53,14 +58,26 @@ class LoopHost:
         self.inbox += got
         return got
 
+    def next(self, timeout=10.0):
+        """What arrives next (``poll``), waiting at most ``timeout`` s for something: a lock-step device that has
+        stopped sending is a failed test, not a hung one."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            got = self.poll(min(0.5, max(0.0, end - time.monotonic())))
+            if got:
+                return got
+        raise AssertionError(f"nothing from the device within {timeout} s")
+
     def wait(self, kind, timeout=10.0, where=lambda m: True):
         end = time.monotonic() + timeout
         while True:
             for i, m in enumerate(self.inbox):
                 if isinstance(m, kind) and where(m):
+                    self.after_wait = self.inbox[i + 1:]
                     del self.inbox[:i + 1]
                     return m
             self.inbox.clear()
+            self.after_wait = []
             left = end - time.monotonic()
             if left <= 0:
                 raise AssertionError(f"no {kind.__name__} within {timeout} s")

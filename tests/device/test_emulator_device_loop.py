@@ -79,7 +79,7 @@ def device_run(tmp_path, seed, segments):
         host.send(msg.Arm(0), controls.pop(0), msg.Start(PACKET, LEAD))
         host.wait(msg.State, where=lambda m: m.streaming)
         while len(rows) < SEGMENT * len(segments):
-            for m in host.poll(1.0):
+            for m in host.next():
                 if isinstance(m, lm.Telemetry):
                     assert m.sample == len(rows)
                     rows += m.rows

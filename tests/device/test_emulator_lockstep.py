@@ -40,10 +40,12 @@ def test_lockstep_equals_the_delayed_loop(tmp_path, latency, core):
     try:
         host.send(messages.Hello())
         host.wait(messages.Info)
-        host.send(messages.Start(1, latency), messages.Arm(0))
+        # armed before START: a lock-step device stands still until START, so no row is read with a State
+        host.send(messages.Arm(0))
         host.wait(messages.State, where=lambda m: m.armed)
+        host.send(messages.Start(1, latency))
         while len(rows) < N:
-            for m in host.poll(0.5):
+            for m in host.next():
                 if isinstance(m, messages.Sensors):
                     for i, row in enumerate(m.values):
                         rows.append(row)
