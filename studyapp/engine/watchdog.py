@@ -25,18 +25,21 @@ stops with it.
 
 At ``stop()`` the parent waits only while the worker shows signs of life
 (``stalled``): a running worker whose heartbeat is older than ``STALL_GRACE``
-(or its ``hang_timeout``, the longer), or a worker closing its devices that
-has said nothing for ``CLOSE_GRACE``, is stalled (stopped by SIGSTOP, hung in
-native code) and gets SIGKILL at once: a stopped process handles neither the
-stop command nor SIGTERM, and waiting out the polite timeout kept the parent
-12 s behind a stalled worker.
+(or its ``hang_timeout``, the longer; only ``hang_timeout`` once the watchdog
+has tripped on it), or a worker closing its devices that has said nothing for
+``CLOSE_GRACE``, is stalled (stopped by SIGSTOP, hung in native code) and gets
+SIGKILL at once: a stopped process handles neither the stop command nor
+SIGTERM, and waiting out the polite timeout kept the parent 12 s behind a
+stalled worker. The grace of a worker not yet tripped is 2 s because at 0.5 s
+a healthy worker descheduled on a loaded machine was killed at stop and its
+summary lost (the MIDI end-to-end test beside two ``yes``, 2026-11-29).
 """
 
 import time
 from multiprocessing.connection import wait as wait_for
 
 POLL = 0.01  # s between watchdog checks
-STALL_GRACE = 0.5  # s: a running worker's heartbeat this old at stop() means it is stalled
+STALL_GRACE = 2.0  # s: a running worker's heartbeat this old at stop() means it is stalled (unless already tripped)
 CLOSE_GRACE = 3.0  # s: a worker closing its devices may be this quiet (a device close gives up after 2 s)
 
 
@@ -104,5 +107,6 @@ class Watchdog:
         snap = self.status_block.read()
         now = time.monotonic()
         if snap["state"] == "running":
-            return now - max(snap["heartbeat"], heard) > max(STALL_GRACE, self.config.hang_timeout)
+            grace = self.config.hang_timeout if self.tripped else max(STALL_GRACE, self.config.hang_timeout)
+            return now - max(snap["heartbeat"], heard) > grace
         return now - max(snap["heartbeat"], heard) > CLOSE_GRACE

@@ -61,3 +61,15 @@ def test_stop_lets_go_of_a_stalled_worker_at_once():
     # It used to wait out its 12 s of timeouts; now it kills at once (1.55-1.68 s from SIGSTOP to
     # `studyapp live`'s exit, docs/engine.md). The margin is for a loaded CI machine, not a speed figure.
     assert took < 6.0
+
+
+def test_stop_waits_out_a_second_of_silence_from_a_worker_the_watchdog_never_tripped_on():
+    """A worker descheduled for a second as it is asked to stop (a loaded machine) is slow, not stalled: stop()
+    gets its summary instead of killing it. Before, 0.5 s of silence at stop() was a kill and the summary was
+    lost (the MIDI end-to-end test beside two ``yes``). The drill's one-second stall is that silence."""
+    from studyapp.engine import commands as cmd
+    engine = Engine(EngineConfig(rate=RATE, source="LVT")).start()
+    wait_for(lambda: engine.status()["samples"] > 0.1 * RATE)
+    engine.send(cmd.Stall(1.0))
+    summary = engine.stop()  # at once: the watchdog stops judging the worker once the parent stops it
+    assert summary is not None and not engine.tripped
