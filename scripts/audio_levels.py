@@ -27,6 +27,7 @@ follows, the loudest silence, and the tone's RMS against the rating stimulus's.
 
 import argparse
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -39,9 +40,12 @@ from studyapp.model.buzz_level import buzz_dbfs
 from studyapp.model.loop import ClosedLoop, LoopConfig
 from studyapp.model.stimulus_level import short_term_rms_dbfs, tone_peak_dbfs
 
+from quoted_figures import bowing_breakdowns  # scripts/, beside this one
+
+ROOT = Path(__file__).resolve().parents[1]
+
 FMAX = (0.0, 1.0, 5.0, stimulus_level.LINEAR_UP_TO_N, 20.0, 40.0)
 SOURCES = ("LVT", "LOWPASS", "KALLEV")
-BREAKDOWN = {"LVT": 8.29, "LOWPASS": 3.87, "KALLEV": 2.89}  # N, strokes (docs/breakdown.md)
 FACTORS = (0.5, 0.8, 1.25)
 
 
@@ -76,10 +80,11 @@ def levels(protocol):
 
 
 def rise(protocol):
+    breakdown = bowing_breakdowns((ROOT / "docs" / "breakdown.md").read_text(), protocol.rate)  # N
     print("source   seed  below pitch at " + " / ".join(f"{k:g} x" for k in FACTORS) + " breakdown (dBFS)  rise")
     for source in SOURCES:
         for seed in (0, 1, 2):
-            parts = heard(protocol, source, [k * BREAKDOWN[source] for k in FACTORS], "strokes", 2.0, seed)
+            parts = heard(protocol, source, [k * breakdown[source] for k in FACTORS], "strokes", 2.0, seed)
             b = [buzz_dbfs(y, WAV_RATE) for y in parts]
             print(f"{source:8s} {seed:4d}  " + " / ".join(f"{v:6.1f}" for v in b)
                   + f"   {b[-1] - b[0]:5.1f} dB from 0.5 x, {b[-1] - b[1]:5.1f} dB from 0.8 x")

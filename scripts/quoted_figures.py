@@ -101,6 +101,16 @@ def breakdown_tables(text):
     return found
 
 
+def bowing_breakdowns(text, rate):
+    """{source: median F_max} of ``text``'s (docs/breakdown.md's) bowing table at ``rate`` (strokes, windows in
+    seconds): read, not copied, since the table is regenerated whenever the world changes and copies went stale."""
+    for _, command, rows in breakdown_tables(text):
+        args = breakdown_settings(command)
+        if (args.gesture, args.rate, args.windows) == ("strokes", rate, "seconds"):
+            return {row["source"]: float(row["fmax_median"]) for row in rows}
+    raise ValueError(f"docs/breakdown.md has no bowing table at {rate:g} Hz")
+
+
 def breakdown_tolerance(gesture, rate):
     return BREAKDOWN_PRECISION + BREAKDOWN_ROUNDING[(gesture, float(rate))]
 

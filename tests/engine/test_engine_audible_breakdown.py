@@ -21,24 +21,14 @@ from studyapp.model.loop import ClosedLoop, LoopConfig
 from tests.experiment.test_experiment_cli import ROOT
 
 sys.path.insert(0, str(ROOT / "scripts"))
-from quoted_figures import breakdown_settings, breakdown_tables  # noqa: E402
+from quoted_figures import bowing_breakdowns  # noqa: E402
 
 SINCLAIR = load_protocol(ROOT / "protocols" / "sinclair2014.toml")
 RATE = SINCLAIR.rate
 BLOCK = 10
 
 
-def quoted_breakdowns():
-    """{source: median F_max} of docs/breakdown.md's bowing table at the protocol's rate (read, not copied: the
-    table is regenerated whenever the world changes, and a copy here went stale once)."""
-    for _, command, rows in breakdown_tables((ROOT / "docs" / "breakdown.md").read_text()):
-        args = breakdown_settings(command)
-        if (args.gesture, args.rate, args.windows) == ("strokes", RATE, "seconds"):
-            return {row["source"]: float(row["fmax_median"]) for row in rows}
-    raise AssertionError("docs/breakdown.md has no bowing table at the protocol's rate")
-
-
-BREAKDOWN = quoted_breakdowns()  # N
+BREAKDOWN = bowing_breakdowns((ROOT / "docs" / "breakdown.md").read_text(), RATE)  # N, as docs/ quotes them
 FACTORS = (0.5, 0.8, 1.25)  # x the breakdown: the hand stops at each and listens
 HOLD_S = 2.0
 RISE_DB = {"LVT": 15.0, "LOWPASS": 8.0, "KALLEV": 8.0}  # from 0.5 x to 1.25 x
