@@ -24,8 +24,11 @@ output, model/body.py, plus the handle's buzz, model/contact_mic.py); the
 signal chain (engine/signal_chain.py) scales it by one fixed gain G before
 anything else, so that the stimulus stays linear, under the output
 limiter's knee (-18 dBFS), over every F_max a protocol's knob reaches below
-1.25 x LVT's bowing breakdown (8.29 N, ``studyapp breakdown --source LVT``,
-docs/breakdown.md: 10.4 N). The string gets louder with F_max: bowed with
+1.25 x LVT's bowing breakdown as it was when the gain was set (8.29 N,
+``studyapp breakdown --source LVT``, docs/breakdown.md of 2026-11-25: 10.4 N;
+since issue 42's sensors and string LVT breaks at 7.40 N, so 10.4 N is 1.4 x
+it, and tests/engine/test_engine_gain_staging.py holds the headroom on the
+world as it is). The string gets louder with F_max: bowed with
 the strokes, its peaks rise from about -11 dB (re the audio's unit) at 1 N to
 at most LOUDEST_DB = +11 dB up to 10.4 N for any of sinclair2014's nine
 conditions (seed 0: +6.9 to +10.8 dB at 10.4 N; a knob sweep reaches +11.8 dB
@@ -52,7 +55,7 @@ WINDOW_S = 0.1  # short-term RMS window
 SETTLE_S = 1.0  # the start of bowing left out (the string building up)
 SECONDS = 6.0  # bowed per condition (several strokes)
 SINE_CREST_DB = 20.0 * math.log10(math.sqrt(2.0))  # 3.01 dB: a sine's peak over its RMS
-LVT_BREAKDOWN_N = 8.29  # LVT's bowing breakdown (N, median of 5 seeds; docs/breakdown.md, 2026-11-25)
+LVT_BREAKDOWN_N = 8.29  # the gain's design point: LVT's bowing breakdown on 2026-11-25 (N, median of 5 seeds)
 LINEAR_UP_TO_N = 1.25 * LVT_BREAKDOWN_N  # 10.4 N: the stimulus is linear (under the knee) up to here
 LOUDEST_DB = 11.0  # the loudest bowed peak up to 1.25 x LVT's breakdown, dB re the audio's unit (above)
 HEADROOM_DB = 4.0  # under the limiter's knee there
