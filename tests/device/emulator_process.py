@@ -7,10 +7,10 @@ import signal
 import subprocess
 import sys
 import time
-import tty
 from pathlib import Path
 
-from studyapp.device.streams import Sender, host_receiver
+from studyapp.device.streams import host_receiver
+from tests.device.pty_host import PtyHost
 
 ROOT = Path(__file__).resolve().parents[2]
 START_TIMEOUT = 120.0  # s: numba's cache loads slowly on a loaded machine
@@ -52,73 +52,12 @@ def stop_emulator(proc, sig=signal.SIGTERM):
     return json.loads(lines[-1][len("stats: "):])
 
 
-class Host:
-    """Frames out, messages in, over the pty; ``wait`` returns the first message of a type."""
+class Host(PtyHost):
+    """Protocol 1's messages in (streams.host_receiver); ``wait`` returns the first message of a type."""
 
     def __init__(self, path):
-        self.fd = os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
-        tty.setraw(self.fd)
-        self.sender = Sender()
+        super().__init__(path)
         self.receiver = host_receiver()
-        self.inbox = []
-        self.after_wait = []  # what a wait read after the message it waited for: the next poll returns it
 
-    def close(self):
-        os.close(self.fd)
-
-    def send(self, *items):
-        data = b"".join(self.sender.frame(m) for m in items)
-        while data:
-            select.select([], [self.fd], [], 1.0)
-            try:
-                n = os.write(self.fd, data)
-            except BlockingIOError:
-                continue
-            data = data[n:]
-
-    def send_raw(self, data):
-        os.write(self.fd, data)
-
-    def poll(self, timeout=0.0):
-        if select.select([self.fd], [], [], timeout)[0]:
-            try:
-                data = os.read(self.fd, 1 << 16)
-            except BlockingIOError:
-                return []
-            got = self.receiver.feed(data)
-            self.inbox += got
-            return self._with_after_wait(got)
-        return self._with_after_wait([])
-
-    def clear(self):
-        self.inbox.clear()
-        self.after_wait = []
-
-    def _with_after_wait(self, got):
-        got, self.after_wait = self.after_wait + got, []
-        return got
-
-    def next(self, timeout=10.0):
-        """What arrives next (``poll``), waiting at most ``timeout`` s for something: a lock-step device that has
-        stopped sending is a failed test, not a hung one."""
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            got = self.poll(min(0.5, max(0.0, end - time.monotonic())))
-            if got:
-                return got
-        raise AssertionError(f"nothing from the device within {timeout} s")
-
-    def wait(self, kind, timeout=5.0, where=lambda m: True):
-        end = time.monotonic() + timeout
-        while True:
-            for i, m in enumerate(self.inbox):
-                if isinstance(m, kind) and where(m):
-                    self.after_wait = self.inbox[i + 1:]
-                    del self.inbox[:i + 1]
-                    return m
-            self.inbox.clear()
-            self.after_wait = []
-            left = end - time.monotonic()
-            if left <= 0:
-                raise AssertionError(f"no {kind.__name__} within {timeout} s")
-            self.poll(min(left, 0.05))
+    def _decode(self, data):
+        return self.receiver.feed(data)

@@ -222,7 +222,7 @@ def test_a_killed_host_leaves_a_device_loop_disarmed_by_its_keepalive_watchdog(t
     emulator = EmulatorProcess(path, "--seed", try_, "--loop", "device", "--keepalive-ms", 100).start()
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     try:
-        host = subprocess.Popen([sys.executable, "-m", "tests.device.loop_host_worker", str(path)],
+        host = subprocess.Popen([sys.executable, "-m", "tests.device.host_worker", str(path), "loop"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=REPO)
         assert _line(host, 300) == "running", host.stderr.read() if host.poll() is not None else "no ready line"
         time.sleep(0.2)
